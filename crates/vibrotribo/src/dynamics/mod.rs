@@ -1,0 +1,18 @@
+//! Exact event-driven mechanics of the chain: closed-form flow, certified event location,
+//! impact law, sticking, release and chatter.
+//!
+//! Entry point: [`Simulator`]. Output goes to an [`Observer`]; ready-made observers are
+//! [`EventLog`], [`Trajectory`] (dense output at any time) and [`UniformSampler`].
+
+mod observer;
+mod oscillator;
+mod roots;
+mod signal;
+mod simulator;
+
+pub use observer::{
+    ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, Segment, StateView, Trajectory,
+    UniformSampler,
+};
+pub use oscillator::Oscillator;
+pub use simulator::{ContactStatus, Simulator, initial_state};

@@ -1,0 +1,131 @@
+//! Event functions as explicit functions of time, with derivatives and rigorous bounds.
+//!
+//! Every event function of the chain (a gap `d_k(t)`, a contact force `N_j(t)`) is, between
+//! events, a linear combination of
+//!
+//! - a constant,
+//! - one harmonic `f_c cos ωt + f_s sin ωt` at the excitation frequency,
+//! - homogeneous parts `a h(t) + b h'(t)` of at most two oscillators.
+//!
+//! [`Signal::jet`] returns the value and first three derivatives at a time, and bounds
+//! `B_n ≥ sup_{s ≥ t} |f^{(n)}(s)|`, n = 1..4, valid for the whole future of the current flow.
+//! The bounds come from an energy argument: any solution `g` of `g'' + 2αg' + ω_n² g = 0` with
+//! α ≥ 0 has non-increasing `E = g'² + ω_n² g²`, and every derivative of `g` is again such a
+//! solution, so `|g^{(n)}(s)| ≤ √(g^{(n)}(t)² + g^{(n+1)}(t)²/ω_n²)` for all s ≥ t. The
+//! harmonic part contributes `R ωⁿ` with R its amplitude. These bounds make the root search
+//! of [`super::roots`] certified: it can never step over a zero.
+
+use super::observer::ClusterFlow;
+use super::oscillator::{Oscillator, Phase};
+
+/// `a·h + b·h'` of the oscillator with index `osc`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Term {
+    pub osc: usize,
+    pub a: f64,
+    pub b: f64,
+}
+
+/// An explicit event function of time (see the module docs).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Signal {
+    pub constant: f64,
+    /// Magnitude of the pieces that were summed into `constant` (for rounding noise).
+    pub constant_mag: f64,
+    pub fc: f64,
+    pub fs: f64,
+    /// Sum of the amplitudes of the harmonic pieces (for rounding noise).
+    pub forced_mag: f64,
+    pub terms: [Term; 2],
+    pub nterms: usize,
+}
+
+/// Value, derivatives and bounds of a [`Signal`] at one time.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Jet {
+    /// f, f', f'', f'''.
+    pub d: [f64; 4],
+    /// `bound[n] ≥ sup_{s≥t} |f^{(n)}(s)|` for n = 1..=4 (`bound[0]` unused).
+    pub bound: [f64; 5],
+    /// Rounding noise of `d[n]`: values below it in magnitude are indistinguishable from 0.
+    pub noise: [f64; 4],
+}
+
+/// Relative rounding allowance used for noise estimates.
+const NOISE: f64 = 32.0 * f64::EPSILON;
+
+impl Signal {
+    /// Adds `coef × (oscillator's forced part + mean)` and `coef × homogeneous part`.
+    pub fn add_oscillator(&mut self, osc_index: usize, osc: &Oscillator, a: f64, b: f64, omega: f64) {
+        // a·s + b·s' with s = mean + pc cos + ps sin + h.
+        self.add_constant(a * osc.mean);
+        // s' forced = ω(ps cos − pc sin).
+        self.add_harmonic(a * osc.pc + b * omega * osc.ps, a * osc.ps - b * omega * osc.pc);
+        self.terms[self.nterms] = Term { osc: osc_index, a, b };
+        self.nterms += 1;
+    }
+
+    /// Adds a constant.
+    pub fn add_constant(&mut self, c: f64) {
+        self.constant += c;
+        self.constant_mag += c.abs();
+    }
+
+    /// Adds `c cos ωt + s sin ωt`.
+    pub fn add_harmonic(&mut self, c: f64, s: f64) {
+        self.fc += c;
+        self.fs += s;
+        self.forced_mag += c.hypot(s);
+    }
+
+    /// Value, derivatives and bounds at time `t` (phase `ph` of `t`).
+    #[inline]
+    pub fn jet(&self, t: f64, ph: Phase, clusters: &[ClusterFlow], omega: f64) -> Jet {
+        let f0 = self.fc * ph.cos + self.fs * ph.sin;
+        let f1 = omega * (self.fs * ph.cos - self.fc * ph.sin);
+        let w2 = omega * omega;
+        let mut d = [self.constant + f0, f1, -w2 * f0, -w2 * f1];
+        let amp = self.fc.hypot(self.fs);
+        let mut bound = [0.0; 5];
+        let mut mag = [
+            self.constant_mag + self.forced_mag,
+            self.forced_mag * omega,
+            self.forced_mag * w2,
+            self.forced_mag * w2 * omega,
+        ];
+        let mut wn = 1.0;
+        for b in bound.iter_mut().skip(1) {
+            wn *= omega;
+            *b = amp * wn;
+        }
+        for term in &self.terms[..self.nterms] {
+            let osc = &clusters[term.osc].oscillator;
+            let (h, h1) = osc.homogeneous(t);
+            let two_a = 2.0 * osc.alpha;
+            let wn2 = osc.wn2;
+            // g = a h + b h' solves the homogeneous ODE; g_{n+2} = −2α g_{n+1} − ω_n² g_n.
+            let h2 = -two_a * h1 - wn2 * h;
+            let mut g = [0.0; 6];
+            g[0] = term.a * h + term.b * h1;
+            g[1] = term.a * h1 + term.b * h2;
+            for n in 2..6 {
+                g[n] = -two_a * g[n - 1] - wn2 * g[n - 2];
+            }
+            let inv_wn2 = 1.0 / wn2;
+            for n in 0..4 {
+                d[n] += g[n];
+                mag[n] += (g[n] * g[n] + g[n + 1] * g[n + 1] * inv_wn2).sqrt();
+            }
+            for n in 1..5 {
+                let up = (g[n] * g[n] + g[n + 1] * g[n + 1] * inv_wn2).sqrt();
+                let down = (g[n] * g[n] + wn2 * g[n - 1] * g[n - 1]).sqrt();
+                bound[n] += up.min(down);
+            }
+        }
+        Jet {
+            d,
+            bound,
+            noise: mag.map(|m| NOISE * m),
+        }
+    }
+}

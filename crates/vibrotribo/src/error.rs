@@ -1,0 +1,109 @@
+//! Error types of the library.
+//!
+//! Every error caused by user input names the parameter at fault, so that a command-line
+//! front end can show it as it is.
+
+use thiserror::Error;
+
+/// A parameter failed validation.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ParamError {
+    /// A scalar parameter is out of its admissible range or not finite.
+    #[error("invalid {name} = {value}: {reason}")]
+    Invalid {
+        /// Parameter name as used in configuration files (e.g. `oscillator.masses[1]`).
+        name: String,
+        /// The offending value.
+        value: f64,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+    /// An array parameter has the wrong number of entries.
+    #[error("{name} has {got} entries, expected {expected}")]
+    Length {
+        /// Parameter name.
+        name: String,
+        /// Required length.
+        expected: usize,
+        /// Actual length.
+        got: usize,
+    },
+    /// The chain needs at least two masses.
+    #[error("the chain needs at least 2 masses, got {0}")]
+    TooFewMasses(usize),
+    /// The initial positions make two neighbouring masses overlap.
+    #[error(
+        "initial state interpenetrates at contact {contact} (between masses {contact} and {}): gap = {gap:e} m",
+        contact + 1
+    )]
+    Interpenetration {
+        /// 1-based contact index (k is the gap between mass k and k+1).
+        contact: usize,
+        /// The (negative) gap, m.
+        gap: f64,
+    },
+    /// Two parameters that exclude each other were both given, or neither.
+    #[error("{0}")]
+    Conflict(String),
+}
+
+/// A simulation could not continue.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SimError {
+    /// The parameters are invalid.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// More events occurred within one excitation period than
+    /// [`SimOptions::max_events_per_period`](crate::SimOptions::max_events_per_period) allows.
+    /// This is the guard that keeps pathological cases from spinning.
+    #[error(
+        "event limit reached at t = {t:.9} s: {events} events within one excitation period \
+         (limit {limit}); the motion is pathological or the limit too low"
+    )]
+    EventLimit {
+        /// Time at which the limit was reached, s.
+        t: f64,
+        /// Events counted in the current period.
+        events: usize,
+        /// The configured limit.
+        limit: usize,
+    },
+    /// The event search could not advance (a root of an event function could not be
+    /// separated from the current time).
+    #[error("event search stalled at t = {t:.12} s on {what}")]
+    Stalled {
+        /// Time, s.
+        t: f64,
+        /// Which event function stalled.
+        what: String,
+    },
+    /// Simultaneous impacts did not settle within the iteration limit.
+    #[error("simultaneous impacts at t = {t:.12} s did not settle after {iterations} pairwise impacts")]
+    ImpactIteration {
+        /// Time, s.
+        t: f64,
+        /// Pairwise impacts applied.
+        iterations: usize,
+    },
+    /// An undamped cluster is driven exactly at its natural frequency: the response grows
+    /// without bound and has no periodic closed form.
+    #[error(
+        "undamped resonance: the cluster of masses {first}..={last} has natural frequency equal to the excitation frequency"
+    )]
+    UndampedResonance {
+        /// First mass of the cluster (1-based).
+        first: usize,
+        /// Last mass of the cluster (1-based).
+        last: usize,
+    },
+    /// A requested time lies before the current simulation time.
+    #[error("cannot run backwards: requested t = {requested} s, current t = {current} s")]
+    Backwards {
+        /// Requested end time, s.
+        requested: f64,
+        /// Current time, s.
+        current: f64,
+    },
+}

@@ -1,0 +1,356 @@
+//! Parameters and state of the vibro-impact chain, and their validation.
+//!
+//! The chain (seed paper Sect. 2, generalised to N ≥ 2 masses): masses `m_1` (top) to `m_N`
+//! (bottom), each tied to a common base by a spring `k_i` and a dashpot `c_i`. The base moves
+//! as `y(t) = A sin(ω t)`. Displacements `x_i` are measured upward from each mass's static
+//! position; away from contact (seed eq. 1)
+//!
+//! ```text
+//! m_i x_i'' + c_i (x_i' − y') + k_i (x_i − y) = 0
+//! ```
+//!
+//! Gap `k` (between mass `k` and `k+1`, seed eq. 2): `d_k = δ_k − (x_{k+1} − x_k) ≥ 0`.
+//!
+//! Physical inputs live in [`ChainParams`]; numerical settings in
+//! [`SimOptions`](crate::SimOptions). Validate once with [`ChainParams::validate`].
+
+use crate::error::ParamError;
+
+/// How the excitation frequency is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Frequency {
+    /// Ω = ω / Ω₁ with Ω₁ = √(k₁/m₁), the paper's nondimensional frequency (relative to the
+    /// *top* mass's natural frequency). Dimensionless.
+    OmegaRatio(f64),
+    /// Excitation frequency f = ω / 2π, Hz.
+    Hertz(f64),
+}
+
+impl Default for Frequency {
+    /// The paper's default Ω = 0.70.
+    fn default() -> Self {
+        Frequency::OmegaRatio(0.70)
+    }
+}
+
+/// Harmonic base excitation `y(t) = A sin(ω t)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Excitation {
+    /// Base displacement amplitude A, m. Default 0.08 m (paper Sect. 4.1).
+    pub amplitude: f64,
+    /// Excitation frequency. Default Ω = 0.70.
+    pub frequency: Frequency,
+}
+
+impl Default for Excitation {
+    fn default() -> Self {
+        Excitation {
+            amplitude: 0.08,
+            frequency: Frequency::default(),
+        }
+    }
+}
+
+/// Physical parameters of an N-mass vibro-impact chain.
+///
+/// [`Default`] is the paper's default case (Sect. 4.1, configuration (1), m₂ = 120 g,
+/// R_m = 2.5, Ω = 0.70).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ChainParams {
+    /// Masses m₁ (top) … m_N (bottom), kg. Default `[0.048, 0.12, 0.048]`.
+    pub masses: Vec<f64>,
+    /// Spring stiffnesses k_i to the base, N/m. Default 120 N/m each.
+    pub stiffness: Vec<f64>,
+    /// Damping coefficients c_i to the base, N·s/m. Default 0.02 N·s/m each.
+    pub damping: Vec<f64>,
+    /// Initial gaps δ_k between mass k and k+1 (length N − 1), m. Default 20 mm each.
+    pub gaps: Vec<f64>,
+    /// Newton coefficient of restitution μ ∈ [0, 1], dimensionless. Default 0.6.
+    pub restitution: f64,
+    /// Base excitation.
+    pub excitation: Excitation,
+}
+
+impl Default for ChainParams {
+    fn default() -> Self {
+        ChainParams {
+            masses: vec![0.048, 0.12, 0.048],
+            stiffness: vec![120.0; 3],
+            damping: vec![0.02; 3],
+            gaps: vec![0.020; 2],
+            restitution: 0.6,
+            excitation: Excitation::default(),
+        }
+    }
+}
+
+impl ChainParams {
+    /// The paper's chatter case (Sect. 4.4, Figs. 20–25): m₁ = m₃ = 50 g, R_m = 3 (m₂ = 150 g),
+    /// δ₁ = δ₂ = 5 mm, Ω = 0.60, other parameters as [`Default`].
+    pub fn paper_chatter_case() -> Self {
+        ChainParams {
+            masses: vec![0.05, 0.15, 0.05],
+            gaps: vec![0.005, 0.005],
+            excitation: Excitation {
+                frequency: Frequency::OmegaRatio(0.60),
+                ..Excitation::default()
+            },
+            ..ChainParams::default()
+        }
+    }
+}
+
+fn check(name: impl Into<String>, value: f64, ok: bool, reason: &'static str) -> Result<(), ParamError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ParamError::Invalid {
+            name: name.into(),
+            value,
+            reason,
+        })
+    }
+}
+
+fn check_finite(name: &str, value: f64) -> Result<(), ParamError> {
+    check(name, value, value.is_finite(), "must be a finite number")
+}
+
+fn check_positive(name: &str, value: f64) -> Result<(), ParamError> {
+    check_finite(name, value)?;
+    check(name, value, value > 0.0, "must be positive")
+}
+
+fn check_non_negative(name: &str, value: f64) -> Result<(), ParamError> {
+    check_finite(name, value)?;
+    check(name, value, value >= 0.0, "must not be negative")
+}
+
+fn check_len(name: &str, v: &[f64], expected: usize) -> Result<(), ParamError> {
+    if v.len() == expected {
+        Ok(())
+    } else {
+        Err(ParamError::Length {
+            name: name.to_string(),
+            expected,
+            got: v.len(),
+        })
+    }
+}
+
+impl ChainParams {
+    /// Number of masses N.
+    pub fn len(&self) -> usize {
+        self.masses.len()
+    }
+
+    /// Always false for a valid chain (N ≥ 2); provided for API completeness.
+    pub fn is_empty(&self) -> bool {
+        self.masses.is_empty()
+    }
+
+    /// Checks every parameter; returns the first problem found, naming the parameter with the
+    /// configuration key it comes from (`oscillator.masses[1]`, `excitation.amplitude`, …).
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let n = self.masses.len();
+        if n < 2 {
+            return Err(ParamError::TooFewMasses(n));
+        }
+        check_len("oscillator.stiffness", &self.stiffness, n)?;
+        check_len("oscillator.damping", &self.damping, n)?;
+        check_len("oscillator.gaps", &self.gaps, n - 1)?;
+        for (i, &m) in self.masses.iter().enumerate() {
+            check_positive(&format!("oscillator.masses[{i}]"), m)?;
+        }
+        for (i, &k) in self.stiffness.iter().enumerate() {
+            check_positive(&format!("oscillator.stiffness[{i}]"), k)?;
+        }
+        for (i, &c) in self.damping.iter().enumerate() {
+            check_non_negative(&format!("oscillator.damping[{i}]"), c)?;
+        }
+        for (i, &d) in self.gaps.iter().enumerate() {
+            check_non_negative(&format!("oscillator.gaps[{i}]"), d)?;
+        }
+        let mu = self.restitution;
+        check_finite("oscillator.restitution", mu)?;
+        check(
+            "oscillator.restitution",
+            mu,
+            (0.0..=1.0).contains(&mu),
+            "must lie in [0, 1]",
+        )?;
+        check_non_negative("excitation.amplitude", self.excitation.amplitude)?;
+        match self.excitation.frequency {
+            Frequency::OmegaRatio(w) => check_positive("excitation.omega_ratio", w)?,
+            Frequency::Hertz(f) => check_positive("excitation.frequency_hz", f)?,
+        }
+        Ok(())
+    }
+
+    /// Natural frequency of the top mass Ω₁ = √(k₁/m₁), rad/s (the paper's frequency unit).
+    pub fn omega1(&self) -> f64 {
+        (self.stiffness[0] / self.masses[0]).sqrt()
+    }
+
+    /// Excitation angular frequency ω, rad/s.
+    pub fn omega(&self) -> f64 {
+        match self.excitation.frequency {
+            Frequency::OmegaRatio(r) => r * self.omega1(),
+            Frequency::Hertz(f) => 2.0 * std::f64::consts::PI * f,
+        }
+    }
+
+    /// Nondimensional excitation frequency Ω = ω/Ω₁.
+    pub fn omega_ratio(&self) -> f64 {
+        self.omega() / self.omega1()
+    }
+
+    /// Excitation period T = 2π/ω, s.
+    pub fn period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.omega()
+    }
+
+    /// The paper's nondimensional groups (seed eqs. 3–6).
+    pub fn nondimensional(&self) -> NondimGroups {
+        let w1 = self.omega1();
+        NondimGroups {
+            damping_ratios: (0..self.len())
+                .map(|i| self.damping[i] / (2.0 * (self.masses[i] * self.stiffness[i]).sqrt()))
+                .collect(),
+            frequency_ratios: (0..self.len())
+                .map(|i| (self.stiffness[i] / self.masses[i]).sqrt() / w1)
+                .collect(),
+            amplitude_ratio: self.excitation.amplitude / self.gaps[0],
+            omega_ratio: self.omega_ratio(),
+            mass_ratio: self.masses[1] / self.masses[0],
+            gap_ratio: if self.gaps.len() > 1 {
+                Some(self.gaps[1] / self.gaps[0])
+            } else {
+                None
+            },
+            time_scale: 1.0 / w1,
+            length_scale: self.gaps[0],
+        }
+    }
+
+    /// Checks an initial state against the chain: lengths, finiteness, no interpenetration.
+    pub fn validate_state(&self, state: &ChainState) -> Result<(), ParamError> {
+        let n = self.len();
+        check_len("run.initial_positions", &state.positions, n)?;
+        check_len("run.initial_velocities", &state.velocities, n)?;
+        for (i, &x) in state.positions.iter().enumerate() {
+            check_finite(&format!("run.initial_positions[{i}]"), x)?;
+        }
+        for (i, &v) in state.velocities.iter().enumerate() {
+            check_finite(&format!("run.initial_velocities[{i}]"), v)?;
+        }
+        for k in 0..n - 1 {
+            let gap = self.gaps[k] - (state.positions[k + 1] - state.positions[k]);
+            // A gap closed to rounding is contact, not interpenetration.
+            let tol = 1e-12 * self.gaps[k].max(self.excitation.amplitude).max(1e-9);
+            if gap < -tol {
+                return Err(ParamError::Interpenetration { contact: k + 1, gap });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The paper's nondimensional groups derived from a [`ChainParams`].
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct NondimGroups {
+    /// ζ_i = c_i / (2√(m_i k_i)), dimensionless.
+    pub damping_ratios: Vec<f64>,
+    /// Ω_i/Ω₁ with Ω_i = √(k_i/m_i), dimensionless.
+    pub frequency_ratios: Vec<f64>,
+    /// A/δ₁, dimensionless.
+    pub amplitude_ratio: f64,
+    /// Ω = ω/Ω₁, dimensionless.
+    pub omega_ratio: f64,
+    /// R_m = m₂/m₁, dimensionless.
+    pub mass_ratio: f64,
+    /// R_δ = δ₂/δ₁ (None for N = 2), dimensionless.
+    pub gap_ratio: Option<f64>,
+    /// t_c = √(m₁/k₁), s (τ = t/t_c).
+    pub time_scale: f64,
+    /// x_c = δ₁, m (X_i = x_i/δ₁).
+    pub length_scale: f64,
+}
+
+/// Positions and velocities of all masses.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ChainState {
+    /// Displacements x_i from static equilibrium, m (upward positive).
+    pub positions: Vec<f64>,
+    /// Velocities x_i', m/s.
+    pub velocities: Vec<f64>,
+}
+
+impl ChainState {
+    /// All masses at rest at their static positions.
+    pub fn at_rest(n: usize) -> Self {
+        ChainState {
+            positions: vec![0.0; n],
+            velocities: vec![0.0; n],
+        }
+    }
+}
+
+/// Numerical settings of the event-driven simulator.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SimOptions {
+    /// Guard against pathological motion: at most this many events (impacts, sticks,
+    /// releases) within one excitation period before the run stops with
+    /// [`SimError::EventLimit`](crate::SimError::EventLimit). Default 20 000.
+    pub max_events_per_period: usize,
+    /// Accuracy of a chatter accumulation-point jump, as a fraction of the excitation period.
+    /// A geometric impact sequence is replaced by its limit (Budd & Dux) once the estimated
+    /// error of the constant-acceleration approximation is below `chatter_tolerance · T`.
+    /// Default 1e-12.
+    pub chatter_tolerance: f64,
+    /// Upper bound on pairwise impacts applied when resolving one simultaneous impact.
+    /// Default 10 000.
+    pub max_impact_iterations: usize,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            max_events_per_period: 20_000,
+            chatter_tolerance: 1e-12,
+            max_impact_iterations: 10_000,
+        }
+    }
+}
+
+impl SimOptions {
+    /// Checks the options.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check(
+            "options.max_events_per_period",
+            self.max_events_per_period as f64,
+            self.max_events_per_period > 0,
+            "must be positive",
+        )?;
+        check_positive("options.chatter_tolerance", self.chatter_tolerance)?;
+        check(
+            "options.chatter_tolerance",
+            self.chatter_tolerance,
+            self.chatter_tolerance < 1e-2,
+            "must be below 1e-2",
+        )?;
+        check(
+            "options.max_impact_iterations",
+            self.max_impact_iterations as f64,
+            self.max_impact_iterations > 0,
+            "must be positive",
+        )
+    }
+}
