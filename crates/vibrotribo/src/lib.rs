@@ -29,7 +29,9 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod dynamics;
+pub mod electrical;
 mod error;
 pub mod model;
 

@@ -1,0 +1,2 @@
+//! Analyses of simulated motion: Poincaré sections, periodicity, spectra, fits
+//! (seed Sect. 4; MODEL-NOTES §3).
