@@ -129,12 +129,17 @@ impl Oscillator {
         let d = kk - m * w * w;
         let cw = c * w;
         let det = d * d + cw * cw;
-        if det <= 1e-24 * (kk * kk) {
-            // Undamped and exactly resonant: no bounded particular solution.
+        let (pc, ps) = if a == 0.0 {
+            (0.0, 0.0)
+        } else if det <= 1e-24 * (kk * kk) {
+            // Undamped and driven exactly at resonance: no bounded particular solution.
             return Err(SimError::UndampedResonance { first: 0, last: 0 });
-        }
-        let pc = (d * c * a * w - cw * kk * a) / det;
-        let ps = (d * kk * a + cw * c * a * w) / det;
+        } else {
+            (
+                (d * c * a * w - cw * kk * a) / det,
+                (d * kk * a + cw * c * a * w) / det,
+            )
+        };
         let alpha = c / (2.0 * m);
         let wn2 = kk / m;
         let disc = alpha * alpha - wn2;
@@ -184,6 +189,19 @@ impl Oscillator {
             h0 * c + (h1 + self.alpha * h0) * s,
             h1 * c - (self.wn2 * h0 + self.alpha * h1) * s,
         )
+    }
+
+    /// Homogeneous part at time `t` with the magnitudes of the terms summed for each,
+    /// `(h, h', |h₀c| + |(h₁+αh₀)s|, |h₁c| + |(ω_n²h₀+αh₁)s|)`, for rounding estimates.
+    #[inline]
+    pub(crate) fn homogeneous_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
+        let tau = t - self.t0;
+        let (c, s) = self.propagator(tau);
+        let h0 = self.h0;
+        let h1 = self.h1;
+        let (p, q) = (h0 * c, (h1 + self.alpha * h0) * s);
+        let (r, u) = (h1 * c, (self.wn2 * h0 + self.alpha * h1) * s);
+        (p + q, r - u, p.abs() + q.abs(), r.abs() + u.abs())
     }
 
     /// `e^{−ατ}c(τ)` and `e^{−ατ}s(τ)` of the module docs.

@@ -56,12 +56,11 @@ where
         let mut jet = eval(t);
         clamp_noise(&mut jet);
         if jet.d[0] <= jet.noise[0] {
-            if let Some(h) = model_crossing(&jet) {
-                return Ok(Found::Root(t + h));
-            }
-            if !first {
+            match local_behaviour(&jet) {
+                Local::Entering(h) => return Ok(Found::Root(t + h)),
                 // The function came down to zero within rounding without crossing: a touch.
-                return Ok(Found::Root(t + touch_offset(&jet)));
+                Local::Touch(h) if !first => return Ok(Found::Root(t + h)),
+                _ => {}
             }
         }
         let step = safe_step(&jet);
@@ -70,8 +69,11 @@ where
             return Ok(Found::Clear);
         }
         if next <= t {
-            // The lower bounds admit no progress: the zero is at t to within one ulp.
-            return Ok(Found::Root(t));
+            // The lower bounds admit no progress: the zero is within an ulp or two of t.
+            return Ok(Found::Root(match local_behaviour(&jet) {
+                Local::Entering(h) => t + h,
+                _ => t,
+            }));
         }
         t = next;
         first = false;
@@ -88,31 +90,57 @@ fn clamp_noise(jet: &mut Jet) {
     }
 }
 
-/// For `f` at zero within rounding: if the local quadratic model `f + f'h + f''h²/2` reaches
-/// zero at some h ≥ 0 (the function is entering zero), that h.
-fn model_crossing(jet: &Jet) -> Option<f64> {
-    let [f, d1, d2, d3] = jet.d;
-    let f = f.max(0.0);
-    if f == 0.0 {
-        // Entering iff the leading nonzero derivative is negative.
-        let lead = [d1, d2, d3].into_iter().find(|&x| x != 0.0).unwrap_or(0.0);
-        return (lead < 0.0).then_some(0.0);
-    }
-    if d1 > 0.0 || (d1 == 0.0 && d2 >= 0.0) {
-        // Leaving zero (or at a minimum): the model's next zero, if any, is a later event
-        // for the search to find, not a crossing here.
-        return None;
-    }
-    // Entering: the smallest positive root of f + d1 h + (d2/2) h² (≈ f/|d1|); none if the
-    // model turns up before reaching zero (a touch).
-    let r = smallest_positive_quadratic_root(f, d1, 0.5 * d2);
-    r.filter(|h| h.is_finite())
+/// What a function at zero (within rounding) does next.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Local {
+    /// It crosses into negative values beyond rounding; the crossing is h ahead.
+    Entering(f64),
+    /// It comes closest to zero h ahead and turns back up without a real crossing.
+    Touch(f64),
+    /// It moves away from zero.
+    Leaving,
 }
 
-/// Where a touch (zero reached without crossing) sits: the minimum of the quadratic model.
-fn touch_offset(jet: &Jet) -> f64 {
-    let [_, d1, d2, _] = jet.d;
-    if d1 < 0.0 && d2 > 0.0 { -d1 / d2 } else { 0.0 }
+/// Decides, for `f` at zero within rounding, what it does next, from the local cubic Taylor
+/// model `m(h) = f + f'h + f''h²/2 + f'''h³/6` on the range `h ≤ h_loc` where the model is
+/// accurate to the rounding noise (`B₄h⁴/24 ≤ noise`).
+///
+/// It enters negative values if it is descending at h = 0⁺ (first nonzero derivative
+/// negative) and its first descending piece reaches below `−noise`: a dip shallower than
+/// rounding (as right after a release, where f'' is at rounding level and f''' > 0 takes over
+/// at once) is not a crossing. A function rising at 0⁺ is leaving, whatever it does later:
+/// a later zero (the next bounce) is for the certified stepping to find.
+fn local_behaviour(jet: &Jet) -> Local {
+    let noise = jet.noise[0];
+    let [f, d1, d2, d3] = jet.d;
+    let lead = [d1, d2, d3].into_iter().find(|&x| x != 0.0).unwrap_or(0.0);
+    if lead >= 0.0 {
+        return Local::Leaving;
+    }
+    let m = [f, d1, 0.5 * d2, d3 / 6.0];
+    let b4 = jet.bound[4] * BOUND_SAFETY;
+    let h_loc = if b4 > 0.0 {
+        (24.0 * noise.max(f64::MIN_POSITIVE) / b4).powf(0.25)
+    } else {
+        f64::INFINITY
+    };
+    // End of the first descending piece: the first critical point of m, or the model's range.
+    let mut points = [0.0; 4];
+    let found = positive_roots(&[d1, d2, 0.5 * d3], &mut points);
+    let first_crit = points[..found].iter().copied().fold(f64::INFINITY, f64::min);
+    let h_end = first_crit.min(h_loc);
+    let h_end = if h_end.is_finite() { h_end } else { 1.0 };
+    let m_end = horner(&m, h_end);
+    if m_end < -noise {
+        return Local::Entering(if f <= 0.0 {
+            0.0
+        } else {
+            bracket_root(&m, 0.0, h_end, false)
+        });
+    }
+    // A minimum within rounding of zero: a touch there; or still descending over the whole
+    // local range, too slowly to leave the rounding band: a touch here.
+    Local::Touch(if first_crit < h_loc { first_crit } else { 0.0 })
 }
 
 /// The largest step certified free of zeros by the Taylor lower bounds. Above the noise

@@ -100,7 +100,7 @@ impl Signal {
         }
         for term in &self.terms[..self.nterms] {
             let osc = &clusters[term.osc].oscillator;
-            let (h, h1) = osc.homogeneous(t);
+            let (h, h1, mag_h, mag_h1) = osc.homogeneous_with_magnitude(t);
             let two_a = 2.0 * osc.alpha;
             let wn2 = osc.wn2;
             // g = a h + b h' solves the homogeneous ODE; g_{n+2} = −2α g_{n+1} − ω_n² g_n.
@@ -112,9 +112,17 @@ impl Signal {
                 g[n] = -two_a * g[n - 1] - wn2 * g[n - 2];
             }
             let inv_wn2 = 1.0 / wn2;
+            // Magnitudes of what is summed, carried through the same recursion.
+            let (aa, bb) = (term.a.abs(), term.b.abs());
+            let mut m = [0.0; 4];
+            m[0] = aa * mag_h + bb * mag_h1;
+            m[1] = aa * mag_h1 + bb * (two_a * mag_h1 + wn2 * mag_h);
+            for n in 2..4 {
+                m[n] = two_a * m[n - 1] + wn2 * m[n - 2];
+            }
             for n in 0..4 {
                 d[n] += g[n];
-                mag[n] += (g[n] * g[n] + g[n + 1] * g[n + 1] * inv_wn2).sqrt();
+                mag[n] += m[n];
             }
             for n in 1..5 {
                 let up = (g[n] * g[n] + g[n + 1] * g[n + 1] * inv_wn2).sqrt();
