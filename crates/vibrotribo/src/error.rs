@@ -34,7 +34,7 @@ pub enum ParamError {
     TooFewMasses(usize),
     /// The initial positions make two neighbouring masses overlap.
     #[error(
-        "initial state interpenetrates at contact {contact} (between masses {contact} and {}): gap = {gap:e} m",
+        "initial state interpenetrates at contact {contact} (between masses {contact} and {}): gap = {gap:.3e} m",
         contact + 1
     )]
     Interpenetration {

@@ -312,8 +312,9 @@ pub struct SimOptions {
     pub max_events_per_period: usize,
     /// Accuracy of a chatter accumulation-point jump, as a fraction of the excitation period.
     /// A geometric impact sequence is replaced by its limit (Budd & Dux) once the estimated
-    /// error of the constant-acceleration approximation is below `chatter_tolerance · T`.
-    /// Default 1e-12.
+    /// error of the constant-acceleration approximation is below `chatter_tolerance · T`, or
+    /// below the rounding error with which the next tiny bounce could be timed if resolved
+    /// individually (gap rounding / rebound speed), whichever is larger. Default 1e-12.
     pub chatter_tolerance: f64,
     /// Upper bound on pairwise impacts applied when resolving one simultaneous impact.
     /// Default 10 000.
