@@ -200,6 +200,20 @@ impl<O: Observer + ?Sized> Observer for Box<O> {
     }
 }
 
+/// An optional observer: `None` observes nothing.
+impl<O: Observer> Observer for Option<O> {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        if let Some(o) = self {
+            o.flow(flow)
+        }
+    }
+    fn event(&mut self, event: &Event, state: &StateView<'_>) {
+        if let Some(o) = self {
+            o.event(event, state)
+        }
+    }
+}
+
 impl<O: Observer> Observer for Vec<O> {
     fn flow(&mut self, flow: &Flow<'_>) {
         for o in self.iter_mut() {

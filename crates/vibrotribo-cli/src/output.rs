@@ -1,0 +1,72 @@
+//! Writing result files: buffered CSV that is flushed as it goes, and JSON.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+/// A CSV file written row by row.
+pub struct CsvFile {
+    path: PathBuf,
+    out: BufWriter<File>,
+    line: String,
+}
+
+impl CsvFile {
+    /// Creates `path` and writes the header `columns`.
+    pub fn create(path: &Path, columns: &[String]) -> Result<Self> {
+        let file = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+        let mut f = CsvFile {
+            path: path.to_path_buf(),
+            out: BufWriter::new(file),
+            line: String::new(),
+        };
+        f.out.write_all(columns.join(",").as_bytes())?;
+        f.out.write_all(b"\n")?;
+        Ok(f)
+    }
+
+    /// Writes one row of already-formatted fields.
+    pub fn row<I, S>(&mut self, fields: I) -> Result<()>
+    where
+        I: IntoIterator<Item = S>,
+        S: std::fmt::Display,
+    {
+        use std::fmt::Write as _;
+        self.line.clear();
+        for (i, f) in fields.into_iter().enumerate() {
+            if i > 0 {
+                self.line.push(',');
+            }
+            let _ = write!(self.line, "{f}");
+        }
+        self.line.push('\n');
+        self.out
+            .write_all(self.line.as_bytes())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+
+    /// Flushes to disk.
+    pub fn flush(&mut self) -> Result<()> {
+        self.out
+            .flush()
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+/// Writes `value` as pretty JSON to `path`.
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Creates `dir` (and parents) for output.
+pub fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))
+}
+
+/// Column names `prefix1suffix, …, prefixNsuffix`.
+pub fn numbered(prefix: &str, n: usize, suffix: &str) -> Vec<String> {
+    (1..=n).map(|i| format!("{prefix}{i}{suffix}")).collect()
+}
