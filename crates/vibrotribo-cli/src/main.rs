@@ -4,6 +4,8 @@
 mod config;
 mod harvester;
 mod output;
+#[allow(dead_code)] // wired into commands as they gain --plot
+mod plot;
 mod progress;
 mod simulate;
 
