@@ -245,8 +245,17 @@ fn chatter_ends_at_the_accumulation_point_then_sticks_and_releases() {
     let t_acc = log.events[chatter].event.time;
     let expected = bruteforce_accumulation(&params, &initial);
     println!("accumulation at {t_acc:.15e} s, brute force {expected:.15e} s");
-    // The requested accuracy of the jump: chatter_tolerance × T.
-    let tol = SimOptions::default().chatter_tolerance * params.period();
+    // The documented accuracy of the jump: chatter_tolerance × T, or the rounding with which
+    // the next bounce could be timed (about two ulps of the positions over the last rebound
+    // speed), whichever is larger.
+    let last = &log.events[chatter - 1];
+    let scale = last.positions.iter().fold(0.0f64, |a, x| a.max(x.abs())) + params.gaps[0];
+    let rounding = 2.0 * f64::EPSILON * scale / last.event.velocity_after;
+    let tol = (SimOptions::default().chatter_tolerance * params.period()).max(rounding);
+    println!(
+        "jump after rebound speed {:e} m/s: tolerance {tol:e} s",
+        last.event.velocity_after
+    );
     assert!(
         (t_acc - expected).abs() < tol,
         "chatter ends at {t_acc}, expected {expected} (tolerance {tol:e})"
