@@ -89,6 +89,11 @@ pub struct Oscillator {
     pub(crate) h0: f64,
     /// Homogeneous part at t0: derivative, m/s.
     pub(crate) h1: f64,
+    /// Rounding errors of `h0`, `h1` (exact by TwoSum): near an undamped resonance the
+    /// forced part dwarfs the motion, and without them the flow would not start exactly at
+    /// its initial state.
+    e0: f64,
+    e1: f64,
     /// α = C/(2M), 1/s.
     pub(crate) alpha: f64,
     /// ω_n² = K/M, 1/s².
@@ -157,6 +162,8 @@ impl Oscillator {
             ps,
             h0: 0.0,
             h1: 0.0,
+            e0: 0.0,
+            e1: 0.0,
             alpha,
             wn2,
             regime,
@@ -164,8 +171,8 @@ impl Oscillator {
         };
         let ph = forcing.phase(t0);
         let (sp, vp) = osc.forced(ph);
-        osc.h0 = s0 - sp;
-        osc.h1 = v0 - vp;
+        (osc.h0, osc.e0) = two_sum(s0, -sp);
+        (osc.h1, osc.e1) = two_sum(v0, -vp);
         Ok(osc)
     }
 
@@ -178,30 +185,19 @@ impl Oscillator {
         )
     }
 
-    /// Homogeneous part at time `t`: (h, h'), m and m/s.
-    #[inline]
-    pub(crate) fn homogeneous(&self, t: f64) -> (f64, f64) {
-        let tau = t - self.t0;
-        let (c, s) = self.propagator(tau);
-        let h0 = self.h0;
-        let h1 = self.h1;
-        (
-            h0 * c + (h1 + self.alpha * h0) * s,
-            h1 * c - (self.wn2 * h0 + self.alpha * h1) * s,
-        )
-    }
-
     /// Homogeneous part at time `t` with the magnitudes of the terms summed for each,
     /// `(h, h', |h₀c| + |(h₁+αh₀)s|, |h₁c| + |(ω_n²h₀+αh₁)s|)`, for rounding estimates.
     #[inline]
     pub(crate) fn homogeneous_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
         let tau = t - self.t0;
         let (c, s) = self.propagator(tau);
-        let h0 = self.h0;
-        let h1 = self.h1;
+        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
         let (p, q) = (h0 * c, (h1 + self.alpha * h0) * s);
         let (r, u) = (h1 * c, (self.wn2 * h0 + self.alpha * h1) * s);
-        (p + q, r - u, p.abs() + q.abs(), r.abs() + u.abs())
+        // The rounding-error initial conditions, propagated by the same flow.
+        let eh = e0 * c + (e1 + self.alpha * e0) * s;
+        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
+        ((p + q) + eh, (r - u) + ehd, p.abs() + q.abs(), r.abs() + u.abs())
     }
 
     /// `e^{−ατ}c(τ)` and `e^{−ατ}s(τ)` of the module docs.
@@ -233,11 +229,19 @@ impl Oscillator {
     }
 
     /// Displacement, m, and velocity, m/s, at time `t` (phase `ph` must be that of `t`).
+    /// At `t0` this returns the initial state to within an ulp, however large the forced
+    /// part.
     #[inline]
     pub(crate) fn state(&self, t: f64, ph: Phase) -> (f64, f64) {
         let (sp, vp) = self.forced(ph);
-        let (h, hd) = self.homogeneous(t);
-        (sp + h, vp + hd)
+        let tau = t - self.t0;
+        let (c, s) = self.propagator(tau);
+        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
+        let h = h0 * c + (h1 + self.alpha * h0) * s;
+        let hd = h1 * c - (self.wn2 * h0 + self.alpha * h1) * s;
+        let eh = e0 * c + (e1 + self.alpha * e0) * s;
+        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
+        ((sp + h) + eh, (vp + hd) + ehd)
     }
 
     /// Start time of this flow, s.
@@ -246,9 +250,40 @@ impl Oscillator {
     }
 }
 
+/// `a + b` and its exact rounding error (Knuth's TwoSum): `a + b = s + e` exactly.
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Near an undamped resonance the forced part is ~1e4 times the motion; the flow must
+    /// still start exactly at its initial state.
+    #[test]
+    fn starts_at_its_initial_state_near_resonance() {
+        let k = OscConstants {
+            mass: 0.1,
+            damping: 0.0,
+            stiffness: 100.0,
+            force: 0.0,
+        };
+        let wn = (k.stiffness / k.mass).sqrt();
+        let forcing = Forcing::new(0.08, wn * (1.0 - 1e-5));
+        for (t0, s0, v0) in [(0.37, 0.07146086647170276, 2.697164490916262), (5.1, -0.013, 0.4)] {
+            let osc = Oscillator::new(k, &forcing, t0, s0, v0).unwrap();
+            let (sp, _) = osc.forced(forcing.phase(t0));
+            assert!(sp.abs() > 100.0 * s0.abs(), "not near resonance: {sp}");
+            let (s, v) = osc.state(t0, forcing.phase(t0));
+            assert!((s - s0).abs() <= 2.0 * f64::EPSILON * s0.abs(), "{s} vs {s0}");
+            assert!((v - v0).abs() <= 2.0 * f64::EPSILON * v0.abs(), "{v} vs {v0}");
+        }
+    }
 
     /// The closed form satisfies its own ODE: check the residual with finite differences of
     /// the velocity in every damping regime.
