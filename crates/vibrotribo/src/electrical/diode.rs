@@ -10,11 +10,13 @@
 //! i = −I_s (1 + (3 n V_T / (e v_j))³)         v_j < −3 n V_T   (SPICE's reverse tail)
 //! ```
 //!
-//! in series with R_s: the terminal voltage is `v = v_j + i R_s`. In the forward branch the
+//! in series with R_s: the terminal voltage is `v = v_j + i R_s`; an optional leakage
+//! conductance G_p sits across the whole diode (`i_total = i + G_p v`). In the forward branch the
 //! current is explicit through the Wright ω function (ω(x) = W(eˣ), the solution of
 //! ω + ln ω = x): `i + I_s = (nV_T/R_s) ω(ln(I_s R_s/(nV_T)) + (v + I_s R_s)/(nV_T))`. The two
 //! branches join with continuous value and slope. ngspice reproduces this law exactly with
-//! `.model d D(IS=I_s N=n RS=R_s)` at `temp = tnom = V_T q/k` and a negligible `gmin`.
+//! `.model d D(IS=I_s N=n RS=R_s)` at `temp = tnom = V_T q/k`, a resistor 1/G_p across each
+//! diode, and apart from its `gmin` (1e-12 S across each junction).
 //!
 //! ## Bridge
 //!
@@ -39,6 +41,8 @@ pub struct Diode {
     pub thermal_voltage: f64,
     /// Series resistance R_s, Ω (positive).
     pub series_resistance: f64,
+    /// Leakage conductance G_p across the diode, S (≥ 0).
+    pub parallel_conductance: f64,
 }
 
 /// Current and conductance of a diode or a bridge at one operating point.
@@ -68,9 +72,10 @@ impl Diode {
         let x = (is * rs / a).ln() + (v + is * rs) / a;
         let w = wright_omega(x);
         let i = a * w / rs - is;
+        let gp = self.parallel_conductance;
         let vj = v - i * rs;
         if vj >= -3.0 * a {
-            return (i, w / ((1.0 + w) * rs));
+            return (i + gp * v, w / ((1.0 + w) * rs) + gp);
         }
         // Reverse tail: solve vj + R_s i(vj) = v (i ≈ −I_s, so R_s i is tiny).
         let k = 3.0 * a / std::f64::consts::E;
@@ -84,7 +89,7 @@ impl Diode {
             let f = vj + rs * i - v;
             vj -= f / (1.0 + rs * g);
         }
-        (i, g / (1.0 + rs * g))
+        (i + gp * v, g / (1.0 + rs * g) + gp)
     }
 
     /// The full-wave bridge of four of these diodes at transducer voltage `v` and storage
@@ -157,6 +162,7 @@ mod tests {
             ideality: 1.752,
             thermal_voltage: 0.025_864,
             series_resistance: 0.568,
+            parallel_conductance: 0.0,
         }
     }
 

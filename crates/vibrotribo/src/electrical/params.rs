@@ -138,6 +138,9 @@ pub struct HarvesterParams {
     /// Thermal voltage V_T = kT/q, V (`harvester.diode_thermal_voltage`). Default
     /// 0.025 864 V (T = 300.15 K, ngspice's default 27 °C).
     pub diode_thermal_voltage: f64,
+    /// Leakage conductance across each diode, S (`harvester.diode_parallel_conductance`).
+    /// Default 0. (ngspice needs some, e.g. 1e-10 S, to solve the floating bridge robustly.)
+    pub diode_parallel_conductance: f64,
 }
 
 impl Default for HarvesterParams {
@@ -161,6 +164,7 @@ impl Default for HarvesterParams {
             diode_ideality: 1.752,
             diode_series_resistance: 0.568,
             diode_thermal_voltage: BOLTZMANN_OVER_CHARGE * 300.15,
+            diode_parallel_conductance: 0.0,
         }
     }
 }
@@ -238,6 +242,10 @@ impl HarvesterParams {
         positive("harvester.diode_ideality", self.diode_ideality)?;
         positive("harvester.diode_series_resistance", self.diode_series_resistance)?;
         positive("harvester.diode_thermal_voltage", self.diode_thermal_voltage)?;
+        non_negative(
+            "harvester.diode_parallel_conductance",
+            self.diode_parallel_conductance,
+        )?;
         Ok(())
     }
 
@@ -311,6 +319,7 @@ impl HarvesterParams {
             ideality: self.diode_ideality,
             thermal_voltage: self.diode_thermal_voltage,
             series_resistance: self.diode_series_resistance,
+            parallel_conductance: self.diode_parallel_conductance,
         }
     }
 }
