@@ -482,3 +482,74 @@ fn toml_harvester_table_deserializes_and_reports_bad_input() {
     let err = c.harvester.validate().unwrap_err().to_string();
     assert!(err.contains("harvester.area") && err.contains("-1"), "{err}");
 }
+
+#[test]
+fn vq_cycle_encloses_the_period_energy() {
+    // With a resistor, ∮ V dQ over a period is ∫ V I dt, the energy dissipated in it.
+    let points = 4000;
+    let mut s = ChargeSolver::new(&params(LoadKind::Resistor, 1e8), 0.1, 2, ChargeOptions::default())
+        .unwrap()
+        .with_vq_cycle(2, points)
+        .unwrap();
+    s.advance(0.0, 0.4, &sine_gaps).unwrap();
+    let vq = s.vq_cycle().unwrap();
+    assert_eq!(vq.times.len(), points + 1);
+    check("first time", 0.0, 0.2, vq.times[0], 1e-15);
+    check("last time", 0.0, 0.3, vq.times[points], 1e-15);
+    let mut area = 0.0;
+    for j in 0..points {
+        // V = V_oc − Q/C holds at every point.
+        let v = vq.voc_v[j] - vq.charge_c[j] / vq.capacitance_f[j];
+        check(
+            "V = Voc - Q/C",
+            vq.times[j],
+            v,
+            vq.voltage_v[j],
+            1e-9 * v.abs().max(1.0),
+        );
+        area += 0.5 * (vq.voltage_v[j] + vq.voltage_v[j + 1]) * (vq.charge_c[j + 1] - vq.charge_c[j]);
+    }
+    let e = s.periods()[2].energy_j;
+    println!("V-Q loop area {area:.9e} J, period energy {e:.9e} J");
+    check("loop area", 0.2, e, area, 1e-5 * e);
+}
+
+#[test]
+fn rectifier_with_load_resistor_balances_energy() {
+    // Energy through the bridge = ½ C_s V_s² + ∫ V_s²/R_L dt (the integral by the trapezoid
+    // rule on a fine sample grid).
+    let (cs, rl) = (1e-7, 2e5);
+    let p = HarvesterParams {
+        load: LoadKind::Rectifier,
+        storage_capacitance: cs,
+        storage_load_resistance: Some(rl),
+        ..HarvesterParams::default()
+    };
+    let dt = 2e-6;
+    let mut s = ChargeSolver::new(&p, 0.1, 2, ChargeOptions::default())
+        .unwrap()
+        .with_sampling(0.0, dt)
+        .unwrap();
+    s.advance(0.0, 0.3, &sine_gaps).unwrap();
+    let sm = s.samples().unwrap();
+    let vs = &sm.storage_voltage_v;
+    let mut dissipated = 0.0;
+    for j in 0..vs.len() - 1 {
+        dissipated += 0.5 * (vs[j] * vs[j] + vs[j + 1] * vs[j + 1]) / rl * dt;
+    }
+    let v_end = s.storage_voltage().unwrap();
+    let balance = 0.5 * cs * v_end * v_end + dissipated;
+    println!(
+        "delivered {:.9e} J = stored {:.9e} J + dissipated {dissipated:.9e} J ({balance:.9e})",
+        s.total_energy(),
+        0.5 * cs * v_end * v_end
+    );
+    assert!(dissipated > 0.2 * s.total_energy(), "the resistor must matter");
+    check(
+        "energy balance",
+        0.3,
+        s.total_energy(),
+        balance,
+        1e-5 * s.total_energy(),
+    );
+}
