@@ -1,0 +1,188 @@
+//! Triboelectric transducers: capacitance C and open-circuit voltage V_oc as functions of the
+//! gaps (seed eqs. 12–13; MODEL-NOTES §2).
+//!
+//! Both transducers have an elastance 1/C and an open-circuit voltage that are *linear* in the
+//! gaps, so the equilibrium charge `Q_eq = C·V_oc` and its rate `dQ_eq/dt` are explicit
+//! functions of the gaps and their rates. The charge solver integrates the deviation
+//! `u = Q − Q_eq = −C·V` from equilibrium, which holds the load voltage without cancellation.
+
+use super::params::{EPSILON_0, VocModel};
+
+/// The electrical state of a transducer at one instant, given the gaps and their rates.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TransducerState {
+    /// Elastance 1/C, 1/F.
+    pub elastance: f64,
+    /// Open-circuit voltage V_oc, V.
+    pub voc: f64,
+    /// Equilibrium (short-circuit) charge `Q_eq = C·V_oc`, C.
+    pub equilibrium_charge: f64,
+    /// Its rate `dQ_eq/dt`, A: the short-circuit current.
+    pub equilibrium_current: f64,
+}
+
+impl TransducerState {
+    /// Capacitance C, F.
+    pub fn capacitance(&self) -> f64 {
+        1.0 / self.elastance
+    }
+}
+
+/// The paper's freestanding contact mode (seed eqs. 12–13): electrodes with dielectric films
+/// on the two outer masses, a freestanding aluminium layer on the middle one.
+///
+/// `C = ε₀S / (d₀ + D₁ + D₂)`, and `V_oc = 2σD₂/ε₀` ([`VocModel::Paper`]) or
+/// `V_oc = σ(D₂ − D₁)/ε₀` ([`VocModel::Exact`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Freestanding {
+    /// ε₀·S, F·m.
+    pub eps_area: f64,
+    /// d₀ = d₁/ε_r1 + d₂/ε_r2, m.
+    pub d0: f64,
+    /// Surface charge density σ, C/m².
+    pub charge_density: f64,
+    /// Open-circuit voltage law.
+    pub voc_model: VocModel,
+    /// Contacts (0-based) holding D₁ and D₂.
+    pub contacts: [usize; 2],
+}
+
+impl Freestanding {
+    /// Capacitance C, F, at gaps D₁, D₂ (m).
+    pub fn capacitance(&self, d1: f64, d2: f64) -> f64 {
+        self.eps_area / (self.d0 + d1 + d2)
+    }
+
+    /// Open-circuit voltage V_oc, V, at gaps D₁, D₂ (m).
+    pub fn open_circuit_voltage(&self, d1: f64, d2: f64) -> f64 {
+        self.charge_density * self.voc_length(d1, d2) / EPSILON_0
+    }
+
+    /// The length L with `V_oc = σL/ε₀`, m.
+    fn voc_length(&self, d1: f64, d2: f64) -> f64 {
+        match self.voc_model {
+            VocModel::Paper => 2.0 * d2,
+            VocModel::Exact => d2 - d1,
+        }
+    }
+
+    /// Full state from gaps D₁, D₂ (m) and their rates (m/s).
+    #[inline]
+    pub fn state(&self, d1: f64, d2: f64, r1: f64, r2: f64) -> TransducerState {
+        let s = self.d0 + d1 + d2;
+        let ds = r1 + r2;
+        let l = self.voc_length(d1, d2);
+        let dl = self.voc_length(r1, r2);
+        // The surface charge σS = ε₀S·σ/ε₀.
+        let sigma_s = self.eps_area * self.charge_density / EPSILON_0;
+        TransducerState {
+            elastance: s / self.eps_area,
+            voc: self.charge_density * l / EPSILON_0,
+            equilibrium_charge: sigma_s * l / s,
+            equilibrium_current: sigma_s * (dl * s - l * ds) / (s * s),
+        }
+    }
+}
+
+/// Two-plate contact-separation mode on one contact: `C = ε₀S/(d₀ + D)`, `V_oc = σD/ε₀`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSeparation {
+    /// ε₀·S, F·m.
+    pub eps_area: f64,
+    /// d₀ = d₁/ε_r1 + d₂/ε_r2, m.
+    pub d0: f64,
+    /// Surface charge density σ, C/m².
+    pub charge_density: f64,
+    /// The contact (0-based) whose gap D separates the plates.
+    pub contact: usize,
+}
+
+impl ContactSeparation {
+    /// Capacitance C, F, at gap D (m).
+    pub fn capacitance(&self, d: f64) -> f64 {
+        self.eps_area / (self.d0 + d)
+    }
+
+    /// Open-circuit voltage V_oc, V, at gap D (m).
+    pub fn open_circuit_voltage(&self, d: f64) -> f64 {
+        self.charge_density * d / EPSILON_0
+    }
+
+    /// Full state from gap D (m) and its rate (m/s).
+    #[inline]
+    pub fn state(&self, d: f64, rate: f64) -> TransducerState {
+        let s = self.d0 + d;
+        let sigma_s = self.eps_area * self.charge_density / EPSILON_0;
+        TransducerState {
+            elastance: s / self.eps_area,
+            voc: self.charge_density * d / EPSILON_0,
+            equilibrium_charge: sigma_s * d / s,
+            equilibrium_current: sigma_s * self.d0 * rate / (s * s),
+        }
+    }
+}
+
+/// A triboelectric transducer of either mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Transducer {
+    /// Freestanding contact mode (the paper's).
+    Freestanding(Freestanding),
+    /// Two-plate contact-separation mode.
+    ContactSeparation(ContactSeparation),
+}
+
+impl Transducer {
+    /// Capacitance C, F, at the chain's gaps (m, indexed by contact).
+    pub fn capacitance(&self, gaps: &[f64]) -> f64 {
+        match self {
+            Transducer::Freestanding(f) => f.capacitance(gaps[f.contacts[0]], gaps[f.contacts[1]]),
+            Transducer::ContactSeparation(c) => c.capacitance(gaps[c.contact]),
+        }
+    }
+
+    /// Open-circuit voltage V_oc, V, at the chain's gaps (m, indexed by contact).
+    pub fn open_circuit_voltage(&self, gaps: &[f64]) -> f64 {
+        match self {
+            Transducer::Freestanding(f) => f.open_circuit_voltage(gaps[f.contacts[0]], gaps[f.contacts[1]]),
+            Transducer::ContactSeparation(c) => c.open_circuit_voltage(gaps[c.contact]),
+        }
+    }
+
+    /// Full state from the chain's gaps (m) and their rates (m/s), indexed by contact.
+    #[inline]
+    pub fn state(&self, gaps: &[f64], rates: &[f64]) -> TransducerState {
+        match self {
+            Transducer::Freestanding(f) => {
+                let [a, b] = f.contacts;
+                f.state(gaps[a], gaps[b], rates[a], rates[b])
+            }
+            Transducer::ContactSeparation(c) => c.state(gaps[c.contact], rates[c.contact]),
+        }
+    }
+
+    /// The contacts (0-based) whose gaps this transducer reads.
+    pub fn contacts(&self) -> &[usize] {
+        match self {
+            Transducer::Freestanding(f) => &f.contacts,
+            Transducer::ContactSeparation(c) => std::slice::from_ref(&c.contact),
+        }
+    }
+
+    /// Charge scale σS, C (the charge a fully separated transducer can move).
+    pub fn charge_scale(&self) -> f64 {
+        let (eps_area, sigma) = match self {
+            Transducer::Freestanding(f) => (f.eps_area, f.charge_density),
+            Transducer::ContactSeparation(c) => (c.eps_area, c.charge_density),
+        };
+        (eps_area * sigma / EPSILON_0).abs()
+    }
+
+    /// Voltage scale σd₀/ε₀, V (the open-circuit voltage of a gap as thick as the films).
+    pub fn voltage_scale(&self) -> f64 {
+        let (d0, sigma) = match self {
+            Transducer::Freestanding(f) => (f.d0, f.charge_density),
+            Transducer::ContactSeparation(c) => (c.d0, c.charge_density),
+        };
+        (sigma * d0 / EPSILON_0).abs()
+    }
+}
