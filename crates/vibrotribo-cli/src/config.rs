@@ -10,6 +10,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use serde::de::{self, Deserializer, Visitor};
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
+use vibrotribo::electrical::{ChargeOptions, HarvesterParams};
 use vibrotribo::{ChainParams, ChainState, Excitation, Frequency, SimOptions};
 
 /// A number or an array of numbers (`stiffness = 120.0` means 120 N/m for every mass).
@@ -118,7 +119,7 @@ pub struct OptionsSection {
 }
 
 /// A whole configuration file.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
     /// `[oscillator]`.
@@ -133,6 +134,12 @@ pub struct Config {
     /// `[options]`.
     #[serde(default)]
     pub options: OptionsSection,
+    /// `[harvester]`: transducer and load (absent: the paper's harvester).
+    #[serde(default)]
+    pub harvester: Option<HarvesterParams>,
+    /// `[electrical]`: charge solver settings.
+    #[serde(default)]
+    pub electrical: Option<ChargeOptions>,
 }
 
 /// What a run records, with defaults applied.

@@ -2,9 +2,11 @@
 //! files and plots. All physics lives in the `vibrotribo` library.
 
 mod config;
+mod export_spice;
 mod harvester;
+mod load_sweep;
 mod output;
-#[allow(dead_code)] // wired into commands as they gain --plot
+#[allow(dead_code)] // parts are used as commands gain --plot
 mod plot;
 mod progress;
 mod simulate;
@@ -25,6 +27,10 @@ struct Cli {
 enum Command {
     /// Simulate one configuration (the paper's default case if no file is given).
     Simulate(simulate::SimulateArgs),
+    /// Average power against load resistance on one run; the optimal load; the V–Q cycle.
+    LoadSweep(load_sweep::LoadSweepArgs),
+    /// Write an ngspice netlist of a run's harvester driven by its gap waveforms.
+    ExportSpice(export_spice::ExportSpiceArgs),
 }
 
 fn run() -> anyhow::Result<()> {
@@ -32,6 +38,8 @@ fn run() -> anyhow::Result<()> {
     progress::install_interrupt_handler();
     match cli.command {
         Command::Simulate(args) => simulate::run(&args),
+        Command::LoadSweep(args) => load_sweep::run(&args),
+        Command::ExportSpice(args) => export_spice::run(&args),
     }
 }
 

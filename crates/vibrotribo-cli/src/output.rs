@@ -70,3 +70,52 @@ pub fn create_dir(dir: &Path) -> Result<()> {
 pub fn numbered(prefix: &str, n: usize, suffix: &str) -> Vec<String> {
     (1..=n).map(|i| format!("{prefix}{i}{suffix}")).collect()
 }
+
+/// `value` with an SI prefix and `unit`, 4 significant digits (`12.92 µW`).
+pub fn si(value: f64, unit: &str) -> String {
+    if !value.is_finite() {
+        return format!("{value} {unit}");
+    }
+    if value == 0.0 {
+        return format!("0 {unit}");
+    }
+    const PREFIXES: [(f64, &str); 11] = [
+        (1e12, "T"),
+        (1e9, "G"),
+        (1e6, "M"),
+        (1e3, "k"),
+        (1.0, ""),
+        (1e-3, "m"),
+        (1e-6, "µ"),
+        (1e-9, "n"),
+        (1e-12, "p"),
+        (1e-15, "f"),
+        (1e-18, "a"),
+    ];
+    let a = value.abs();
+    let (scale, prefix) = PREFIXES
+        .iter()
+        .copied()
+        .find(|(s, _)| a >= *s)
+        .unwrap_or(PREFIXES[PREFIXES.len() - 1]);
+    let x = value / scale;
+    let digits = if x.abs() >= 100.0 {
+        1
+    } else if x.abs() >= 10.0 {
+        2
+    } else {
+        3
+    };
+    format!("{x:.digits$} {prefix}{unit}")
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn si_prefixes() {
+        assert_eq!(super::si(1.292e-5, "W"), "12.92 µW");
+        assert_eq!(super::si(1e5, "Ω"), "100.0 kΩ");
+        assert_eq!(super::si(0.0, "A"), "0 A");
+        assert_eq!(super::si(-2.5e-9, "C"), "-2.500 nC");
+    }
+}

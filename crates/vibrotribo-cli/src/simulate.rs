@@ -1,4 +1,5 @@
-//! `vibrotribo simulate`: one run of the chain, with a human summary and optional files.
+//! `vibrotribo simulate`: one run of the chain and its harvester, with a human summary and
+//! optional files.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -6,10 +7,11 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
+use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind};
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
 use crate::config::{Loaded, RunSpec};
-use crate::output::{CsvFile, create_dir, numbered, write_json};
+use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Progress, interrupted};
 
 /// Options of `vibrotribo simulate`.
@@ -24,6 +26,9 @@ pub struct SimulateArgs {
     /// Write events.csv, trajectory.csv and summary.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Mechanics only: skip the triboelectric harvester.
+    #[arg(long)]
+    pub mechanics_only: bool,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -39,11 +44,19 @@ struct Files {
     gaps: Vec<f64>,
     x: Vec<f64>,
     v: Vec<f64>,
+    row: Vec<f64>,
+    electrical: bool,
+    rectifier: bool,
     error: Option<anyhow::Error>,
 }
 
 impl Files {
-    fn create(dir: &Path, params: &ChainParams, spec: &RunSpec) -> Result<Self> {
+    fn create(
+        dir: &Path,
+        params: &ChainParams,
+        spec: &RunSpec,
+        harvester: Option<&HarvesterParams>,
+    ) -> Result<Self> {
         create_dir(dir)?;
         let n = params.len();
         let mut ev_cols: Vec<String> = [
@@ -52,15 +65,22 @@ impl Files {
             "contact",
             "rel_velocity_m_s",
             "rel_velocity_after_m_s",
+            "sequence_impacts",
         ]
         .map(String::from)
         .to_vec();
-        ev_cols.push("sequence_impacts".into());
         ev_cols.extend(numbered("x", n, "_m"));
         ev_cols.extend(numbered("v", n, "_m_s"));
         let mut tr_cols = vec!["time_s".to_string()];
         tr_cols.extend(numbered("x", n, "_m"));
         tr_cols.extend(numbered("v", n, "_m_s"));
+        let rectifier = harvester.is_some_and(|h| h.load == LoadKind::Rectifier);
+        if harvester.is_some() {
+            tr_cols.extend(["q_c", "i_a", "v_v", "c_f", "voc_v"].map(String::from));
+            if rectifier {
+                tr_cols.push("vs_v".into());
+            }
+        }
         tr_cols.push("y_m".into());
         tr_cols.extend(numbered("d", n - 1, "_m"));
         Ok(Files {
@@ -72,6 +92,9 @@ impl Files {
             gaps: params.gaps.clone(),
             x: vec![0.0; n],
             v: vec![0.0; n],
+            row: Vec::with_capacity(tr_cols.len()),
+            electrical: harvester.is_some(),
+            rectifier,
             error: None,
         })
     }
@@ -89,26 +112,42 @@ impl Files {
         self.events.flush()?;
         self.trajectory.flush()
     }
-}
 
-impl Observer for Files {
-    fn flow(&mut self, flow: &Flow<'_>) {
+    /// Writes the grid rows inside `flow`; electrical columns come from `samples`, which the
+    /// charge solver has already filled up to the end of this flow (same grid).
+    fn rows(&mut self, flow: &Flow<'_>, samples: Option<&ElectricalSamples>) {
         while self.next_sample <= self.last_sample {
-            let t = self.next_sample as f64 * self.dt;
+            let j = self.next_sample;
+            let t = j as f64 * self.dt;
             if t > flow.t_end {
                 break;
             }
             flow.state_at(t, &mut self.x, &mut self.v);
             let (y, _) = flow.base_at(t);
             let n = self.x.len();
-            let gaps = (0..n - 1).map(|k| self.gaps[k] - (self.x[k + 1] - self.x[k]));
-            let row: Vec<f64> = std::iter::once(t)
-                .chain(self.x.iter().copied())
-                .chain(self.v.iter().copied())
-                .chain(std::iter::once(y))
-                .chain(gaps)
-                .collect();
-            let r = self.trajectory.row(row);
+            self.row.clear();
+            self.row.push(t);
+            self.row.extend_from_slice(&self.x);
+            self.row.extend_from_slice(&self.v);
+            if self.electrical {
+                let idx = j as usize;
+                let at = |v: &[f64]| v.get(idx).copied().unwrap_or(f64::NAN);
+                let e = samples.filter(|s| s.times.get(idx).is_some_and(|&ts| ts == t));
+                let get = |f: fn(&ElectricalSamples) -> &Vec<f64>| e.map_or(f64::NAN, |s| at(f(s)));
+                self.row.push(get(|s| &s.charge_c));
+                self.row.push(get(|s| &s.current_a));
+                self.row.push(get(|s| &s.voltage_v));
+                self.row.push(get(|s| &s.capacitance_f));
+                self.row.push(get(|s| &s.voc_v));
+                if self.rectifier {
+                    self.row.push(get(|s| &s.storage_voltage_v));
+                }
+            }
+            self.row.push(y);
+            for k in 0..n - 1 {
+                self.row.push(self.gaps[k] - (self.x[k + 1] - self.x[k]));
+            }
+            let r = self.trajectory.row(self.row.iter());
             self.keep(r);
             self.next_sample += 1;
         }
@@ -132,27 +171,74 @@ impl Observer for Files {
     }
 }
 
+/// Everything that watches a `simulate` run.
+struct Recorder {
+    stats: RunStats,
+    solver: Option<ChargeSolver>,
+    files: Option<Files>,
+}
+
+impl Observer for Recorder {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        if let Some(s) = &mut self.solver {
+            s.flow(flow);
+        }
+        if let Some(f) = &mut self.files {
+            f.rows(flow, self.solver.as_ref().and_then(ChargeSolver::samples));
+        }
+    }
+
+    fn event(&mut self, event: &Event, state: &StateView<'_>) {
+        self.stats.event(event, state);
+        if let Some(f) = &mut self.files {
+            f.event(event, state);
+        }
+    }
+}
+
 /// Runs `vibrotribo simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     let loaded = Loaded::load(args.config.as_deref(), &args.set)?;
     let params = loaded.config.chain_params()?;
     let spec = loaded.config.run_spec(&params)?;
     let options = loaded.config.sim_options()?;
+    let harvester = if args.mechanics_only {
+        None
+    } else {
+        Some(loaded.harvester(&params)?)
+    };
     let period = params.period();
     let mut sim = Simulator::new(&params, &spec.initial, options)?;
-    let mut stats = RunStats::new(params.len() - 1, period, spec.transient_periods);
-    let mut files = match &args.out {
-        Some(dir) => Some(Files::create(dir, &params, &spec)?),
+    let solver = match &harvester {
+        Some(h) => {
+            let mut s = ChargeSolver::for_chain(h, &params, loaded.charge_options()?)?;
+            if args.out.is_some() {
+                s = s.with_sampling(0.0, period / spec.samples_per_period as f64)?;
+            }
+            Some(s)
+        }
         None => None,
+    };
+    let files = match &args.out {
+        Some(dir) => Some(Files::create(dir, &params, &spec, harvester.as_ref())?),
+        None => None,
+    };
+    let mut rec = Recorder {
+        stats: RunStats::new(params.len() - 1, period, spec.transient_periods),
+        solver,
+        files,
     };
     let progress = Progress::new(spec.periods, "periods", args.quiet);
     let started = Instant::now();
     let mut done = 0;
-    let mut failure = None;
+    let mut failure: Option<anyhow::Error> = None;
     for p in 1..=spec.periods {
-        let result = sim.run_until(p as f64 * period, &mut (&mut stats, &mut files));
-        if let Err(e) = result {
-            failure = Some(e);
+        if let Err(e) = sim.run_until(p as f64 * period, &mut rec) {
+            failure = Some(e.into());
+            break;
+        }
+        if let Some(Err(e)) = rec.solver.as_ref().map(ChargeSolver::status) {
+            failure = Some(anyhow::Error::from(e).context("charge solver"));
             break;
         }
         done = p;
@@ -163,12 +249,29 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     progress.finish();
     let elapsed = started.elapsed().as_secs_f64();
-    let summary = summary_json(&loaded, &params, &spec, &stats, done, elapsed, failure.as_ref());
-    if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
+    let summary = summary_json(
+        &loaded,
+        &params,
+        &spec,
+        &rec,
+        harvester.as_ref(),
+        done,
+        elapsed,
+        failure.as_ref(),
+    );
+    if let (Some(files), Some(dir)) = (rec.files.as_mut(), &args.out) {
         files.flush()?;
         write_json(&dir.join("summary.json"), &summary)?;
     }
-    print_summary(&params, &spec, &stats, done, elapsed, args.out.as_deref());
+    print_summary(
+        &params,
+        &spec,
+        &rec,
+        harvester.as_ref(),
+        done,
+        elapsed,
+        args.out.as_deref(),
+    );
     if let Some(e) = failure {
         return Err(e).context(format!("simulation stopped after {done} complete periods"));
     }
@@ -181,19 +284,21 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn summary_json(
     loaded: &Loaded,
     params: &ChainParams,
     spec: &RunSpec,
-    stats: &RunStats,
+    rec: &Recorder,
+    harvester: Option<&HarvesterParams>,
     done: u64,
     elapsed: f64,
-    failure: Option<&vibrotribo::SimError>,
+    failure: Option<&anyhow::Error>,
 ) -> serde_json::Value {
+    let stats = &rec.stats;
     let per_contact = stats.impacts_per_period(done);
     let after = stats.impacts_after_transient();
-    let nd = params.nondimensional();
-    json!({
+    let mut out = json!({
         "periods": done,
         "periods_requested": spec.periods,
         "transient_periods": spec.transient_periods,
@@ -210,23 +315,69 @@ fn summary_json(
         "excitation_period_s": params.period(),
         "omega_rad_s": params.omega(),
         "omega_ratio": params.omega_ratio(),
-        "nondimensional": nd,
-        "parameters": params,
-        "settings": loaded.table,
-        "wall_time_s": elapsed,
-        "interrupted": done < spec.periods && failure.is_none(),
-        "error": failure.map(|e| e.to_string()),
-    })
+    });
+    let obj = out.as_object_mut().expect("object");
+    if let (Some(solver), Some(h)) = (&rec.solver, harvester) {
+        let s = solver.summary(spec.transient_periods as usize);
+        obj.insert(
+            "average_power_w".into(),
+            json!(s.as_ref().map(|s| s.average_power_w)),
+        );
+        obj.insert(
+            "energy_per_period_j".into(),
+            json!(s.as_ref().map(|s| s.energy_per_period_j)),
+        );
+        obj.insert(
+            "peak_current_a".into(),
+            json!(s.as_ref().map(|s| s.peak_current_a)),
+        );
+        obj.insert(
+            "peak_voltage_v".into(),
+            json!(s.as_ref().map(|s| s.peak_voltage_v)),
+        );
+        obj.insert("power_curve".into(), json!(solver.power_curve()));
+        obj.insert(
+            "energy_in_each_period_j".into(),
+            json!(solver.periods().iter().map(|p| p.energy_j).collect::<Vec<_>>()),
+        );
+        if h.load == LoadKind::Rectifier {
+            obj.insert(
+                "storage_voltage_at_period_end_v".into(),
+                json!(
+                    solver
+                        .periods()
+                        .iter()
+                        .map(|p| p.storage_voltage_v)
+                        .collect::<Vec<_>>()
+                ),
+            );
+            obj.insert("time_to_target_s".into(), json!(solver.time_to_target()));
+        }
+        obj.insert("harvester".into(), json!(h));
+        obj.insert("electrical_solver".into(), json!(format!("{:?}", solver.stats())));
+    }
+    obj.insert("nondimensional".into(), json!(params.nondimensional()));
+    obj.insert("parameters".into(), json!(params));
+    obj.insert("settings".into(), json!(loaded.table));
+    obj.insert("wall_time_s".into(), json!(elapsed));
+    obj.insert(
+        "interrupted".into(),
+        json!(done < spec.periods && failure.is_none()),
+    );
+    obj.insert("error".into(), json!(failure.map(|e| format!("{e:#}"))));
+    out
 }
 
 fn print_summary(
     params: &ChainParams,
     spec: &RunSpec,
-    stats: &RunStats,
+    rec: &Recorder,
+    harvester: Option<&HarvesterParams>,
     done: u64,
     elapsed: f64,
     out: Option<&Path>,
 ) {
+    let stats = &rec.stats;
     let n = params.len();
     let per_contact = stats.impacts_per_period(done);
     println!(
@@ -260,6 +411,33 @@ fn print_summary(
         .map(|(k, v)| format!("m{}–m{}: {v:.3} m/s", k + 1, k + 2))
         .collect();
     println!("  largest closing speed: {}", speeds.join(", "));
+    if let (Some(solver), Some(h)) = (&rec.solver, harvester) {
+        let load = match h.load {
+            LoadKind::Resistor => format!("resistor {}", si(h.load_resistance, "Ω")),
+            LoadKind::Rectifier => format!("rectifier into {}", si(h.storage_capacitance, "F")),
+            other => other.as_str().to_string(),
+        };
+        match solver.summary(spec.transient_periods as usize) {
+            Some(s) => println!(
+                "  harvester ({}, V_oc {}, {load}): average power {} after the transient, {} per period, peak current {}, peak voltage {}",
+                h.mode.as_str(),
+                h.voc_model.as_str(),
+                si(s.average_power_w, "W"),
+                si(s.energy_per_period_j, "J"),
+                si(s.peak_current_a, "A"),
+                si(s.peak_voltage_v, "V"),
+            ),
+            None => println!("  harvester: no complete period after the transient"),
+        }
+        if h.load == LoadKind::Rectifier {
+            if let Some(v) = solver.storage_voltage() {
+                println!("  storage capacitor at {}", si(v, "V"));
+            }
+            if let Some(t) = solver.time_to_target() {
+                println!("  target voltage reached at t = {t:.6} s");
+            }
+        }
+    }
     if let Some(dir) = out {
         println!(
             "  wrote {0}/events.csv, {0}/trajectory.csv, {0}/summary.json",

@@ -172,3 +172,188 @@ fn bad_input_is_named() {
     let o = vibrotribo(&["simulate", cfg.to_str().unwrap()]);
     assert!(stderr(&o).contains("not valid TOML"), "{}", stderr(&o));
 }
+
+#[test]
+fn electrical_outputs_match_the_reference_power() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let o = vibrotribo(&[
+        "simulate",
+        "--out",
+        d,
+        "--set",
+        "run.periods=40",
+        "--set",
+        "run.transient_periods=30",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = read_csv(&dir.path().join("trajectory.csv"));
+    for col in ["q_c", "i_a", "v_v", "c_f", "voc_v"] {
+        assert!(
+            header.iter().any(|h| h == col),
+            "trajectory.csv lacks {col}: {header:?}"
+        );
+    }
+    let ci = header.iter().position(|h| h == "c_f").unwrap();
+    let first_c: f64 = rows[0][ci].parse().unwrap();
+    // C = ε0 S / (d0 + D1 + D2) at the start: d0 = 2 × 0.1 mm / 2.0, D = 20 mm each.
+    let expected = 8.8541878128e-12 * 0.01 / (1e-4 + 0.04);
+    assert!(
+        (first_c - expected).abs() < 1e-12 * expected,
+        "{first_c} vs {expected}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(reference_dir().join("default-case-summary.json")).unwrap(),
+    )
+    .unwrap();
+    let ours = summary["average_power_w"].as_f64().unwrap();
+    let theirs = reference["average_power_w"]["value"].as_f64().unwrap();
+    assert!(
+        (ours - theirs).abs() < 1e-6 * theirs,
+        "average power {ours} vs reference {theirs}"
+    );
+    assert_eq!(summary["power_curve"].as_array().unwrap().len(), 40);
+    for key in ["energy_per_period_j", "peak_current_a", "peak_voltage_v"] {
+        assert!(summary[key].as_f64().unwrap() > 0.0, "{key}");
+    }
+}
+
+#[test]
+fn rectifier_run_reports_storage_voltage() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let o = vibrotribo(&[
+        "simulate",
+        "--out",
+        d,
+        "--set",
+        "harvester.load=rectifier",
+        "--set",
+        "harvester.target_voltage=10",
+        "--set",
+        "run.periods=12",
+        "--set",
+        "run.transient_periods=2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+    let vs: Vec<f64> = summary["storage_voltage_at_period_end_v"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        vs.windows(2).all(|w| w[1] >= w[0]),
+        "a bridge only charges: {vs:?}"
+    );
+    let t = summary["time_to_target_s"].as_f64().expect("10 V reached");
+    assert!(t > 0.0 && t < 12.0 * 0.1795196);
+    let (header, _) = read_csv(&dir.path().join("trajectory.csv"));
+    assert!(header.iter().any(|h| h == "vs_v"));
+}
+
+#[test]
+fn load_sweep_finds_the_optimum_and_power_grows_with_r_below_it() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let o = vibrotribo(&[
+        "load-sweep",
+        "--out",
+        d,
+        "--from",
+        "1e3",
+        "--to",
+        "1e13",
+        "--steps",
+        "11",
+        "--set",
+        "run.periods=12",
+        "--set",
+        "run.transient_periods=4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = read_csv(&dir.path().join("load_sweep.csv"));
+    assert_eq!(
+        header,
+        ["load_resistance_ohm", "average_power_w", "energy_per_period_j"]
+    );
+    let p: Vec<f64> = rows.iter().map(|r| r[1].parse().unwrap()).collect();
+    // In the quasi-static regime (R·C ≪ the motion's time scale) P = R⟨(dQ_eq/dt)²⟩ ∝ R.
+    assert!(
+        (p[1] / p[0] - 10.0).abs() < 0.1,
+        "P(10 kΩ)/P(1 kΩ) = {}",
+        p[1] / p[0]
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("load_sweep.json")).unwrap()).unwrap();
+    let best = json["optimum"]["average_power_w"].as_f64().unwrap();
+    assert!(p.iter().all(|&x| x <= best * (1.0 + 1e-9)));
+    assert!(!json["optimum_at_edge"].as_bool().unwrap());
+    let (vq_header, vq) = read_csv(&dir.path().join("vq_cycle.csv"));
+    assert_eq!(vq_header[..3], ["load_resistance_ohm", "time_s", "q_c"]);
+    assert_eq!(vq.len(), 2 * 401);
+}
+
+#[test]
+fn export_spice_writes_a_netlist_that_ngspice_agrees_with() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let o = vibrotribo(&[
+        "simulate",
+        "--out",
+        d,
+        "--set",
+        "run.periods=6",
+        "--set",
+        "run.transient_periods=3",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = vibrotribo(&["export-spice", d, "--periods", "1", "--check"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let deck = std::fs::read_to_string(dir.path().join("harvester.cir")).unwrap();
+    assert!(deck.contains("PWL(") && deck.contains("tran"), "{deck}");
+    let out = String::from_utf8_lossy(&o.stdout);
+    let rel: f64 = out
+        .split("relative difference ")
+        .nth(1)
+        .and_then(|s| s.split(';').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no comparison in {out}"));
+    assert!(rel.abs() < 1e-3, "ngspice differs by {rel}");
+}
+
+#[test]
+fn bad_harvester_input_is_named() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["simulate", "--set", "harvester.area=-1"], "harvester.area = -1"),
+        (
+            &["simulate", "--set", "harvester.load_resistance=-5"],
+            "harvester.load_resistance",
+        ),
+        (
+            &["simulate", "--set", "harvester.relative_permittivity=[2, 0]"],
+            "harvester.relative_permittivity[1]",
+        ),
+        (
+            &["simulate", "--set", "harvester.mode=sliding"],
+            "unknown variant `sliding`",
+        ),
+        (
+            &["simulate", "--set", "harvester.loadd=resistor"],
+            "unknown parameter `harvester.loadd`",
+        ),
+    ];
+    for (args, expected) in cases {
+        let o = vibrotribo(args);
+        assert!(!o.status.success(), "{args:?} should fail");
+        let err = stderr(&o);
+        assert!(
+            err.contains(expected),
+            "{args:?}: expected {expected:?} in {err:?}"
+        );
+    }
+}

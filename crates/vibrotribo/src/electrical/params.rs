@@ -48,6 +48,16 @@ pub enum VocModel {
     Exact,
 }
 
+impl VocModel {
+    /// Name as written in configuration files: `paper` or `exact`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            VocModel::Paper => "paper",
+            VocModel::Exact => "exact",
+        }
+    }
+}
+
 /// What the transducer's electrodes are connected to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -1,0 +1,108 @@
+//! `vibrotribo export-spice RUN_DIR`: an ngspice netlist of a run's harvester, driven by the
+//! run's gap waveforms, for use in one's own circuit designs (and an optional check against
+//! ngspice).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use vibrotribo::electrical::spice::{self, SpiceOptions};
+use vibrotribo::electrical::{ChargeSolver, PwlGaps};
+use vibrotribo::{Simulator, Trajectory};
+
+use crate::config::Loaded;
+use crate::output::si;
+
+/// Options of `vibrotribo export-spice`.
+#[derive(Debug, clap::Args)]
+pub struct ExportSpiceArgs {
+    /// A directory written by `vibrotribo simulate --out`.
+    pub run_dir: PathBuf,
+    /// First excitation period exported (default: the first after the transient).
+    #[arg(long)]
+    pub from_period: Option<u64>,
+    /// Periods exported (default: 2).
+    #[arg(long, default_value_t = 2)]
+    pub periods: u64,
+    /// PWL sampling interval as a fraction of the excitation period (every impact is also a
+    /// breakpoint).
+    #[arg(long, default_value_t = 1.0 / 2000.0)]
+    pub dt_fraction: f64,
+    /// Netlist file name, written in RUN_DIR.
+    #[arg(long, default_value = "harvester.cir")]
+    pub name: String,
+    /// Also run ngspice on the netlist and compare its delivered energy with vibrotribo's.
+    #[arg(long)]
+    pub check: bool,
+}
+
+/// Runs `vibrotribo export-spice`.
+pub fn run(args: &ExportSpiceArgs) -> Result<()> {
+    let summary_path = args.run_dir.join("summary.json");
+    let text = std::fs::read_to_string(&summary_path).with_context(|| {
+        format!(
+            "cannot read {} (export-spice needs a directory written by `vibrotribo simulate --out`)",
+            summary_path.display()
+        )
+    })?;
+    let summary: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not valid JSON", summary_path.display()))?;
+    let settings = summary
+        .get("settings")
+        .cloned()
+        .with_context(|| format!("{} has no `settings`", summary_path.display()))?;
+    let table: toml::Table =
+        serde_json::from_value(settings).context("the recorded settings are not a table")?;
+    let loaded = Loaded::from_table(table)?;
+    let chain = loaded.config.chain_params()?;
+    let spec = loaded.config.run_spec(&chain)?;
+    let harvester = loaded.harvester(&chain)?;
+    if !(args.dt_fraction > 0.0 && args.dt_fraction < 1.0) {
+        bail!("--dt-fraction must lie in (0, 1), got {}", args.dt_fraction);
+    }
+    let from = args.from_period.unwrap_or(spec.transient_periods);
+    if args.periods == 0 {
+        bail!("--periods must be at least 1");
+    }
+    let period = chain.period();
+    let (t0, t1) = (from as f64 * period, (from + args.periods) as f64 * period);
+
+    // Re-create the run's exact trajectory (the simulation is deterministic).
+    let mut sim = Simulator::new(&chain, &spec.initial, loaded.config.sim_options()?)?;
+    sim.run_until(t0, &mut ())?;
+    let mut trajectory = Trajectory::new(&sim);
+    sim.run_until(t1, &mut trajectory)?;
+    let pwl = PwlGaps::from_trajectory(&trajectory, args.dt_fraction * period, t1)?;
+    let options = SpiceOptions::default();
+    let data_file = "vibrotribo-out.txt";
+    let deck = spice::netlist(&harvester, &pwl, t1, &options, data_file)?;
+    let path = args.run_dir.join(&args.name);
+    std::fs::write(&path, &deck).with_context(|| format!("cannot write {}", path.display()))?;
+    println!(
+        "wrote {} ({} PWL points, periods {from}..{} of the run, t = {t0:.6}…{t1:.6} s shifted to start at 0)",
+        path.display(),
+        pwl.times().len(),
+        from + args.periods
+    );
+    println!(
+        "  run it with `ngspice -b {}` in {}; it writes {data_file} (time, charge in nC, energy in nJ, voltage)",
+        args.name,
+        args.run_dir.display()
+    );
+    if args.check {
+        let ours = {
+            let mut s = ChargeSolver::for_chain(&harvester, &chain, loaded.charge_options()?)?;
+            s.run_pwl(&pwl)?;
+            s.total_energy()
+        };
+        let run = spice::run_ngspice(&harvester, &pwl, t1, &options)?;
+        let theirs = run.energy_j.last().copied().unwrap_or(f64::NAN);
+        println!(
+            "  delivered energy: vibrotribo {}, ngspice {} (relative difference {:.2e}; ngspice took {:.2} s)",
+            si(ours, "J"),
+            si(theirs, "J"),
+            (ours - theirs) / theirs,
+            run.elapsed.as_secs_f64()
+        );
+    }
+    Ok(())
+}
