@@ -8,8 +8,10 @@ mod load_sweep;
 mod output;
 #[allow(dead_code)] // parts are used as commands gain --plot
 mod plot;
+mod plots;
 mod progress;
 mod simulate;
+mod sweep;
 
 use std::process::ExitCode;
 
@@ -31,6 +33,22 @@ enum Command {
     LoadSweep(load_sweep::LoadSweepArgs),
     /// Write an ngspice netlist of a run's harvester driven by its gap waveforms.
     ExportSpice(export_spice::ExportSpiceArgs),
+    /// Sweep one parameter: orbit diagram, impact velocities, period, power.
+    Sweep(sweep::SweepArgs),
+    /// Combine the shards of one sweep (`sweep --shard I/N`) into the unsharded output.
+    Merge(sweep::MergeArgs),
+    /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
+    Plot(PlotArgs),
+}
+
+/// Options of `vibrotribo plot`.
+#[derive(Debug, clap::Args)]
+struct PlotArgs {
+    /// A directory written by `simulate --out`, `sweep --out` or `map --out`.
+    dir: std::path::PathBuf,
+    /// PSD of this mass only (1-based; default: every mass).
+    #[arg(long)]
+    psd_mass: Option<usize>,
 }
 
 fn run() -> anyhow::Result<()> {
@@ -40,6 +58,9 @@ fn run() -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&args),
         Command::LoadSweep(args) => load_sweep::run(&args),
         Command::ExportSpice(args) => export_spice::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
+        Command::Merge(args) => sweep::merge(&args),
+        Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
     }
 }
 

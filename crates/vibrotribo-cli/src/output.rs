@@ -71,6 +71,65 @@ pub fn numbered(prefix: &str, n: usize, suffix: &str) -> Vec<String> {
     (1..=n).map(|i| format!("{prefix}{i}{suffix}")).collect()
 }
 
+/// A text field for CSV: quoted (with quotes doubled) if it holds a comma, quote or newline.
+pub fn csv_text(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// Reads a CSV file written by this program: header and rows of fields (quoted fields are
+/// kept whole).
+pub fn read_csv(path: &Path) -> Result<(Vec<String>, Vec<Vec<String>>)> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .ok_or_else(|| anyhow::anyhow!("{} is empty", path.display()))?
+        .split(',')
+        .map(String::from)
+        .collect();
+    let rows = lines.map(split_csv_line).collect();
+    Ok((header, rows))
+}
+
+fn split_csv_line(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut field = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    out.push(field);
+    out
+}
+
+/// Column `name` of `header`, or an error naming the file's columns.
+pub fn column(header: &[String], name: &str) -> Result<usize> {
+    header
+        .iter()
+        .position(|h| h == name)
+        .ok_or_else(|| anyhow::anyhow!("no column `{name}` (columns: {})", header.join(", ")))
+}
+
+/// Column `idx` of `rows` parsed as numbers (empty or unparsable fields become NaN).
+pub fn numbers(rows: &[Vec<String>], idx: usize) -> Vec<f64> {
+    rows.iter()
+        .map(|r| r.get(idx).and_then(|f| f.parse().ok()).unwrap_or(f64::NAN))
+        .collect()
+}
+
 /// `value` with an SI prefix and `unit`, 4 significant digits (`12.92 µW`).
 pub fn si(value: f64, unit: &str) -> String {
     if !value.is_finite() {
@@ -111,6 +170,15 @@ pub fn si(value: f64, unit: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn csv_fields_round_trip() {
+        let text = super::csv_text("stopped, at t = 1: \"event limit\"");
+        assert_eq!(
+            super::split_csv_line(&format!("1.5,,{text}")),
+            ["1.5", "", "stopped, at t = 1: \"event limit\""]
+        );
+    }
+
     #[test]
     fn si_prefixes() {
         assert_eq!(super::si(1.292e-5, "W"), "12.92 µW");

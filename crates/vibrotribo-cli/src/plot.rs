@@ -518,9 +518,28 @@ fn draw_xy<DB: DrawingBackend>(
 ) -> Result<()> {
     let area = titled(root, &chart.figure.title)?;
     let (x, y) = (chart.x.clone(), chart.y.clone());
+    let y_span = y.end - y.start;
     match chart.figure.y_scale {
-        Scale::Linear => draw_xy_on(root, &area, chart.figure, &chart.layers, format, x, y),
-        Scale::Log => draw_xy_on(root, &area, chart.figure, &chart.layers, format, x, y.log_scale()),
+        Scale::Linear => draw_xy_on(
+            root,
+            &area,
+            chart.figure,
+            &chart.layers,
+            format,
+            x,
+            y,
+            Some(y_span),
+        ),
+        Scale::Log => draw_xy_on(
+            root,
+            &area,
+            chart.figure,
+            &chart.layers,
+            format,
+            x,
+            y.log_scale(),
+            None,
+        ),
     }
 }
 
@@ -533,12 +552,21 @@ fn draw_xy_on<DB, Y>(
     format: Format,
     x: Range<f64>,
     y: Y,
+    y_span: Option<f64>,
 ) -> Result<()>
 where
     DB: DrawingBackend,
     Y: AsRangedCoord<Value = f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
+    // Ticks of a linear axis that are rounding away from 0 (e.g. −5.6e-17) read as 0.
+    let x_span = x.end - x.start;
+    let snap = |v: f64, span: Option<f64>| match span {
+        Some(span) if v.abs() < 1e-9 * span.abs() => 0.0,
+        _ => v,
+    };
+    let fx = move |v: &f64| tick_label(snap(*v, Some(x_span)));
+    let fy = move |v: &f64| tick_label(snap(*v, y_span));
     let mut chart = ChartBuilder::on(area)
         .margin(16)
         .margin_right(28)
@@ -546,15 +574,14 @@ where
         .y_label_area_size(90)
         .build_cartesian_2d(x, y)
         .map_err(err)?;
-    let formatter = |v: &f64| tick_label(*v);
     chart
         .configure_mesh()
         .x_desc(&figure.x_label)
         .y_desc(&figure.y_label)
         .axis_desc_style(font(LABEL_PX))
         .label_style(font(TICK_PX))
-        .x_label_formatter(&formatter)
-        .y_label_formatter(&formatter)
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
         .light_line_style(RGBColor(235, 235, 235))
         .bold_line_style(RGBColor(210, 210, 210))
         .draw()

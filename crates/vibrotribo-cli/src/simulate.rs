@@ -29,6 +29,10 @@ pub struct SimulateArgs {
     /// Mechanics only: skip the triboelectric harvester.
     #[arg(long)]
     pub mechanics_only: bool,
+    /// Also write the per-run analyses (Poincaré sections, PSDs) and draw the pictures
+    /// (needs --out).
+    #[arg(long)]
+    pub plot: bool,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -198,6 +202,9 @@ impl Observer for Recorder {
 
 /// Runs `vibrotribo simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
+    if args.plot && args.out.is_none() {
+        anyhow::bail!("--plot needs --out DIR");
+    }
     let loaded = Loaded::load(args.config.as_deref(), &args.set)?;
     let params = loaded.config.chain_params()?;
     let spec = loaded.config.run_spec(&params)?;
@@ -262,6 +269,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let (Some(files), Some(dir)) = (rec.files.as_mut(), &args.out) {
         files.flush()?;
         write_json(&dir.join("summary.json"), &summary)?;
+        if args.plot {
+            crate::plots::analyze_run(dir, None)?;
+        }
     }
     print_summary(
         &params,

@@ -24,6 +24,7 @@ mod poincare;
 mod power;
 mod spectrum;
 mod stats;
+mod sweep;
 
 pub use fit::{QuadraticFit, fit_quadratic};
 pub use period::{PeriodOptions, Periodicity, detect_period};
@@ -31,6 +32,7 @@ pub use poincare::{ImpactPoint, ImpactSection, StroboscopicOptions, Stroboscopic
 pub use power::{mean_power, running_average_power};
 pub use spectrum::{Detrend, Psd, WelchOptions, Window, welch_psd};
 pub use stats::RunStats;
+pub use sweep::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 
 use crate::error::ParamError;
 use thiserror::Error;

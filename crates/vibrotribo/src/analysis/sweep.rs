@@ -1,0 +1,249 @@
+//! One point of a parameter sweep: a run after its transient, condensed into what bifurcation
+//! diagrams, impact-velocity diagrams and power curves need (seed Figs. 7, 12, 14, 17, 18,
+//! 20, 21).
+//!
+//! [`run_point`] simulates a chain from a given state for `transient + recorded` excitation
+//! periods and returns the stroboscopic samples of every mass at `t = nT` after the transient
+//! (the orbit diagram), every impact after the transient with its closing speed (the paper's
+//! "bifurcation diagram of V12 / V23"), impacts per period per contact, the detected period,
+//! whether chatter, sticking or grazing occurred, the average power of a harvester if one is
+//! given, and the final state (for continuation to the next parameter value).
+
+use super::{PeriodOptions, Periodicity, RunStats, StroboscopicOptions, StroboscopicSection, detect_period};
+use crate::dynamics::{Event, EventKind, Flow, Observer, Simulator, StateView};
+use crate::electrical::{ChargeOptions, ChargeSolver, ElectricalError, HarvesterParams};
+use crate::error::SimError;
+use crate::model::{ChainParams, ChainState, SimOptions};
+use thiserror::Error;
+
+/// Settings of [`run_point`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointOptions {
+    /// Periods simulated before anything is recorded. Default 300.
+    pub transient_periods: u64,
+    /// Periods recorded after the transient. Default 100.
+    pub recorded_periods: u64,
+    /// Relative tolerance of the period detection ([`PeriodOptions::tolerance`]).
+    /// Default 1e-4.
+    pub period_tolerance: f64,
+    /// An impact slower than this fraction of the base's peak speed A·ω, that is not a bounce
+    /// of a chatter sequence (its closing speed is below half the previous rebound speed at
+    /// that contact, or it is the first impact there), counts as grazing. Default 1e-3.
+    pub grazing_ratio: f64,
+    /// Periods before the recorded window at which the charge solver starts from the
+    /// electrostatic equilibrium (the circuit forgets its initial charge within a few R·C,
+    /// far less than this for all but extreme loads). Default 20.
+    pub electrical_warmup_periods: u64,
+}
+
+impl Default for PointOptions {
+    fn default() -> Self {
+        PointOptions {
+            transient_periods: 300,
+            recorded_periods: 100,
+            period_tolerance: 1e-4,
+            grazing_ratio: 1e-3,
+            electrical_warmup_periods: 20,
+        }
+    }
+}
+
+impl PointOptions {
+    /// The period-detection settings for `recorded_periods` samples: periods up to
+    /// min(64, recorded/2), each checked over the rest of the window.
+    pub fn period_options(&self) -> PeriodOptions {
+        let recorded = self.recorded_periods.max(2) as usize;
+        let max_period = 64.min(recorded / 2).max(1);
+        let repeats = (recorded / max_period).saturating_sub(1).max(1);
+        PeriodOptions {
+            max_period,
+            tolerance: self.period_tolerance,
+            repeats,
+            scale: None,
+        }
+    }
+}
+
+/// One impact after the transient.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImpactRecord {
+    /// Time from the start of the point's run, s.
+    pub time: f64,
+    /// Contact, 0-based.
+    pub contact: usize,
+    /// Closing speed just before the impact, m/s.
+    pub closing_speed: f64,
+}
+
+/// What one sweep point found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointResult {
+    /// Period indices n of the stroboscopic samples (t = nT), after the transient.
+    pub strobe_periods: Vec<u64>,
+    /// Positions at those times, m, flattened (`strobe[j·N + i]`).
+    pub strobe: Vec<f64>,
+    /// Impacts after the transient.
+    pub impacts: Vec<ImpactRecord>,
+    /// Mean impacts per period after the transient, per contact.
+    pub impacts_per_period: Vec<f64>,
+    /// The detected period of the stroboscopic positions (`None` if too few samples).
+    pub periodicity: Option<Periodicity>,
+    /// Whether a chatter sequence ended in an accumulation-point jump after the transient.
+    pub chatter: bool,
+    /// Whether any contact stuck after the transient.
+    pub sticking: bool,
+    /// Whether a grazing impact occurred after the transient (see
+    /// [`PointOptions::grazing_ratio`]).
+    pub grazing: bool,
+    /// Average power after the transient (seed eq. 14), W, if a harvester was given.
+    pub average_power_w: Option<f64>,
+    /// State at the end of the run (t = (transient + recorded)·T).
+    pub final_state: ChainState,
+}
+
+impl PointResult {
+    /// Detected period in excitation periods, 0 if non-periodic (or undetermined).
+    pub fn period(&self) -> usize {
+        self.periodicity.and_then(|p| p.period()).unwrap_or(0)
+    }
+
+    /// Total impacts per period after the transient.
+    pub fn total_impacts_per_period(&self) -> f64 {
+        self.impacts_per_period.iter().sum()
+    }
+}
+
+/// A sweep point failed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum PointError {
+    /// The mechanics stopped.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The charge solver stopped.
+    #[error("charge solver: {0}")]
+    Electrical(#[from] ElectricalError),
+}
+
+/// Records impacts after the transient and flags grazing.
+struct Impacts {
+    after: f64,
+    grazing_speed: f64,
+    last_rebound: Vec<f64>,
+    records: Vec<ImpactRecord>,
+    grazing: bool,
+}
+
+impl Observer for Impacts {
+    fn event(&mut self, event: &Event, _state: &StateView<'_>) {
+        if event.kind != EventKind::Impact {
+            if matches!(
+                event.kind,
+                EventKind::Stick | EventKind::Release | EventKind::Chatter
+            ) {
+                self.last_rebound[event.contact] = 0.0;
+            }
+            return;
+        }
+        let k = event.contact;
+        let v = event.velocity_before;
+        if event.time >= self.after {
+            self.records.push(ImpactRecord {
+                time: event.time,
+                contact: k,
+                closing_speed: v,
+            });
+            let chatter_bounce = self.last_rebound[k] > 0.0 && v >= 0.5 * self.last_rebound[k];
+            if v < self.grazing_speed && !chatter_bounce {
+                self.grazing = true;
+            }
+        }
+        self.last_rebound[k] = event.velocity_after;
+    }
+}
+
+/// Passes flows to the charge solver from a start time on.
+struct FromTime<O> {
+    from: f64,
+    inner: O,
+}
+
+impl<O: Observer> Observer for FromTime<O> {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        if flow.t_start >= self.from {
+            self.inner.flow(flow);
+        }
+    }
+}
+
+/// Runs one sweep point: `params` from `initial` for `transient + recorded` periods (see the
+/// module docs). With `harvester`, the charge solver starts
+/// [`electrical_warmup_periods`](PointOptions::electrical_warmup_periods) before the recorded
+/// window and the average power over the recorded periods is reported.
+pub fn run_point(
+    params: &ChainParams,
+    initial: &ChainState,
+    sim_options: &SimOptions,
+    harvester: Option<(&HarvesterParams, &ChargeOptions)>,
+    options: &PointOptions,
+) -> Result<PointResult, PointError> {
+    let n = params.len();
+    let period = params.period();
+    let transient = options.transient_periods;
+    let total = transient + options.recorded_periods;
+    let mut sim = Simulator::new(params, initial, sim_options.clone())?;
+    let mut strobe = StroboscopicSection::new(
+        n,
+        period,
+        StroboscopicOptions {
+            phase_time: 0.0,
+            transient_periods: transient + 1,
+        },
+    )
+    .expect("valid stroboscopic options");
+    let mut stats = RunStats::new(n - 1, period, transient);
+    let mut impacts = Impacts {
+        after: transient as f64 * period,
+        grazing_speed: options.grazing_ratio * params.excitation.amplitude * params.omega(),
+        last_rebound: vec![0.0; n - 1],
+        records: Vec::new(),
+        grazing: false,
+    };
+    let warmup = options.electrical_warmup_periods.min(transient);
+    let mut solver = match harvester {
+        Some((h, o)) => Some(FromTime {
+            from: (transient - warmup) as f64 * period,
+            inner: ChargeSolver::for_chain(h, params, o.clone()).map_err(|e| PointError::Sim(e.into()))?,
+        }),
+        None => None,
+    };
+    sim.run_until(
+        total as f64 * period,
+        &mut (&mut strobe, &mut stats, &mut impacts, &mut solver),
+    )?;
+    let average_power_w = match &solver {
+        Some(s) => {
+            s.inner.status()?;
+            s.inner.summary(warmup as usize).map(|s| s.average_power_w)
+        }
+        None => None,
+    };
+    let popts = options.period_options();
+    let periodicity = if strobe.len() >= popts.samples_needed() {
+        detect_period(&strobe.positions, n, &popts).ok()
+    } else {
+        None
+    };
+    Ok(PointResult {
+        strobe_periods: strobe.indices.clone(),
+        strobe: strobe.positions,
+        impacts_per_period: stats.impacts_per_period(total),
+        impacts: impacts.records,
+        periodicity,
+        chatter: stats.chatter_sequences > 0,
+        sticking: stats.sticks > 0,
+        grazing: impacts.grazing,
+        average_power_w,
+        final_state: sim.state(),
+    })
+}
