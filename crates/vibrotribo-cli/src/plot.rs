@@ -544,6 +544,8 @@ fn draw_xy<DB: DrawingBackend>(
 }
 
 /// Builds the chart on `area` with y coordinate `y` and draws mesh, lines, points, legend.
+/// `y_span` is the extent of a linear y axis (for tick labels), `None` for a log axis.
+#[allow(clippy::too_many_arguments)]
 fn draw_xy_on<DB, Y>(
     root: &DrawingArea<DB, Shift>,
     area: &DrawingArea<DB, Shift>,
