@@ -5,6 +5,7 @@ mod config;
 mod export_spice;
 mod harvester;
 mod load_sweep;
+mod map;
 mod output;
 #[allow(dead_code)] // parts are used as commands gain --plot
 mod plot;
@@ -37,6 +38,10 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Combine the shards of one sweep (`sweep --shard I/N`) into the unsharded output.
     Merge(sweep::MergeArgs),
+    /// Average power, period and impacts per period on a two-parameter grid.
+    Map(map::MapArgs),
+    /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
+    OptimizeMassRatio(map::OptimizeArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
     Plot(PlotArgs),
 }
@@ -60,6 +65,8 @@ fn run() -> anyhow::Result<()> {
         Command::ExportSpice(args) => export_spice::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => sweep::merge(&args),
+        Command::Map(args) => map::run(&args),
+        Command::OptimizeMassRatio(args) => map::optimize(&args),
         Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
     }
 }

@@ -1,0 +1,462 @@
+//! `vibrotribo map` (average power, period and impacts per period on a two-parameter grid)
+//! and `vibrotribo optimize-mass-ratio` (the optimal mass ratio R_mo(Ω) and the paper's
+//! quadratic fit of it, seed Fig. 16).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use rayon::prelude::*;
+use serde_json::json;
+use vibrotribo::analysis::{PointResult, fit_quadratic};
+
+use crate::config::Loaded;
+use crate::output::{CsvFile, create_dir, csv_text, write_json};
+use crate::plot::{self, Figure, Series};
+use crate::progress::{Progress, interrupted};
+use crate::sweep::{PointRunner, RunArgs, grid, set_threads};
+
+/// Options of `vibrotribo map`.
+#[derive(Debug, clap::Args)]
+pub struct MapArgs {
+    /// Configuration file (TOML); the paper's default case if omitted.
+    pub config: Option<PathBuf>,
+    /// Override a parameter (repeatable), as for `simulate`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Parameter along x (any key `sweep --param` accepts).
+    #[arg(long)]
+    pub x: String,
+    /// First x value.
+    #[arg(long)]
+    pub x_from: f64,
+    /// Last x value.
+    #[arg(long)]
+    pub x_to: f64,
+    /// Number of x values.
+    #[arg(long)]
+    pub x_steps: usize,
+    /// Parameter along y.
+    #[arg(long)]
+    pub y: String,
+    /// First y value.
+    #[arg(long)]
+    pub y_from: f64,
+    /// Last y value.
+    #[arg(long)]
+    pub y_to: f64,
+    /// Number of y values.
+    #[arg(long)]
+    pub y_steps: usize,
+    /// Write map.csv and map.json to this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also draw heat maps (PNG and SVG) into the output directory.
+    #[arg(long)]
+    pub plot: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
+    if steps == 0 {
+        bail!("--{name}-steps must be at least 1");
+    }
+    if !from.is_finite() || !to.is_finite() {
+        bail!("--{name}-from and --{name}-to must be finite numbers");
+    }
+    Ok(())
+}
+
+/// Runs `points` in parallel chunks, calling `write` in order; stops early on Ctrl-C.
+/// Returns how many were written.
+pub fn run_grid<'k, P, W>(
+    runner: &PointRunner,
+    points: &[P],
+    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
+    quiet: bool,
+    mut write: W,
+) -> Result<usize>
+where
+    P: Sync,
+    W: FnMut(&P, &Result<PointResult, String>) -> Result<()>,
+{
+    let progress = Progress::new(points.len() as u64, "points", quiet);
+    let chunk = rayon::current_num_threads() * 4;
+    let mut done = 0;
+    for block in points.chunks(chunk) {
+        let results: Vec<Result<PointResult, String>> = block
+            .par_iter()
+            .map(|p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")))
+            .collect();
+        for (p, r) in block.iter().zip(&results) {
+            write(p, r)?;
+            done += 1;
+            progress.inc(1);
+        }
+        if interrupted() {
+            break;
+        }
+    }
+    progress.finish();
+    Ok(done)
+}
+
+/// Runs `vibrotribo map`.
+pub fn run(args: &MapArgs) -> Result<()> {
+    check_axis("x", args.x_from, args.x_to, args.x_steps)?;
+    check_axis("y", args.y_from, args.y_to, args.y_steps)?;
+    if args.plot && args.out.is_none() {
+        bail!("--plot needs --out DIR");
+    }
+    set_threads(args.run.threads)?;
+    let base = Loaded::load(args.config.as_deref(), &args.set)?;
+    let runner = PointRunner::new(base, &args.run)?;
+    let (xs, ys) = (
+        grid(args.x_from, args.x_to, args.x_steps),
+        grid(args.y_from, args.y_to, args.y_steps),
+    );
+    for (k, v) in [(&args.x, xs[0]), (&args.y, ys[0])] {
+        runner.base().with(k, v)?.config.chain_params()?;
+    }
+    let points: Vec<(f64, f64)> = ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect();
+    let contacts = runner.base().config.chain_params()?.len() - 1;
+    let mut csv = match &args.out {
+        Some(dir) => {
+            create_dir(dir)?;
+            let mut cols: Vec<String> = [
+                "x",
+                "y",
+                "average_power_w",
+                "impacts_per_period",
+                "period",
+                "chatter",
+                "sticking",
+                "grazing",
+            ]
+            .map(String::from)
+            .to_vec();
+            cols.extend(crate::output::numbered("impacts_per_period_", contacts, ""));
+            cols.push("error".into());
+            Some(CsvFile::create(&dir.join("map.csv"), &cols)?)
+        }
+        None => None,
+    };
+    let started = Instant::now();
+    let (xk, yk) = (args.x.as_str(), args.y.as_str());
+    let done = run_grid(
+        &runner,
+        &points,
+        |&(x, y)| vec![(xk, x), (yk, y)],
+        args.run.quiet,
+        |&(x, y), r| {
+            let Some(csv) = csv.as_mut() else { return Ok(()) };
+            let mut row = vec![x.to_string(), y.to_string()];
+            match r {
+                Ok(p) => {
+                    row.extend([
+                        p.average_power_w.map_or(String::new(), |v| v.to_string()),
+                        p.total_impacts_per_period().to_string(),
+                        p.period().to_string(),
+                        p.chatter.to_string(),
+                        p.sticking.to_string(),
+                        p.grazing.to_string(),
+                    ]);
+                    row.extend(p.impacts_per_period.iter().map(f64::to_string));
+                    row.push(String::new());
+                }
+                Err(e) => {
+                    row.extend(std::iter::repeat_n(String::new(), 6 + contacts));
+                    row.push(csv_text(e));
+                }
+            }
+            csv.row(row)
+        },
+    )?;
+    if let (Some(csv), Some(dir)) = (csv.as_mut(), &args.out) {
+        csv.flush()?;
+        let o = runner.options();
+        write_json(
+            &dir.join("map.json"),
+            &json!({
+                "command": "map",
+                "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": args.x_steps, "values": xs},
+                "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": args.y_steps, "values": ys},
+                "transient_periods": o.transient_periods,
+                "recorded_periods": o.recorded_periods,
+                "period_tolerance": o.period_tolerance,
+                "mechanics_only": args.run.mechanics_only,
+                "complete": done == points.len(),
+                "settings": runner.base().table,
+            }),
+        )?;
+        if args.plot {
+            crate::plots::plot_map(dir)?;
+        }
+    }
+    println!(
+        "map of {} × {} ({} × {} points): {done} computed in {:.2} s on {} threads",
+        args.x,
+        args.y,
+        xs.len(),
+        ys.len(),
+        started.elapsed().as_secs_f64(),
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+/// Options of `vibrotribo optimize-mass-ratio`.
+#[derive(Debug, clap::Args)]
+pub struct OptimizeArgs {
+    /// Configuration file (TOML). The paper's study (Sect. 4.3.2) uses m1 = m3 = 50 g:
+    /// `--set oscillator.masses=[0.05,0.15,0.05]` on the default case.
+    pub config: Option<PathBuf>,
+    /// Override a parameter (repeatable), as for `simulate`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// First Ω.
+    #[arg(long, default_value_t = 0.55)]
+    pub omega_from: f64,
+    /// Last Ω.
+    #[arg(long, default_value_t = 0.95)]
+    pub omega_to: f64,
+    /// Number of Ω values.
+    #[arg(long, default_value_t = 9)]
+    pub omega_steps: usize,
+    /// Smallest mass ratio R_m = m2/m1 tried (m1 and m3 fixed).
+    #[arg(long, default_value_t = 1.2)]
+    pub rm_from: f64,
+    /// Largest mass ratio tried.
+    #[arg(long, default_value_t = 7.0)]
+    pub rm_to: f64,
+    /// Number of mass ratios per Ω.
+    #[arg(long, default_value_t = 59)]
+    pub rm_steps: usize,
+    /// Write power_grid.csv, optimum.csv and fit.json to this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also draw R_mo(Ω) with the fits (PNG and SVG).
+    #[arg(long)]
+    pub plot: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// The paper's fit of the optimal mass ratio, R_mo = aΩ² + bΩ + c (Sect. 4.3.2).
+pub const PAPER_FIT: [f64; 3] = [11.43, -28.46, 18.03];
+
+/// The maximum of `values` on the equally spaced `grid`, refined by the parabola through the
+/// best point and its neighbours (when it is interior and the parabola is concave).
+pub fn refine_maximum(grid: &[f64], values: &[f64]) -> Option<(f64, f64)> {
+    let (best, &vmax) = values
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))?;
+    if best == 0 || best + 1 >= values.len() || !values[best - 1].is_finite() || !values[best + 1].is_finite()
+    {
+        return Some((grid[best], vmax));
+    }
+    let (a, b, c) = (values[best - 1], vmax, values[best + 1]);
+    let denom = a - 2.0 * b + c;
+    if denom >= 0.0 {
+        return Some((grid[best], vmax));
+    }
+    let h = grid[best + 1] - grid[best];
+    let shift = 0.5 * (a - c) / denom;
+    Some((grid[best] + shift * h, b - 0.25 * (a - c) * shift))
+}
+
+/// Runs `vibrotribo optimize-mass-ratio`.
+pub fn optimize(args: &OptimizeArgs) -> Result<()> {
+    check_axis("omega", args.omega_from, args.omega_to, args.omega_steps)?;
+    check_axis("rm", args.rm_from, args.rm_to, args.rm_steps)?;
+    if args.rm_from <= 0.0 {
+        bail!("--rm-from must be positive");
+    }
+    if args.run.mechanics_only {
+        bail!("the optimal mass ratio maximises power: --mechanics-only does not apply");
+    }
+    if args.plot && args.out.is_none() {
+        bail!("--plot needs --out DIR");
+    }
+    set_threads(args.run.threads)?;
+    let base = Loaded::load(args.config.as_deref(), &args.set)?;
+    let runner = PointRunner::new(base, &args.run)?;
+    let (omegas, ratios) = (
+        grid(args.omega_from, args.omega_to, args.omega_steps),
+        grid(args.rm_from, args.rm_to, args.rm_steps),
+    );
+    let points: Vec<(f64, f64)> = omegas
+        .iter()
+        .flat_map(|&w| ratios.iter().map(move |&r| (w, r)))
+        .collect();
+    let mut power = vec![f64::NAN; points.len()];
+    let mut index = 0;
+    let mut grid_csv = match &args.out {
+        Some(dir) => {
+            create_dir(dir)?;
+            Some(CsvFile::create(
+                &dir.join("power_grid.csv"),
+                &[
+                    "omega_ratio",
+                    "mass_ratio",
+                    "average_power_w",
+                    "impacts_per_period",
+                    "period",
+                    "error",
+                ]
+                .map(String::from),
+            )?)
+        }
+        None => None,
+    };
+    let started = Instant::now();
+    let done = run_grid(
+        &runner,
+        &points,
+        |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)],
+        args.run.quiet,
+        |&(w, r), res| {
+            if let Ok(p) = res {
+                power[index] = p.average_power_w.unwrap_or(f64::NAN);
+            }
+            index += 1;
+            if let Some(csv) = grid_csv.as_mut() {
+                let row = match res {
+                    Ok(p) => vec![
+                        w.to_string(),
+                        r.to_string(),
+                        p.average_power_w.map_or(String::new(), |v| v.to_string()),
+                        p.total_impacts_per_period().to_string(),
+                        p.period().to_string(),
+                        String::new(),
+                    ],
+                    Err(e) => vec![
+                        w.to_string(),
+                        r.to_string(),
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        csv_text(e),
+                    ],
+                };
+                csv.row(row)?;
+            }
+            Ok(())
+        },
+    )?;
+    if done < points.len() {
+        bail!("interrupted after {done} of {} points", points.len());
+    }
+    let n = ratios.len();
+    let mut optimum = Vec::new();
+    for (i, &w) in omegas.iter().enumerate() {
+        let row = &power[i * n..(i + 1) * n];
+        if let Some((r, p)) = refine_maximum(&ratios, row) {
+            let at_edge = (r - ratios[0]).abs() < 1e-12 || (r - ratios[n - 1]).abs() < 1e-12;
+            optimum.push((w, r, p, at_edge));
+        }
+    }
+    let ws: Vec<f64> = optimum.iter().map(|o| o.0).collect();
+    let rs: Vec<f64> = optimum.iter().map(|o| o.1).collect();
+    let fit = fit_quadratic(&ws, &rs).ok();
+    println!(
+        "optimal mass ratio over Ω = {}…{} ({} values) × R_m = {}…{} ({} values), {} transient + {} recorded periods, in {:.1} s:",
+        args.omega_from,
+        args.omega_to,
+        omegas.len(),
+        args.rm_from,
+        args.rm_to,
+        n,
+        runner.options().transient_periods,
+        runner.options().recorded_periods,
+        started.elapsed().as_secs_f64()
+    );
+    for (w, r, p, edge) in &optimum {
+        let paper = PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2];
+        println!(
+            "  Ω = {w:.4}: R_mo = {r:.3} (paper's fit {paper:.3}), P = {:.4e} W{}",
+            p,
+            if *edge {
+                " (at the edge of the R_m range)"
+            } else {
+                ""
+            }
+        );
+    }
+    if let Some(f) = &fit {
+        println!(
+            "  fit R_mo = {:.2} Ω² {:+.2} Ω {:+.2} (R² = {}); the paper's: {} Ω² {:+} Ω {:+}",
+            f.a,
+            f.b,
+            f.c,
+            f.r_squared.map_or("n/a".into(), |r| format!("{r:.3}")),
+            PAPER_FIT[0],
+            PAPER_FIT[1],
+            PAPER_FIT[2]
+        );
+    }
+    if let (Some(csv), Some(dir)) = (grid_csv.as_mut(), &args.out) {
+        csv.flush()?;
+        let mut o = CsvFile::create(
+            &dir.join("optimum.csv"),
+            &[
+                "omega_ratio",
+                "optimal_mass_ratio",
+                "average_power_w",
+                "at_edge",
+                "paper_fit",
+            ]
+            .map(String::from),
+        )?;
+        for (w, r, p, edge) in &optimum {
+            let paper = PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2];
+            o.row([
+                w.to_string(),
+                r.to_string(),
+                p.to_string(),
+                edge.to_string(),
+                paper.to_string(),
+            ])?;
+        }
+        o.flush()?;
+        write_json(
+            &dir.join("fit.json"),
+            &json!({
+                "fit": fit.as_ref().map(|f| json!({"a": f.a, "b": f.b, "c": f.c, "r_squared": f.r_squared, "rms_residual": f.rms_residual})),
+                "paper_fit": {"a": PAPER_FIT[0], "b": PAPER_FIT[1], "c": PAPER_FIT[2]},
+                "omega_ratio": ws,
+                "optimal_mass_ratio": rs,
+                "transient_periods": runner.options().transient_periods,
+                "recorded_periods": runner.options().recorded_periods,
+                "settings": runner.base().table,
+            }),
+        )?;
+        if args.plot {
+            let fine: Vec<f64> = grid(args.omega_from, args.omega_to, 100);
+            let paper: Vec<f64> = fine
+                .iter()
+                .map(|w| PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2])
+                .collect();
+            let ours: Vec<f64> = fine
+                .iter()
+                .map(|w| fit.as_ref().map_or(f64::NAN, |f| f.a * w * w + f.b * w + f.c))
+                .collect();
+            for ext in ["png", "svg"] {
+                let fig = Figure::new("Optimal mass ratio R_mo(Ω)", "Ω = ω/Ω1", "R_mo = m2/m1");
+                plot::phase_portrait(
+                    &dir.join(format!("optimal_mass_ratio.{ext}")),
+                    &fig,
+                    &[
+                        Series::new("paper's fit", &fine, &paper),
+                        Series::new("fit to vibrotribo's optima", &fine, &ours),
+                    ],
+                    Some(Series::new("vibrotribo optima", &ws, &rs)),
+                )?;
+            }
+        }
+    }
+    Ok(())
+}
