@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use serde_json::json;
 use vibrotribo::analysis::{PointResult, fit_quadratic};
@@ -116,10 +116,12 @@ pub fn run(args: &MapArgs) -> Result<()> {
         grid(args.x_from, args.x_to, args.x_steps),
         grid(args.y_from, args.y_to, args.y_steps),
     );
-    for (k, v) in [(&args.x, xs[0]), (&args.y, ys[0])] {
-        runner.base().with(k, v)?.config.chain_params()?;
-    }
     let points: Vec<(f64, f64)> = ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect();
+    for &(x, y) in &points {
+        runner
+            .check(&[(&args.x, x), (&args.y, y)])
+            .with_context(|| format!("{} = {x}, {} = {y}", args.x, args.y))?;
+    }
     let contacts = runner.base().config.chain_params()?.len() - 1;
     let mut csv = match &args.out {
         Some(dir) => {
@@ -292,6 +294,11 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         .iter()
         .flat_map(|&w| ratios.iter().map(move |&r| (w, r)))
         .collect();
+    for &(w, r) in &points {
+        runner
+            .check(&[("omega_ratio", w), ("mass_ratio", r)])
+            .with_context(|| format!("Ω = {w}, R_m = {r}"))?;
+    }
     let mut power = vec![f64::NAN; points.len()];
     let mut index = 0;
     let mut grid_csv = match &args.out {

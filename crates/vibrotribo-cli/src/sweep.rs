@@ -185,6 +185,20 @@ impl PointRunner {
         &self.base
     }
 
+    /// Checks that the configuration with `keys` set to `values` is valid, without running it.
+    pub fn check(&self, keys: &[(&str, f64)]) -> Result<()> {
+        let mut loaded = self.base.clone();
+        for (k, v) in keys {
+            loaded = loaded.with(k, *v)?;
+        }
+        let params = loaded.config.chain_params()?;
+        loaded.config.run_spec(&params)?;
+        if !self.mechanics_only {
+            loaded.harvester(&params)?;
+        }
+        Ok(())
+    }
+
     /// Runs the configuration with `keys` set to `values`, from `initial` (or the configured
     /// initial state).
     pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult> {
@@ -362,12 +376,12 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let runner = PointRunner::new(base, &args.run)?;
     let masses = runner.base().config.chain_params()?.len();
     let values = grid(args.from, args.to, args.steps);
-    // Fail early on a bad key or value.
-    runner
-        .base()
-        .with(&args.param, values[0])
-        .and_then(|l| l.config.chain_params().map(|_| ()))
-        .with_context(|| format!("--param {}", args.param))?;
+    // Fail early on a bad key or on any value of the grid that makes a bad configuration.
+    for &v in &values {
+        runner
+            .check(&[(&args.param, v)])
+            .with_context(|| format!("--param {} = {v}", args.param))?;
+    }
     let mut order: Vec<usize> = (0..values.len()).collect();
     if args.continuation == Continuation::Down {
         order.reverse();

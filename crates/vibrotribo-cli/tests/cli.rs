@@ -357,3 +357,294 @@ fn bad_harvester_input_is_named() {
         );
     }
 }
+
+fn sweep_args<'a>(dir: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "sweep",
+        "--param",
+        "excitation.omega_ratio",
+        "--from",
+        "0.55",
+        "--to",
+        "0.8",
+        "--steps",
+        "7",
+        "--transient",
+        "30",
+        "--recorded",
+        "24",
+        "--out",
+        dir,
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    args
+}
+
+fn read(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(name).display()))
+}
+
+#[test]
+fn sweep_output_does_not_depend_on_the_thread_count() {
+    let (a, b) = (tempdir(), tempdir());
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        let o = vibrotribo(&sweep_args(dir.path().to_str().unwrap(), &["--threads", threads]));
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    for name in ["orbit.csv", "impacts.csv", "summary.csv", "sweep.json"] {
+        assert_eq!(
+            read(a.path(), name),
+            read(b.path(), name),
+            "{name} differs between 1 and 2 threads"
+        );
+    }
+    let (header, rows) = read_csv(&a.path().join("summary.csv"));
+    assert_eq!(
+        header[..6],
+        [
+            "param",
+            "average_power_w",
+            "impacts_per_period",
+            "period",
+            "chatter",
+            "sticking"
+        ]
+    );
+    assert_eq!(rows.len(), 7);
+    let (oh, orows) = read_csv(&a.path().join("orbit.csv"));
+    assert_eq!(oh, ["param", "period", "x1_m", "x2_m", "x3_m"]);
+    assert_eq!(orows.len(), 7 * 24);
+}
+
+#[test]
+fn shards_merge_into_exactly_the_unsharded_output() {
+    let whole = tempdir();
+    let o = vibrotribo(&sweep_args(whole.path().to_str().unwrap(), &[]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let shards: Vec<tempfile::TempDir> = (0..3).map(|_| tempdir()).collect();
+    for (i, dir) in shards.iter().enumerate() {
+        let shard = format!("{i}/3");
+        let o = vibrotribo(&sweep_args(dir.path().to_str().unwrap(), &["--shard", &shard]));
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let merged = tempdir();
+    let mut args = vec!["merge", "--out", merged.path().to_str().unwrap()];
+    // Shards given in any order.
+    for i in [2, 0, 1] {
+        args.push(shards[i].path().to_str().unwrap());
+    }
+    let o = vibrotribo(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for name in ["orbit.csv", "impacts.csv", "summary.csv", "sweep.json"] {
+        assert_eq!(
+            read(whole.path(), name),
+            read(merged.path(), name),
+            "merged {name} differs"
+        );
+    }
+    // A missing shard is refused.
+    let o = vibrotribo(&[
+        "merge",
+        "--out",
+        merged.path().to_str().unwrap(),
+        shards[0].path().to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("exactly once"), "{}", stderr(&o));
+}
+
+#[test]
+fn sweep_rows_agree_with_separate_simulate_runs() {
+    let sweep = tempdir();
+    let o = vibrotribo(&sweep_args(sweep.path().to_str().unwrap(), &[]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (sh, srows) = read_csv(&sweep.path().join("summary.csv"));
+    let (_, orows) = read_csv(&sweep.path().join("orbit.csv"));
+    for row in [&srows[1], &srows[5]] {
+        let value = &row[0];
+        let run = tempdir();
+        let set = format!("excitation.omega_ratio={value}");
+        let o = vibrotribo(&[
+            "simulate",
+            "--out",
+            run.path().to_str().unwrap(),
+            "--set",
+            &set,
+            "--set",
+            "run.periods=54",
+            "--set",
+            "run.transient_periods=30",
+            "--set",
+            "run.samples_per_period=10",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let summary: serde_json::Value = serde_json::from_str(&read(run.path(), "summary.json")).unwrap();
+        let ipp: f64 = row[sh.iter().position(|h| h == "impacts_per_period").unwrap()]
+            .parse()
+            .unwrap();
+        assert_eq!(
+            ipp,
+            summary["impacts_per_period"].as_f64().unwrap(),
+            "impacts per period at Ω = {value}"
+        );
+        // Average power: the sweep starts the charge solver 20 periods before its window from
+        // equilibrium, simulate at t = 0; at 100 kΩ the circuit forgets within microseconds.
+        let p_sweep: f64 = row[1].parse().unwrap();
+        let p_sim = summary["average_power_w"].as_f64().unwrap();
+        assert!(
+            (p_sweep - p_sim).abs() < 1e-6 * p_sim,
+            "power at Ω = {value}: {p_sweep} vs {p_sim}"
+        );
+        // Stroboscopic samples: trajectory.csv rows at t = nT (every 10th row).
+        let (_, trows) = read_csv(&run.path().join("trajectory.csv"));
+        let ours: Vec<&Vec<String>> = orows.iter().filter(|r| &r[0] == value).collect();
+        assert_eq!(ours.len(), 24);
+        for o in ours {
+            let n: usize = o[1].parse().unwrap();
+            let t = &trows[n * 10];
+            for i in 0..3 {
+                let a: f64 = o[2 + i].parse().unwrap();
+                let b: f64 = t[1 + i].parse().unwrap();
+                assert!(
+                    (a - b).abs() < 1e-12,
+                    "x{} at period {n}, Ω = {value}: {a} vs {b}",
+                    i + 1
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn sweep_continuation_and_bad_input() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let o = vibrotribo(&sweep_args(d, &["--continuation", "down", "--mechanics-only"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, rows) = read_csv(&dir.path().join("summary.csv"));
+    let values: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    assert!(
+        values.windows(2).all(|w| w[1] < w[0]),
+        "down sweeps run downwards: {values:?}"
+    );
+    assert!(rows.iter().all(|r| r[1].is_empty()), "mechanics only: no power");
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "sweep",
+                "--param",
+                "oscillator.mass",
+                "--from",
+                "1",
+                "--to",
+                "2",
+                "--steps",
+                "3",
+            ],
+            "unknown parameter `oscillator.mass`",
+        ),
+        (
+            &[
+                "sweep",
+                "--param",
+                "mass_ratio",
+                "--from",
+                "1",
+                "--to",
+                "2",
+                "--steps",
+                "3",
+                "--continuation",
+                "up",
+                "--shard",
+                "0/2",
+            ],
+            "--shard needs --continuation none",
+        ),
+        (
+            &[
+                "sweep",
+                "--param",
+                "mass_ratio",
+                "--from",
+                "1",
+                "--to",
+                "2",
+                "--steps",
+                "3",
+                "--shard",
+                "2/2",
+            ],
+            "need 0 ≤ I < N",
+        ),
+        (
+            &[
+                "sweep",
+                "--param",
+                "restitution",
+                "--from",
+                "0.5",
+                "--to",
+                "1.5",
+                "--steps",
+                "3",
+            ],
+            "must lie in [0, 1]",
+        ),
+    ];
+    for (args, expected) in cases {
+        let o = vibrotribo(args);
+        let err = stderr(&o);
+        // A bad value inside the range is reported in that row, a bad first value up front.
+        if o.status.success() {
+            panic!("{args:?} should fail, stderr: {err}");
+        }
+        assert!(
+            err.contains(expected),
+            "{args:?}: expected {expected:?} in {err:?}"
+        );
+    }
+}
+
+#[test]
+fn map_writes_a_grid_and_heat_maps() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let o = vibrotribo(&[
+        "map",
+        "--x",
+        "omega_ratio",
+        "--x-from",
+        "0.6",
+        "--x-to",
+        "0.8",
+        "--x-steps",
+        "3",
+        "--y",
+        "mass_ratio",
+        "--y-from",
+        "2",
+        "--y-to",
+        "3",
+        "--y-steps",
+        "2",
+        "--transient",
+        "20",
+        "--recorded",
+        "10",
+        "--out",
+        d,
+        "--plot",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = read_csv(&dir.path().join("map.csv"));
+    assert_eq!(
+        header[..5],
+        ["x", "y", "average_power_w", "impacts_per_period", "period"]
+    );
+    assert_eq!(rows.len(), 6);
+    let png = std::fs::read(dir.path().join("map_average_power_w.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+}
