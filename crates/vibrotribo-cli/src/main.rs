@@ -11,6 +11,7 @@ mod output;
 mod plot;
 mod plots;
 mod progress;
+mod reproduce;
 mod simulate;
 mod sweep;
 
@@ -42,6 +43,8 @@ enum Command {
     Map(map::MapArgs),
     /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
     OptimizeMassRatio(map::OptimizeArgs),
+    /// Recompute the paper's study (Figs. 5–25) and write REPORT.md comparing its findings.
+    Reproduce(reproduce::ReproduceArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
     Plot(PlotArgs),
 }
@@ -67,6 +70,7 @@ fn run() -> anyhow::Result<()> {
         Command::Merge(args) => sweep::merge(&args),
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),
+        Command::Reproduce(args) => reproduce::run(&args),
         Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
     }
 }

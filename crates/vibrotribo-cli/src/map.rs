@@ -165,7 +165,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
                         p.grazing.to_string(),
                     ]);
                     row.extend(p.impacts_per_period.iter().map(f64::to_string));
-                    row.push(String::new());
+                    row.push(p.electrical_error.as_deref().map_or(String::new(), csv_text));
                 }
                 Err(e) => {
                     row.extend(std::iter::repeat_n(String::new(), 6 + contacts));

@@ -307,7 +307,7 @@ impl SweepFiles {
                     r.grazing.to_string(),
                 ];
                 row.extend(r.impacts_per_period.iter().map(f64::to_string));
-                row.push(String::new());
+                row.push(r.electrical_error.as_deref().map_or(String::new(), csv_text));
                 self.summary.row(row)
             }
             Err(e) => {

@@ -11,7 +11,7 @@
 
 use super::{PeriodOptions, Periodicity, RunStats, StroboscopicOptions, StroboscopicSection, detect_period};
 use crate::dynamics::{Event, EventKind, Flow, Observer, Simulator, StateView};
-use crate::electrical::{ChargeOptions, ChargeSolver, ElectricalError, HarvesterParams};
+use crate::electrical::{ChargeOptions, ChargeSolver, HarvesterParams};
 use crate::error::SimError;
 use crate::model::{ChainParams, ChainState, SimOptions};
 use thiserror::Error;
@@ -95,8 +95,11 @@ pub struct PointResult {
     /// Whether a grazing impact occurred after the transient (see
     /// [`PointOptions::grazing_ratio`]).
     pub grazing: bool,
-    /// Average power after the transient (seed eq. 14), W, if a harvester was given.
+    /// Average power after the transient (seed eq. 14), W, if a harvester was given and its
+    /// charge solver succeeded.
     pub average_power_w: Option<f64>,
+    /// Why the charge solver failed, if it did (the mechanics is still reported).
+    pub electrical_error: Option<String>,
     /// State at the end of the run (t = (transient + recorded)·T).
     pub final_state: ChainState,
 }
@@ -120,9 +123,6 @@ pub enum PointError {
     /// The mechanics stopped.
     #[error(transparent)]
     Sim(#[from] SimError),
-    /// The charge solver stopped.
-    #[error("charge solver: {0}")]
-    Electrical(#[from] ElectricalError),
 }
 
 /// Records impacts after the transient and flags grazing.
@@ -221,12 +221,12 @@ pub fn run_point(
         total as f64 * period,
         &mut (&mut strobe, &mut stats, &mut impacts, &mut solver),
     )?;
-    let average_power_w = match &solver {
-        Some(s) => {
-            s.inner.status()?;
-            s.inner.summary(warmup as usize).map(|s| s.average_power_w)
-        }
-        None => None,
+    let (average_power_w, electrical_error) = match &solver {
+        Some(s) => match s.inner.status() {
+            Ok(()) => (s.inner.summary(warmup as usize).map(|s| s.average_power_w), None),
+            Err(e) => (None, Some(e.to_string())),
+        },
+        None => (None, None),
     };
     let popts = options.period_options();
     let periodicity = if strobe.len() >= popts.samples_needed() {
@@ -244,6 +244,7 @@ pub fn run_point(
         sticking: stats.sticks > 0,
         grazing: impacts.grazing,
         average_power_w,
+        electrical_error,
         final_state: sim.state(),
     })
 }
