@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
-use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind};
+use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, TransducerMode};
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
 use crate::config::{Loaded, RunSpec};
@@ -431,7 +431,10 @@ fn print_summary(
             Some(s) => println!(
                 "  harvester ({}, V_oc {}, {load}): average power {} after the transient, {} per period, peak current {}, peak voltage {}",
                 h.mode.as_str(),
-                h.voc_model.as_str(),
+                match h.mode {
+                    TransducerMode::Freestanding => h.voc_model.as_str(),
+                    TransducerMode::ContactSeparation => "σD/ε0",
+                },
                 si(s.average_power_w, "W"),
                 si(s.energy_per_period_j, "J"),
                 si(s.peak_current_a, "A"),
