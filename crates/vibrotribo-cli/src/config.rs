@@ -155,6 +155,24 @@ pub struct RunSpec {
     pub initial: ChainState,
 }
 
+/// The configuration of a command: a TOML file and `--set` overrides.
+#[derive(Debug, clap::Args)]
+pub struct ConfigArgs {
+    /// Configuration file (TOML); the paper's default case if omitted.
+    pub config: Option<std::path::PathBuf>,
+    /// Override a parameter, e.g. `--set excitation.omega_ratio=0.75`,
+    /// `--set oscillator.masses=[0.05,0.15,0.05]`, `--set mass_ratio=3` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl ConfigArgs {
+    /// Reads the file and applies the overrides.
+    pub fn load(&self) -> Result<Loaded> {
+        Loaded::load(self.config.as_deref(), &self.set)
+    }
+}
+
 /// The raw configuration tree with overrides applied, and its typed reading.
 #[derive(Debug, Clone)]
 pub struct Loaded {

@@ -8,7 +8,7 @@ use serde_json::json;
 use vibrotribo::electrical::{ChargeSolver, LoadKind, load_sweep, log_spaced};
 use vibrotribo::{Simulator, Trajectory};
 
-use crate::config::Loaded;
+use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot;
 use crate::progress::Progress;
@@ -16,11 +16,8 @@ use crate::progress::Progress;
 /// Options of `vibrotribo load-sweep`.
 #[derive(Debug, clap::Args)]
 pub struct LoadSweepArgs {
-    /// Configuration file (TOML); the paper's default case if omitted.
-    pub config: Option<PathBuf>,
-    /// Override a parameter (repeatable), as for `simulate`.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub input: ConfigArgs,
     /// Smallest load resistance, Ω.
     #[arg(long, default_value_t = 1e3)]
     pub from: f64,
@@ -59,7 +56,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
     if args.plot && args.out.is_none() {
         bail!("--plot needs --out DIR");
     }
-    let loaded = Loaded::load(args.config.as_deref(), &args.set)?;
+    let loaded = args.input.load()?;
     let chain = loaded.config.chain_params()?;
     let spec = loaded.config.run_spec(&chain)?;
     let mut harvester = loaded.harvester(&chain)?;

@@ -5,12 +5,12 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use rayon::prelude::*;
 use serde_json::json;
-use vibrotribo::analysis::{PointResult, fit_quadratic};
+use vibrotribo::analysis::{PointResult, QuadraticFit, fit_quadratic};
 
-use crate::config::Loaded;
+use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, csv_text, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::{Progress, interrupted};
@@ -19,11 +19,8 @@ use crate::sweep::{PointRunner, RunArgs, grid, set_threads};
 /// Options of `vibrotribo map`.
 #[derive(Debug, clap::Args)]
 pub struct MapArgs {
-    /// Configuration file (TOML); the paper's default case if omitted.
-    pub config: Option<PathBuf>,
-    /// Override a parameter (repeatable), as for `simulate`.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub input: ConfigArgs,
     /// Parameter along x (any key `sweep --param` accepts).
     #[arg(long)]
     pub x: String,
@@ -110,18 +107,16 @@ pub fn run(args: &MapArgs) -> Result<()> {
         bail!("--plot needs --out DIR");
     }
     set_threads(args.run.threads)?;
-    let base = Loaded::load(args.config.as_deref(), &args.set)?;
+    let base = args.input.load()?;
     let runner = PointRunner::new(base, &args.run)?;
     let (xs, ys) = (
         grid(args.x_from, args.x_to, args.x_steps),
         grid(args.y_from, args.y_to, args.y_steps),
     );
     let points: Vec<(f64, f64)> = ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect();
-    for &(x, y) in &points {
-        runner
-            .check(&[(&args.x, x), (&args.y, y)])
-            .with_context(|| format!("{} = {x}, {} = {y}", args.x, args.y))?;
-    }
+    runner.check_all(&points, |&(x, y)| {
+        vec![(args.x.as_str(), x), (args.y.as_str(), y)]
+    })?;
     let contacts = runner.base().config.chain_params()?.len() - 1;
     let mut csv = match &args.out {
         Some(dir) => {
@@ -211,12 +206,8 @@ pub fn run(args: &MapArgs) -> Result<()> {
 /// Options of `vibrotribo optimize-mass-ratio`.
 #[derive(Debug, clap::Args)]
 pub struct OptimizeArgs {
-    /// Configuration file (TOML). The paper's study (Sect. 4.3.2) uses m1 = m3 = 50 g:
-    /// `--set oscillator.masses=[0.05,0.15,0.05]` on the default case.
-    pub config: Option<PathBuf>,
-    /// Override a parameter (repeatable), as for `simulate`.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub input: ConfigArgs,
     /// First Ω.
     #[arg(long, default_value_t = 0.55)]
     pub omega_from: f64,
@@ -247,6 +238,37 @@ pub struct OptimizeArgs {
 
 /// The paper's fit of the optimal mass ratio, R_mo = aΩ² + bΩ + c (Sect. 4.3.2).
 pub const PAPER_FIT: [f64; 3] = [11.43, -28.46, 18.03];
+
+/// The paper's fit evaluated at Ω = `w`.
+pub fn paper_fit(w: f64) -> f64 {
+    PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2]
+}
+
+/// Draws the optima (`ws`, `rs`), the paper's fit and `fit` over `[w_from, w_to]` to `path`.
+pub fn plot_optimal_mass_ratio(
+    path: &std::path::Path,
+    ws: &[f64],
+    rs: &[f64],
+    fit: Option<&QuadraticFit>,
+    (w_from, w_to): (f64, f64),
+) -> Result<()> {
+    let fine = grid(w_from, w_to, 100);
+    let paper: Vec<f64> = fine.iter().map(|&w| paper_fit(w)).collect();
+    let ours: Vec<f64> = fine
+        .iter()
+        .map(|w| fit.map_or(f64::NAN, |f| f.a * w * w + f.b * w + f.c))
+        .collect();
+    let fig = Figure::new("Optimal mass ratio R_mo(Ω)", "Ω = ω/Ω1", "R_mo = m2/m1");
+    plot::phase_portrait(
+        path,
+        &fig,
+        &[
+            Series::new("paper's fit", &fine, &paper),
+            Series::new("fit to vibrotribo's optima", &fine, &ours),
+        ],
+        Some(Series::new("vibrotribo optima", ws, rs)),
+    )
+}
 
 /// The maximum of `values` on the equally spaced `grid`, refined by the parabola through the
 /// best point and its neighbours (when it is interior and the parabola is concave).
@@ -284,7 +306,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         bail!("--plot needs --out DIR");
     }
     set_threads(args.run.threads)?;
-    let base = Loaded::load(args.config.as_deref(), &args.set)?;
+    let base = args.input.load()?;
     let runner = PointRunner::new(base, &args.run)?;
     let (omegas, ratios) = (
         grid(args.omega_from, args.omega_to, args.omega_steps),
@@ -294,11 +316,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         .iter()
         .flat_map(|&w| ratios.iter().map(move |&r| (w, r)))
         .collect();
-    for &(w, r) in &points {
-        runner
-            .check(&[("omega_ratio", w), ("mass_ratio", r)])
-            .with_context(|| format!("Ω = {w}, R_m = {r}"))?;
-    }
+    runner.check_all(&points, |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)])?;
     let mut power = vec![f64::NAN; points.len()];
     let mut index = 0;
     let mut grid_csv = match &args.out {
@@ -382,7 +400,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         started.elapsed().as_secs_f64()
     );
     for (w, r, p, edge) in &optimum {
-        let paper = PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2];
+        let paper = paper_fit(*w);
         println!(
             "  Ω = {w:.4}: R_mo = {r:.3} (paper's fit {paper:.3}), P = {:.4e} W{}",
             p,
@@ -419,7 +437,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             .map(String::from),
         )?;
         for (w, r, p, edge) in &optimum {
-            let paper = PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2];
+            let paper = paper_fit(*w);
             o.row([
                 w.to_string(),
                 r.to_string(),
@@ -442,25 +460,13 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             }),
         )?;
         if args.plot {
-            let fine: Vec<f64> = grid(args.omega_from, args.omega_to, 100);
-            let paper: Vec<f64> = fine
-                .iter()
-                .map(|w| PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2])
-                .collect();
-            let ours: Vec<f64> = fine
-                .iter()
-                .map(|w| fit.as_ref().map_or(f64::NAN, |f| f.a * w * w + f.b * w + f.c))
-                .collect();
             for ext in ["png", "svg"] {
-                let fig = Figure::new("Optimal mass ratio R_mo(Ω)", "Ω = ω/Ω1", "R_mo = m2/m1");
-                plot::phase_portrait(
+                plot_optimal_mass_ratio(
                     &dir.join(format!("optimal_mass_ratio.{ext}")),
-                    &fig,
-                    &[
-                        Series::new("paper's fit", &fine, &paper),
-                        Series::new("fit to vibrotribo's optima", &fine, &ours),
-                    ],
-                    Some(Series::new("vibrotribo optima", &ws, &rs)),
+                    &ws,
+                    &rs,
+                    fit.as_ref(),
+                    (args.omega_from, args.omega_to),
                 )?;
             }
         }

@@ -19,7 +19,7 @@ use vibrotribo::{
 };
 
 use crate::config::{Loaded, set_key};
-use crate::map::{PAPER_FIT, refine_maximum};
+use crate::map::{paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::{create_dir, si};
 use crate::plot::{self, Figure, Legend, Scale, Series};
 use crate::progress::interrupted;
@@ -60,6 +60,17 @@ enum Verdict {
 }
 
 impl Verdict {
+    /// All of `total` checks as the paper says: agrees; none: differs; else partly.
+    fn of(matches: usize, total: usize) -> Self {
+        if matches == total {
+            Verdict::Agrees
+        } else if matches == 0 {
+            Verdict::Differs
+        } else {
+            Verdict::Partly
+        }
+    }
+
     fn text(self) -> &'static str {
         match self {
             Verdict::Agrees => "agrees",
@@ -325,6 +336,38 @@ fn impact_points(values: &[f64], results: &[PointResult], contact: usize) -> (Ve
     (xs, ys)
 }
 
+/// An orbit diagram (one mass's stroboscopic samples against the parameter, times `scale`).
+#[allow(clippy::too_many_arguments)]
+fn orbit_figure(
+    ctx: &Ctx,
+    name: &str,
+    title: &str,
+    xl: &str,
+    yl: &str,
+    values: &[f64],
+    results: &[PointResult],
+    scale: f64,
+) -> Result<String> {
+    let (x, y) = orbit_points(values, results, 1, scale);
+    scatter(ctx, name, title, xl, yl, &[("X2", &x, &y)])
+}
+
+/// An impact-velocity diagram (closing speeds at `contact` against the parameter).
+#[allow(clippy::too_many_arguments)]
+fn impact_figure(
+    ctx: &Ctx,
+    name: &str,
+    title: &str,
+    xl: &str,
+    yl: &str,
+    values: &[f64],
+    results: &[PointResult],
+    contact: usize,
+) -> Result<String> {
+    let (x, y) = impact_points(values, results, contact);
+    scatter(ctx, name, title, xl, yl, &[("V", &x, &y)])
+}
+
 fn scatter(
     ctx: &Ctx,
     name: &str,
@@ -495,11 +538,7 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
         "5",
         "Config. (1): impacts above m1's static position, below m3's, on both sides of m2's; (2) the opposite; (3) impacts below every mass's static position; (4) the opposite.",
         format!("Sides of the static position at impacts: {}. {matches} of 4 configurations as the paper describes.", ours.join("; ")),
-        match matches {
-            4 => Verdict::Agrees,
-            0 => Verdict::Differs,
-            _ => Verdict::Partly,
-        },
+        Verdict::of(matches, 4),
     );
 
     // Fig. 6: average power of configurations (1) and (2) at three mass ratios and two
@@ -577,11 +616,7 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
         "6",
         "The first symmetric configuration (m1 = m3 < m2) harvests better than the second.",
         format!("Mean power over the three mass ratios is higher for configuration (1) at {better} of 2 frequencies (Ω = 0.6, 1.2)."),
-        match better {
-            2 => Verdict::Agrees,
-            0 => Verdict::Differs,
-            _ => Verdict::Partly,
-        },
+        Verdict::of(better, 2),
     );
     Ok(())
 }
@@ -596,43 +631,47 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     ])?;
     let values = grid(1.0, 1.6, ctx.budget.coarse);
     let results = sweep(ctx, &base, "gap_ratio", &values, false)?;
-    let (px, py) = orbit_points(&values, &results, 1, 1.0 / 0.020);
-    let a = scatter(
+    let a = orbit_figure(
         ctx,
         "fig07a_orbit_x2",
         "Orbit diagram of X2 against R_δ",
         "R_δ = δ2/δ1",
         "X2 = x2/δ1",
-        &[("X2", &px, &py)],
+        &values,
+        &results,
+        1.0 / 0.020,
     )?;
     let fine = grid(1.40, 1.52, ctx.budget.fine);
     let fres = sweep(ctx, &base, "gap_ratio", &fine, false)?;
-    let (fx, fy) = orbit_points(&fine, &fres, 1, 1.0 / 0.020);
-    let b = scatter(
+    let b = orbit_figure(
         ctx,
         "fig07b_orbit_x2_zoom",
         "Orbit diagram of X2, R_δ = 1.40–1.52",
         "R_δ",
         "X2",
-        &[("X2", &fx, &fy)],
+        &fine,
+        &fres,
+        1.0 / 0.020,
     )?;
-    let (v1x, v1y) = impact_points(&values, &results, 0);
-    let (v2x, v2y) = impact_points(&values, &results, 1);
-    let c = scatter(
+    let c = impact_figure(
         ctx,
         "fig07c_v12",
         "Impact velocities V12 against R_δ",
         "R_δ",
         "V12 [m/s]",
-        &[("V12", &v1x, &v1y)],
+        &values,
+        &results,
+        0,
     )?;
-    let d = scatter(
+    let d = impact_figure(
         ctx,
         "fig07d_v23",
         "Impact velocities V23 against R_δ",
         "R_δ",
         "V23 [m/s]",
-        &[("V23", &v2x, &v2y)],
+        &values,
+        &results,
+        1,
     )?;
     ctx.figure(
         "7",
@@ -883,11 +922,7 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         "10",
         "R_δ = 1.415 periodic, 1.423 non-periodic, 1.430 period 8, 1.512 period 13.",
         lines_text.join("; "),
-        match matches {
-            4 => Verdict::Agrees,
-            0 => Verdict::Differs,
-            _ => Verdict::Partly,
-        },
+        Verdict::of(matches, 4),
     );
     // Fig. 11: power against the order of the periodicity.
     // The claim orders periodic motions by period; a non-periodic one has no order.
@@ -965,14 +1000,15 @@ fn fig_12(ctx: &mut Ctx) -> Result<()> {
     ])?;
     let values = grid(0.0025, 0.040, ctx.budget.fine);
     let res = sweep(ctx, &base, "gap", &values, true)?;
-    let (px, py) = orbit_points(&values, &res, 1, 1.0);
-    let img = scatter(
+    let img = orbit_figure(
         ctx,
         "fig12_orbit_deltax2",
         "Orbit diagram of δ·X2 = x2 against the symmetric spacing δ",
         "δ [m]",
         "δ·X2 = x2 [m]",
-        &[("x2", &px, &py)],
+        &values,
+        &res,
+        1.0,
     )?;
     ctx.figure(
         "12",
@@ -1133,23 +1169,25 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     ])?;
     let values = grid(1.5, 8.0, ctx.budget.coarse);
     let res = sweep(ctx, &base, "mass_ratio", &values, false)?;
-    let (px, py) = orbit_points(&values, &res, 1, 1.0 / 0.020);
-    let a = scatter(
+    let a = orbit_figure(
         ctx,
         "fig14a_orbit_x2",
         "Orbit diagram of X2 against R_m (Ω = 0.72)",
         "R_m = m2/m1",
         "X2",
-        &[("X2", &px, &py)],
+        &values,
+        &res,
+        1.0 / 0.020,
     )?;
-    let (vx, vy) = impact_points(&values, &res, 0);
-    let b = scatter(
+    let b = impact_figure(
         ctx,
         "fig14b_v12",
         "Impact velocities V12 against R_m (Ω = 0.72)",
         "R_m",
         "V12 [m/s]",
-        &[("V12", &vx, &vy)],
+        &values,
+        &res,
+        0,
     )?;
     let power: Vec<f64> = res
         .iter()
@@ -1272,26 +1310,8 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     let ws: Vec<f64> = opt.iter().map(|o| o.0).collect();
     let rs: Vec<f64> = opt.iter().map(|o| o.1).collect();
     let fit = fit_quadratic(&ws, &rs).ok();
-    let fine = grid(0.55, 0.95, 81);
-    let paper: Vec<f64> = fine
-        .iter()
-        .map(|w| PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2])
-        .collect();
-    let ours: Vec<f64> = fine
-        .iter()
-        .map(|w| fit.as_ref().map_or(f64::NAN, |q| q.a * w * w + q.b * w + q.c))
-        .collect();
-    let fig = Figure::new("Optimal mass ratio R_mo against Ω", "Ω", "R_mo");
     let img = both(ctx, "fig16_optimal_mass_ratio", |p| {
-        plot::phase_portrait(
-            p,
-            &fig,
-            &[
-                Series::new("paper's fit", &fine, &paper),
-                Series::new("fit to vibrotribo", &fine, &ours),
-            ],
-            Some(Series::new("vibrotribo optima", &ws, &rs)),
-        )
+        plot_optimal_mass_ratio(p, &ws, &rs, fit.as_ref(), (0.55, 0.95))
     })?;
     ctx.figure(
         "16",
@@ -1316,7 +1336,7 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     let max_dev = ws
         .iter()
         .zip(&rs)
-        .map(|(w, r)| (r - (PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2])).abs())
+        .map(|(w, r)| (r - paper_fit(*w)).abs())
         .fold(0.0, f64::max);
     ctx.finding(
         "16",
@@ -1376,23 +1396,25 @@ fn fig_17(ctx: &mut Ctx) -> Result<()> {
         ])?;
         let values = grid(1.5, 8.0, ctx.budget.fine);
         let res = sweep(ctx, &base, "mass_ratio", &values, true)?;
-        let (px, py) = orbit_points(&values, &res, 1, 1.0 / 0.020);
-        images.push(scatter(
+        images.push(orbit_figure(
             ctx,
             &format!("fig17a_orbit_{w}"),
             &format!("Orbit diagram of X2 against R_m, Ω = {w}"),
             "R_m",
             "X2",
-            &[("X2", &px, &py)],
+            &values,
+            &res,
+            1.0 / 0.020,
         )?);
-        let (vx, vy) = impact_points(&values, &res, 0);
-        images.push(scatter(
+        images.push(impact_figure(
             ctx,
             &format!("fig17b_v12_{w}"),
             &format!("V12 against R_m, Ω = {w}"),
             "R_m",
             "V12 [m/s]",
-            &[("V12", &vx, &vy)],
+            &values,
+            &res,
+            0,
         )?);
         let vmax: Vec<f64> = res
             .iter()
@@ -1437,11 +1459,7 @@ fn fig_17(ctx: &mut Ctx) -> Result<()> {
         "17",
         "At Ω = 1.30 and 2.00 the impact velocity levels off as R_m grows: no optimal mass ratio.",
         texts.join("; "),
-        match saturate {
-            2 => Verdict::Agrees,
-            0 => Verdict::Differs,
-            _ => Verdict::Partly,
-        },
+        Verdict::of(saturate, 2),
     );
     Ok(())
 }
@@ -1453,25 +1471,27 @@ fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
     ])?;
     let values = grid(1.5, 6.0, ctx.budget.coarse);
     let res = sweep(ctx, &base, "mass_ratio", &values, true)?;
-    let (px, py) = orbit_points(&values, &res, 1, 1.0 / 0.020);
-    let a = scatter(
+    let a = orbit_figure(
         ctx,
         "fig18a_orbit_x2",
         "Orbit diagram of X2 against R_m, Ω = 0.30",
         "R_m",
         "X2",
-        &[("X2", &px, &py)],
+        &values,
+        &res,
+        1.0 / 0.020,
     )?;
     let fine = grid(3.9, 4.5, ctx.budget.fine);
     let fres = sweep(ctx, &base, "mass_ratio", &fine, true)?;
-    let (fx, fy) = orbit_points(&fine, &fres, 1, 1.0 / 0.020);
-    let b = scatter(
+    let b = orbit_figure(
         ctx,
         "fig18b_orbit_x2_zoom",
         "Orbit diagram of X2, R_m = 3.9–4.5, Ω = 0.30",
         "R_m",
         "X2",
-        &[("X2", &fx, &fy)],
+        &fine,
+        &fres,
+        1.0 / 0.020,
     )?;
     ctx.figure(
         "18",
@@ -1558,14 +1578,15 @@ fn figs_20_25(ctx: &mut Ctx) -> Result<()> {
     ])?;
     let values = grid(0.3, 1.0, ctx.budget.coarse);
     let res = sweep(ctx, &base, "omega_ratio", &values, false)?;
-    let (px, py) = orbit_points(&values, &res, 1, 1.0 / 0.005);
-    let a = scatter(
+    let a = orbit_figure(
         ctx,
         "fig20_orbit_x2",
         "Orbit diagram of X2 against Ω (chatter case)",
         "Ω",
         "X2 = x2/δ1",
-        &[("X2", &px, &py)],
+        &values,
+        &res,
+        1.0 / 0.005,
     )?;
     let power: Vec<f64> = res
         .iter()
@@ -1590,23 +1611,25 @@ fn figs_20_25(ctx: &mut Ctx) -> Result<()> {
     for (name, lo, hi) in [("chatter", 0.55, 0.65), ("resonance", 0.72, 0.80)] {
         let g = grid(lo, hi, ctx.budget.fine);
         let r = sweep(ctx, &base, "omega_ratio", &g, false)?;
-        let (px, py) = orbit_points(&g, &r, 1, 1.0 / 0.005);
-        images.push(scatter(
+        images.push(orbit_figure(
             ctx,
             &format!("fig21_orbit_{name}"),
             &format!("X2 around the {name} range"),
             "Ω",
             "X2",
-            &[("X2", &px, &py)],
+            &g,
+            &r,
+            1.0 / 0.005,
         )?);
-        let (vx, vy) = impact_points(&g, &r, 0);
-        images.push(scatter(
+        images.push(impact_figure(
             ctx,
             &format!("fig21_v12_{name}"),
             &format!("V12 around the {name} range"),
             "Ω",
             "V12 [m/s]",
-            &[("V12", &vx, &vy)],
+            &g,
+            &r,
+            0,
         )?);
         zones.push((name, g, r));
     }

@@ -10,19 +10,15 @@ use vibrotribo::analysis::RunStats;
 use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, TransducerMode};
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
-use crate::config::{Loaded, RunSpec};
+use crate::config::{ConfigArgs, Loaded, RunSpec};
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Progress, interrupted};
 
 /// Options of `vibrotribo simulate`.
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
-    /// Configuration file (TOML); the paper's default case if omitted.
-    pub config: Option<PathBuf>,
-    /// Override a parameter, e.g. `--set excitation.omega_ratio=0.75`,
-    /// `--set oscillator.masses=[0.05,0.15,0.05]`, `--set mass_ratio=3` (repeatable).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub input: ConfigArgs,
     /// Write events.csv, trajectory.csv and summary.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -205,7 +201,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if args.plot && args.out.is_none() {
         anyhow::bail!("--plot needs --out DIR");
     }
-    let loaded = Loaded::load(args.config.as_deref(), &args.set)?;
+    let loaded = args.input.load()?;
     let params = loaded.config.chain_params()?;
     let spec = loaded.config.run_spec(&params)?;
     let options = loaded.config.sim_options()?;

@@ -11,7 +11,7 @@ use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::analysis::{PointOptions, PointResult, run_point};
 
-use crate::config::Loaded;
+use crate::config::{ConfigArgs, Loaded};
 use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
 use crate::progress::{Progress, interrupted};
 
@@ -86,11 +86,8 @@ pub struct RunArgs {
 /// Options of `vibrotribo sweep`.
 #[derive(Debug, clap::Args)]
 pub struct SweepArgs {
-    /// Configuration file (TOML); the paper's default case if omitted.
-    pub config: Option<PathBuf>,
-    /// Override a parameter (repeatable), as for `simulate`.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    #[command(flatten)]
+    pub input: ConfigArgs,
     /// The swept parameter: a configuration key (`excitation.omega_ratio`,
     /// `oscillator.gaps[1]`, `harvester.load_resistance`, …) or a derived one (`mass_ratio`,
     /// `gap_ratio`, `gap`, `omega_ratio`, `restitution`, …).
@@ -195,6 +192,21 @@ impl PointRunner {
         loaded.config.run_spec(&params)?;
         if !self.mechanics_only {
             loaded.harvester(&params)?;
+        }
+        Ok(())
+    }
+
+    /// Checks every point of a grid (`keys` gives each point's settings); the error names
+    /// the first bad point.
+    pub fn check_all<'k, P>(&self, points: &[P], keys: impl Fn(&P) -> Vec<(&'k str, f64)>) -> Result<()> {
+        for p in points {
+            let k = keys(p);
+            self.check(&k).with_context(|| {
+                k.iter()
+                    .map(|(key, v)| format!("{key} = {v}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            })?;
         }
         Ok(())
     }
@@ -372,16 +384,12 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         );
     }
     set_threads(args.run.threads)?;
-    let base = Loaded::load(args.config.as_deref(), &args.set)?;
+    let base = args.input.load()?;
     let runner = PointRunner::new(base, &args.run)?;
     let masses = runner.base().config.chain_params()?.len();
     let values = grid(args.from, args.to, args.steps);
     // Fail early on a bad key or on any value of the grid that makes a bad configuration.
-    for &v in &values {
-        runner
-            .check(&[(&args.param, v)])
-            .with_context(|| format!("--param {} = {v}", args.param))?;
-    }
+    runner.check_all(&values, |&v| vec![(args.param.as_str(), v)])?;
     let mut order: Vec<usize> = (0..values.len()).collect();
     if args.continuation == Continuation::Down {
         order.reverse();

@@ -12,7 +12,7 @@
 //! Gap `k` (between mass `k` and `k+1`, seed eq. 2): `d_k = δ_k − (x_{k+1} − x_k) ≥ 0`.
 //!
 //! Physical inputs live in [`ChainParams`]; numerical settings in
-//! [`SimOptions`](crate::SimOptions). Validate once with [`ChainParams::validate`].
+//! [`SimOptions`]. Validate once with [`ChainParams::validate`].
 
 use crate::error::ParamError;
 
