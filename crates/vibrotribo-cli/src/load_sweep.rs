@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use serde_json::json;
+use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
 use vibrotribo::electrical::{ChargeSolver, LoadKind, load_sweep, log_spaced};
 use vibrotribo::{Simulator, Trajectory};
 
@@ -137,6 +138,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
             &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"].map(String::from),
         )?;
         let mut cycles = Vec::new();
+        let mut margins = Vec::new();
         for r in [configured, best.resistance_ohm] {
             let mut h = harvester.clone();
             h.load_resistance = r;
@@ -144,9 +146,38 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
                 ChargeSolver::for_chain(&h, &chain, options.clone())?.with_vq_cycle(last, args.vq_points)?;
             s.run_trajectory(&trajectory)?;
             if let Some(c) = s.vq_cycle() {
+                let mut margin = BreakdownMargin::default();
+                let (mut d, mut rates) = (vec![0.0; chain.len() - 1], vec![0.0; chain.len() - 1]);
                 for j in 0..c.times.len() {
                     vq.row([r, c.times[j], c.charge_c[j], c.voltage_v[j], c.current_a[j]])?;
+                    if let Some(flow) = trajectory.flow_at(c.times[j]) {
+                        flow.gaps_at(c.times[j], &mut d, &mut rates);
+                        let d2 = d.get(h.contact + 1).copied().unwrap_or(0.0);
+                        margin.add(
+                            &h,
+                            &PaschenParams::default(),
+                            c.times[j],
+                            c.charge_c[j],
+                            d[h.contact],
+                            d2,
+                        );
+                    }
                 }
+                println!(
+                    "  at {}: largest |V_gap|/V_breakdown over the last period {:.3}{}",
+                    si(r, "Ω"),
+                    margin.worst_ratio,
+                    if margin.worst_ratio >= 1.0 {
+                        format!(
+                            " ({} across {}): the air would break down",
+                            si(margin.gap_voltage_v, "V"),
+                            si(margin.gap_m, "m")
+                        )
+                    } else {
+                        String::new()
+                    }
+                );
+                margins.push(json!({"load_resistance_ohm": r, "air_breakdown": margin}));
                 cycles.push((r, c.charge_c.clone(), c.voltage_v.clone()));
             }
         }
@@ -159,6 +190,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
                 "configured_load_ohm": configured,
                 "configured_average_power_w": p_configured,
                 "power_ratio_configured_to_optimum": p_configured / best.average_power_w,
+                "air_breakdown_last_period": margins,
                 "points": sweep.points,
                 "periods": spec.periods,
                 "transient_periods": spec.transient_periods,

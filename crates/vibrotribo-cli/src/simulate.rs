@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
+use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
 use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, TransducerMode};
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
@@ -47,6 +48,8 @@ struct Files {
     row: Vec<f64>,
     electrical: bool,
     rectifier: bool,
+    /// Air breakdown check over the samples after the transient (with a harvester).
+    breakdown: Option<(HarvesterParams, BreakdownMargin, f64)>,
     error: Option<anyhow::Error>,
 }
 
@@ -95,6 +98,13 @@ impl Files {
             row: Vec::with_capacity(tr_cols.len()),
             electrical: harvester.is_some(),
             rectifier,
+            breakdown: harvester.map(|h| {
+                (
+                    h.clone(),
+                    BreakdownMargin::default(),
+                    spec.transient_periods as f64 * params.period(),
+                )
+            }),
             error: None,
         })
     }
@@ -141,6 +151,17 @@ impl Files {
                 self.row.push(get(|s| &s.voc_v));
                 if self.rectifier {
                     self.row.push(get(|s| &s.storage_voltage_v));
+                }
+                if let Some((h, margin, from)) = self.breakdown.as_mut()
+                    && t >= *from
+                {
+                    let (d1, d2) = (
+                        self.gaps[h.contact] - (self.x[h.contact + 1] - self.x[h.contact]),
+                        self.gaps.get(h.contact + 1).map_or(0.0, |g| {
+                            g - (self.x[(h.contact + 2).min(n - 1)] - self.x[h.contact + 1])
+                        }),
+                    );
+                    margin.add(h, &PaschenParams::default(), t, get(|s| &s.charge_c), d1, d2);
                 }
             }
             self.row.push(y);
@@ -359,6 +380,9 @@ fn summary_json(
             );
             obj.insert("time_to_target_s".into(), json!(solver.time_to_target()));
         }
+        if let Some((_, margin, _)) = rec.files.as_ref().and_then(|f| f.breakdown.as_ref()) {
+            obj.insert("air_breakdown".into(), json!(margin));
+        }
         obj.insert("harvester".into(), json!(h));
         obj.insert("electrical_solver".into(), json!(format!("{:?}", solver.stats())));
     }
@@ -437,6 +461,20 @@ fn print_summary(
                 si(s.peak_voltage_v, "V"),
             ),
             None => println!("  harvester: no complete period after the transient"),
+        }
+        if let Some((_, m, _)) = rec.files.as_ref().and_then(|f| f.breakdown.as_ref()) {
+            println!(
+                "  air gaps: largest |V_gap|/V_breakdown = {:.3} (gap {}, {} across {}; Paschen's law, air at 1 atm){}",
+                m.worst_ratio,
+                m.gap,
+                si(m.gap_voltage_v, "V"),
+                si(m.gap_m, "m"),
+                if m.worst_ratio >= 1.0 {
+                    ": the air would break down"
+                } else {
+                    ""
+                }
+            );
         }
         if h.load == LoadKind::Rectifier {
             if let Some(v) = solver.storage_voltage() {

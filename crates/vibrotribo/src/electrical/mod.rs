@@ -37,6 +37,7 @@
 //!   the optimum refined.
 //! - [`spice`]: ngspice netlists of the same circuit for cross-checking.
 
+pub mod breakdown;
 mod diode;
 mod params;
 mod radau;

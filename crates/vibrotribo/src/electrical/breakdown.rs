@@ -1,0 +1,169 @@
+//! Air breakdown across the gaps (Paschen's law): is a computed operating point physical?
+//!
+//! The electric field in each air gap follows from Gauss's law across the stack (MODEL-NOTES
+//! §2). With `Q` the charge of the transducer in the exact form `V = −Q/C + σ(D₂ − D₁)/ε₀`
+//! (freestanding mode: top electrode −Q, film −σS, metal +2σS, film −σS, bottom electrode
+//! +Q), the gap voltages are
+//!
+//! ```text
+//! V_gap1 = (Q + σS) D₁ / (ε₀S),     V_gap2 = (σS − Q) D₂ / (ε₀S)
+//! ```
+//!
+//! and in contact-separation mode (electrode +Q, film −σS, gap D, metal) `V_gap = (σS − Q)
+//! D/(ε₀S)`. A charge computed with the paper's open-circuit law (eq. 13) is first converted
+//! to the exact form that gives the same terminal voltage:
+//! `Q_exact = Q_paper − σS(D₁ + D₂)/(d₀ + D₁ + D₂)`.
+//!
+//! Paschen's law gives the breakdown voltage of a gap d in a gas at pressure p,
+//! `V_b = B p d / (ln(A p d) − ln ln(1 + 1/γ))`; below the curve's minimum (where the
+//! denominator is not positive) no breakdown can start. Defaults are air at one atmosphere:
+//! A = 15 /(cm·Torr), B = 365 V/(cm·Torr), γ = 0.01.
+
+use super::params::{EPSILON_0, HarvesterParams, TransducerMode, VocModel};
+
+/// Paschen-law constants of the gas in the gaps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PaschenParams {
+    /// Gas pressure p, Pa. Default 101 325 Pa.
+    pub pressure: f64,
+    /// Ionisation constant A, 1/(Pa·m). Default 11.25 (air: 15 /(cm·Torr)).
+    pub a: f64,
+    /// Constant B, V/(Pa·m). Default 273.8 (air: 365 V/(cm·Torr)).
+    pub b: f64,
+    /// Secondary emission coefficient γ, dimensionless. Default 0.01.
+    pub gamma: f64,
+}
+
+impl Default for PaschenParams {
+    fn default() -> Self {
+        const TORR: f64 = 101_325.0 / 760.0;
+        PaschenParams {
+            pressure: 101_325.0,
+            a: 15.0 / (0.01 * TORR),
+            b: 365.0 / (0.01 * TORR),
+            gamma: 0.01,
+        }
+    }
+}
+
+impl PaschenParams {
+    /// Breakdown voltage of a gap `d`, m, in V; `+∞` where breakdown cannot start (left of
+    /// the Paschen minimum, or a closed gap).
+    pub fn breakdown_voltage(&self, d: f64) -> f64 {
+        let pd = self.pressure * d;
+        let denominator = (self.a * pd).ln() - (1.0 + 1.0 / self.gamma).ln().ln();
+        if d.is_nan() || denominator.is_nan() || d <= 0.0 || denominator <= 0.0 {
+            return f64::INFINITY;
+        }
+        self.b * pd / denominator
+    }
+}
+
+/// Voltages across the air gaps, V (one for contact-separation mode; the second is 0), for
+/// the transducer `params` with charge `q`, C, as the charge solver reports it, and gaps
+/// `d1`, `d2`, m (`d2` unused in contact-separation mode).
+pub fn gap_voltages(params: &HarvesterParams, q: f64, d1: f64, d2: f64) -> [f64; 2] {
+    let s = params.area;
+    let sigma_s = params.charge_density * s;
+    let eps_s = EPSILON_0 * s;
+    match params.mode {
+        TransducerMode::Freestanding => {
+            let q = match params.voc_model {
+                VocModel::Exact => q,
+                VocModel::Paper => q - sigma_s * (d1 + d2) / (params.effective_thickness() + d1 + d2),
+            };
+            [(q + sigma_s) * d1 / eps_s, (sigma_s - q) * d2 / eps_s]
+        }
+        TransducerMode::ContactSeparation => [(sigma_s - q) * d1 / eps_s, 0.0],
+    }
+}
+
+/// The worst ratio |V_gap| / V_b over samples of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct BreakdownMargin {
+    /// Largest |V_gap|/V_b seen (≥ 1 means the air would break down), dimensionless.
+    pub worst_ratio: f64,
+    /// Time of that sample, s.
+    pub time_s: f64,
+    /// Which gap (1-based, in the transducer's order).
+    pub gap: usize,
+    /// The gap's voltage there, V.
+    pub gap_voltage_v: f64,
+    /// Its width there, m.
+    pub gap_m: f64,
+}
+
+impl BreakdownMargin {
+    /// Folds in one sample: time `t`, s, charge `q`, C, gaps `d1`, `d2`, m.
+    pub fn add(
+        &mut self,
+        params: &HarvesterParams,
+        paschen: &PaschenParams,
+        t: f64,
+        q: f64,
+        d1: f64,
+        d2: f64,
+    ) {
+        let v = gap_voltages(params, q, d1, d2);
+        for (k, (&vk, &dk)) in v.iter().zip(&[d1, d2]).enumerate() {
+            let ratio = vk.abs() / paschen.breakdown_voltage(dk);
+            if ratio > self.worst_ratio {
+                *self = BreakdownMargin {
+                    worst_ratio: ratio,
+                    time_s: t,
+                    gap: k + 1,
+                    gap_voltage_v: vk,
+                    gap_m: dk,
+                };
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paschen_curve_of_air() {
+        let p = PaschenParams::default();
+        // Textbook values for air at one atmosphere: ~4.5 kV across 1 mm (about 3 MV/m
+        // at larger gaps), a minimum near 330 V at p·d ≈ 0.75 Torr·cm (about 10 µm).
+        let v1mm = p.breakdown_voltage(1e-3);
+        assert!((3.5e3..5.5e3).contains(&v1mm), "{v1mm}");
+        let v1cm = p.breakdown_voltage(1e-2);
+        assert!((2.8e4..4.0e4).contains(&v1cm), "{v1cm}");
+        let minimum = (1..2000)
+            .map(|i| p.breakdown_voltage(i as f64 * 1e-7))
+            .fold(f64::INFINITY, f64::min);
+        assert!((250.0..450.0).contains(&minimum), "{minimum}");
+        assert_eq!(p.breakdown_voltage(1e-7), f64::INFINITY);
+    }
+
+    #[test]
+    fn gap_voltages_follow_gauss() {
+        let h = HarvesterParams {
+            voc_model: VocModel::Exact,
+            ..HarvesterParams::default()
+        };
+        let (d1, d2) = (0.004, 0.006);
+        let sigma = h.charge_density;
+        // Uncharged electrodes: each gap sees the field of the tribo charges alone, σ/ε0.
+        let v = gap_voltages(&h, 0.0, d1, d2);
+        assert!((v[0] - sigma * d1 / EPSILON_0).abs() < 1e-9 * v[0].abs());
+        assert!((v[1] - sigma * d2 / EPSILON_0).abs() < 1e-9 * v[1].abs());
+        // The gap voltages and the film drops add up to the terminal voltage of eq. 11
+        // (exact form), for any charge.
+        let q = 3.7e-8;
+        let v = gap_voltages(&h, q, d1, d2);
+        let films = -q * h.effective_thickness() / (EPSILON_0 * h.area);
+        let terminal =
+            -q / (EPSILON_0 * h.area / (h.effective_thickness() + d1 + d2)) + sigma * (d2 - d1) / EPSILON_0;
+        // Top to bottom: −(gap 1) drop runs against the metal's field; V = films − V_g1 + V_g2.
+        assert!(
+            (films - v[0] + v[1] - terminal).abs() < 1e-9 * terminal.abs().max(1.0),
+            "{films} {v:?} {terminal}"
+        );
+    }
+}
