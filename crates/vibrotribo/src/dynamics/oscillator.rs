@@ -248,6 +248,103 @@ impl Oscillator {
     pub fn start_time(&self) -> f64 {
         self.t0
     }
+
+    /// A rate Λ, 1/s, that bounds how fast the Taylor coefficients of the motion can grow:
+    /// at least ω (the forced part) and 2α + ω_n (every root of `λ² + 2αλ + ω_n² = 0` in all
+    /// damping regimes, and the two coefficients of that recurrence). See [`taylor`](Self::taylor).
+    pub(crate) fn rate_bound(&self) -> f64 {
+        (2.0 * self.alpha + self.wn2.sqrt()).max(self.omega)
+    }
+
+    /// Scaled Taylor coefficients of the displacement about `tc` (phase `ph` of `tc`) with
+    /// radius `r`, s: `coef[j] = s⁽ʲ⁾(tc) rʲ / j!`, m, for as many `j` as needed to bring the
+    /// truncation error on `|t − tc| ≤ r` below `rel` times the size of the motion (static
+    /// offset + forced amplitude + `|h(tc)| + r|h'(tc)|`), at most `coef.len()` terms.
+    ///
+    /// Returns the number of terms written, the truncation bound reached, m, and the
+    /// tolerance it was held to, m. The
+    /// homogeneous part obeys `h⁽ʲ⁺²⁾ = −2α h⁽ʲ⁺¹⁾ − ω_n² h⁽ʲ⁾`; once `j + 1 ≥ 4Λr`
+    /// ([`rate_bound`](Self::rate_bound)) each scaled coefficient is at most 5/16 of the larger
+    /// of the two before it, so the tail after `j` is below `max(|g_{j−1}|, |g_j|)`. The
+    /// forced part's tail is bounded by its exponential series. The first two coefficients
+    /// are the values [`state`](Self::state) returns.
+    pub(crate) fn taylor(&self, tc: f64, ph: Phase, r: f64, rel: f64, coef: &mut [f64]) -> (usize, f64, f64) {
+        let (sp, vp) = self.forced(ph);
+        let tau = tc - self.t0;
+        let (c, s) = self.propagator(tau);
+        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
+        let h = h0 * c + (h1 + self.alpha * h0) * s;
+        let hd = h1 * c - (self.wn2 * h0 + self.alpha * h1) * s;
+        let eh = e0 * c + (e1 + self.alpha * e0) * s;
+        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
+        let max_terms = coef.len();
+        // Homogeneous part g_j and forced part F_j = wⱼ·cyc(j) with wⱼ = (ωr)ʲ/j!.
+        let (mut g_prev, mut g) = (h + eh, (hd + ehd) * r);
+        // The forced part's scaled coefficients cycle through (A, B, −A, −B)·wⱼ: carry the
+        // pair (Fⱼ, Fⱼ₊₁ rotated back) and rotate it by a quarter turn per term.
+        let amp_a = self.pc * ph.cos + self.ps * ph.sin;
+        let amp_b = self.ps * ph.cos - self.pc * ph.sin;
+        let amp = self.pc.hypot(self.ps);
+        let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs());
+        if max_terms < 2 {
+            return (0, f64::INFINITY, tol);
+        }
+        coef[0] = (sp + h) + eh;
+        coef[1] = ((vp + hd) + ehd) * r;
+        let wr = self.omega * r;
+        // (p, q) = wⱼ·(cycⱼ, cycⱼ₊₁) with wⱼ = (ωr)ʲ/j!, at j = 1.
+        let (mut p, mut q) = (wr * amp_b, -wr * amp_a);
+        let mut w = wr;
+        let two_ar = 2.0 * self.alpha * r;
+        let wn2r2 = self.wn2 * r * r;
+        let min_terms = 4.0 * self.rate_bound() * r;
+        let mut tail = f64::INFINITY;
+        let mut n = 2;
+        while n < max_terms {
+            let j = n as f64;
+            let (inv_j, inv_jm1) = (reciprocal(n), reciprocal(n - 1));
+            let g_next = -(two_ar * g + wn2r2 * g_prev * inv_jm1) * inv_j;
+            let step = wr * inv_j;
+            (p, q) = (q * step, -p * step);
+            w *= step;
+            coef[n] = p + g_next;
+            g_prev = g;
+            g = g_next;
+            n += 1;
+            // Terms 0..n are written: bound the tail Σ_{j ≥ n}. Since j ≥ 4Λr ≥ 4ωr, the forced
+            // part's terms fall at least 4× per term: its tail is below (4/3)·|F_n|.
+            if j >= min_terms {
+                let forced_tail = FOUR_THIRDS * amp * w * wr * reciprocal(n);
+                tail = forced_tail + g.abs().max(g_prev.abs());
+                if tail <= tol {
+                    break;
+                }
+            }
+        }
+        (n, tail, tol)
+    }
+}
+
+const FOUR_THIRDS: f64 = 4.0 / 3.0;
+
+/// Most Taylor terms with tabulated reciprocals.
+const RECIPROCALS: usize = 64;
+
+/// `1/j` for `j` in `0..RECIPROCALS` (`1/0` unused).
+static INV: [f64; RECIPROCALS] = {
+    let mut t = [0.0; RECIPROCALS];
+    let mut j = 1;
+    while j < RECIPROCALS {
+        t[j] = 1.0 / j as f64;
+        j += 1;
+    }
+    t
+};
+
+/// `1/j`, from the table when it holds `j`.
+#[inline]
+fn reciprocal(j: usize) -> f64 {
+    if j < RECIPROCALS { INV[j] } else { 1.0 / j as f64 }
 }
 
 /// `a + b` and its exact rounding error (Knuth's TwoSum): `a + b = s + e` exactly.
