@@ -263,11 +263,12 @@ impl Oscillator {
     ///
     /// Returns the number of terms written, the truncation bound reached, m, and the
     /// tolerance it was held to, m. The
-    /// homogeneous part obeys `h⁽ʲ⁺²⁾ = −2α h⁽ʲ⁺¹⁾ − ω_n² h⁽ʲ⁾`; once `j + 1 ≥ 4Λr`
-    /// ([`rate_bound`](Self::rate_bound)) each scaled coefficient is at most 5/16 of the larger
-    /// of the two before it, so the tail after `j` is below `max(|g_{j−1}|, |g_j|)`. The
-    /// forced part's tail is bounded by its exponential series. The first two coefficients
-    /// are the values [`state`](Self::state) returns.
+    /// homogeneous part obeys `h⁽ʲ⁺²⁾ = −2α h⁽ʲ⁺¹⁾ − ω_n² h⁽ʲ⁾`; once `j + 1 ≥ KΛr`
+    /// ([`rate_bound`](Self::rate_bound), K = 8) each scaled coefficient is at most
+    /// `c = 1/K + 1/K²` of the larger of the two before it, so the tail after `j` is below
+    /// `2c/(1 − c)·max(|g_{j−1}|, |g_j|)`. The forced part's terms then fall by K per term,
+    /// so its tail is below `K/(K − 1)` times its next term. The first two coefficients are
+    /// the values [`state`](Self::state) returns.
     pub(crate) fn taylor(&self, tc: f64, ph: Phase, r: f64, rel: f64, coef: &mut [f64]) -> (usize, f64, f64) {
         let (sp, vp) = self.forced(ph);
         let tau = tc - self.t0;
@@ -284,8 +285,11 @@ impl Oscillator {
         // pair (Fⱼ, Fⱼ₊₁ rotated back) and rotate it by a quarter turn per term.
         let amp_a = self.pc * ph.cos + self.ps * ph.sin;
         let amp_b = self.ps * ph.cos - self.pc * ph.sin;
-        let amp = self.pc.hypot(self.ps);
+        // No overflow is possible at these magnitudes: no need for hypot.
+        let amp = (self.pc * self.pc + self.ps * self.ps).sqrt();
         let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs());
+        // Terms beyond the reciprocal table are never needed (a sub-piece needs about 20).
+        let max_terms = max_terms.min(RECIPROCALS - 1);
         if max_terms < 2 {
             return (0, f64::INFINITY, tol);
         }
@@ -297,25 +301,25 @@ impl Oscillator {
         let mut w = wr;
         let two_ar = 2.0 * self.alpha * r;
         let wn2r2 = self.wn2 * r * r;
-        let min_terms = 4.0 * self.rate_bound() * r;
+        let min_terms = TAIL_K * self.rate_bound() * r;
         let mut tail = f64::INFINITY;
         let mut n = 2;
-        while n < max_terms {
-            let j = n as f64;
-            let (inv_j, inv_jm1) = (reciprocal(n), reciprocal(n - 1));
-            let g_next = -(two_ar * g + wn2r2 * g_prev * inv_jm1) * inv_j;
+        let mut inv_prev = 1.0;
+        for (j, slot) in coef.iter_mut().enumerate().take(max_terms).skip(2) {
+            let inv_j = INV[j];
+            let g_next = -(two_ar * g + wn2r2 * g_prev * inv_prev) * inv_j;
             let step = wr * inv_j;
             (p, q) = (q * step, -p * step);
             w *= step;
-            coef[n] = p + g_next;
+            *slot = p + g_next;
             g_prev = g;
             g = g_next;
-            n += 1;
-            // Terms 0..n are written: bound the tail Σ_{j ≥ n}. Since j ≥ 4Λr ≥ 4ωr, the forced
-            // part's terms fall at least 4× per term: its tail is below (4/3)·|F_n|.
-            if j >= min_terms {
-                let forced_tail = FOUR_THIRDS * amp * w * wr * reciprocal(n);
-                tail = forced_tail + g.abs().max(g_prev.abs());
+            inv_prev = inv_j;
+            n = j + 1;
+            // Terms 0..=j are written: bound the tail Σ_{i > j} (see the docs).
+            if j as f64 >= min_terms {
+                let forced_tail = FORCED_TAIL * amp * w * wr * INV[j + 1];
+                tail = forced_tail + HOMOGENEOUS_TAIL * g.abs().max(g_prev.abs());
                 if tail <= tol {
                     break;
                 }
@@ -325,7 +329,16 @@ impl Oscillator {
     }
 }
 
-const FOUR_THIRDS: f64 = 4.0 / 3.0;
+/// Terms of a Taylor expansion are bounded once `j + 1 ≥ TAIL_K·Λr` (see `Oscillator::taylor`).
+const TAIL_K: f64 = 8.0;
+
+/// Tail of the homogeneous part over the larger of the last two terms: `2c/(1 − c)`,
+/// `c = 1/K + 1/K²`.
+const HOMOGENEOUS_TAIL: f64 =
+    2.0 * (1.0 / TAIL_K + 1.0 / (TAIL_K * TAIL_K)) / (1.0 - (1.0 / TAIL_K + 1.0 / (TAIL_K * TAIL_K)));
+
+/// Tail of the forced part over its next term: `K/(K − 1)`.
+const FORCED_TAIL: f64 = TAIL_K / (TAIL_K - 1.0);
 
 /// Most Taylor terms with tabulated reciprocals.
 const RECIPROCALS: usize = 64;
@@ -340,12 +353,6 @@ static INV: [f64; RECIPROCALS] = {
     }
     t
 };
-
-/// `1/j`, from the table when it holds `j`.
-#[inline]
-fn reciprocal(j: usize) -> f64 {
-    if j < RECIPROCALS { INV[j] } else { 1.0 / j as f64 }
-}
 
 /// `a + b` and its exact rounding error (Knuth's TwoSum): `a + b = s + e` exactly.
 #[inline]
