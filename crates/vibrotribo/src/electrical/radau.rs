@@ -230,13 +230,16 @@ const DD7: [f64; 7] = [
 /// test). Returns false on a zero or non-finite pivot.
 #[inline]
 pub(crate) fn solve_unpivoted<const N: usize>(m: &mut [[f64; N]; N], b: &mut [f64; N]) -> bool {
+    // Reciprocals of the pivots, reused by the back substitution (no division on its chain).
+    let mut inv_diag = [0.0; N];
     for col in 0..N {
         let (done, rest) = m.split_at_mut(col + 1);
         let pivot = &done[col];
-        if !(pivot[col] != 0.0 && pivot[col].is_finite()) {
+        let inv = 1.0 / pivot[col];
+        if !(inv != 0.0 && inv.is_finite()) {
             return false;
         }
-        let inv = 1.0 / pivot[col];
+        inv_diag[col] = inv;
         let bc = b[col];
         for (row, br) in rest.iter_mut().zip(b[col + 1..].iter_mut()) {
             let f = row[col] * inv;
@@ -252,7 +255,7 @@ pub(crate) fn solve_unpivoted<const N: usize>(m: &mut [[f64; N]; N], b: &mut [f6
         for k in col + 1..N {
             s -= m[col][k] * b[k];
         }
-        b[col] = s / m[col][col];
+        b[col] = s * inv_diag[col];
     }
     true
 }
