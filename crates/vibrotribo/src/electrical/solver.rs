@@ -371,6 +371,8 @@ pub struct ChargeSolver {
     transducer: Transducer,
     /// The transducer in the form evaluated at stage points.
     charge_map: ChargeMap,
+    /// `NOISE_CHARGE / NOISE` times the charge scale σS, C (see `qeq_noise_scale`).
+    charge_noise: f64,
     load: LoadModel,
     options: ChargeOptions,
     tab_resistor: Tableau<RESISTOR_STAGES>,
@@ -531,6 +533,7 @@ impl ChargeSolver {
         Ok(ChargeSolver {
             transducer,
             charge_map,
+            charge_noise: NOISE_CHARGE / NOISE * transducer.charge_scale(),
             node_gaps: vec![0.0; MAX_STAGES * gaps],
             load,
             options,
@@ -1202,10 +1205,11 @@ impl ChargeSolver {
             dz += tab.dd[i] * (z[i] + dq[i]);
             terms += tab.dd[i].abs() * (z[i].abs() + qeq_mag);
         }
-        let e = g * (h * f0 + dz) / den;
+        let g_den = g / den;
+        let e = g_den * (h * f0 + dz);
         // Noise level of the estimate, in volts.
         let el1 = nodes[S - 1].elastance;
-        let noise = NOISE * g * terms / den * el1;
+        let noise = NOISE * g_den * terms * el1;
         let scale = self.options.rtol * v0.abs().max(v1.abs()) + self.atol() + noise;
         let err_v = (e * el1).abs() / scale;
         // Energy: p = G V²; a voltage noise δV makes a power noise 2G|V|δV.
@@ -1431,7 +1435,7 @@ impl ChargeSolver {
 
     /// The magnitude whose `NOISE` fraction bounds the noise of `Q_eq` over a step, C.
     fn qeq_noise_scale<const S: usize>(&self, n0: &TransducerState, dq: &[f64; S]) -> f64 {
-        n0.equilibrium_charge.abs() + dq[S - 1].abs() + NOISE_CHARGE / NOISE * self.transducer.charge_scale()
+        n0.equilibrium_charge.abs() + dq[S - 1].abs() + self.charge_noise
     }
 
     /// Sets the energy of a trial step from its stage powers (W) and returns the scaled error
