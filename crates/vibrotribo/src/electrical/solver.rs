@@ -400,7 +400,8 @@ pub struct ChargeSolver {
     last_period_power: f64,
     h: f64,
     h_acc: f64,
-    err_acc: f64,
+    /// `err^(1/(S+1))` of the last accepted step (at least that of 1e-2).
+    err_acc_root: f64,
     have_acc: bool,
     /// Voltage scale of the default absolute tolerance, V.
     v_scale: f64,
@@ -555,7 +556,7 @@ impl ChargeSolver {
             last_period_power: 0.0,
             h: 1e-6 * period,
             h_acc: 0.0,
-            err_acc: 0.0,
+            err_acc_root: 0.0,
             have_acc: false,
             v_scale: 0.0,
             t_start: 0.0,
@@ -1127,15 +1128,16 @@ impl ChargeSolver {
         // system is reliable, and kinks leave boundary layers orders of magnitude thinner
         // than the step that met them.
         let max_shrink = if accepted { 5.0 } else { 1000.0 };
-        let mut quot = (err_root::<S>(err) / SAFE).clamp(0.125, max_shrink);
+        let root = err_root::<S>(err);
+        let mut quot = (root / SAFE).clamp(0.125, max_shrink);
         if accepted {
             if self.have_acc {
-                let gus =
-                    ((self.h_acc / h) * err_root::<S>(err * err / self.err_acc) / SAFE).clamp(0.125, 5.0);
+                // (err²/err_acc)^(1/(S+1)), from the roots already taken.
+                let gus = ((self.h_acc / h) * root * root / self.err_acc_root / SAFE).clamp(0.125, 5.0);
                 quot = quot.max(gus);
             }
             self.h_acc = h;
-            self.err_acc = err.max(1e-2);
+            self.err_acc_root = root.max(err_root::<S>(1e-2));
             self.have_acc = true;
         }
         h / quot
