@@ -1,5 +1,5 @@
 //! The electrical solve against the mechanical simulation it rides on, on the paper's default
-//! case (10 periods from rest, 100 kΩ and near-optimal 100 MΩ loads, and the rectifier).
+//! case (10 periods from rest; 100 kΩ, 100 MΩ and 10 GΩ loads, and the rectifier).
 //!
 //! `cargo bench -p vibrotribo --bench electrical`. Criterion prints the medians; the ratio
 //! electrical / mechanics is what to read off.
@@ -54,6 +54,9 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("electrical_100M_replay", |b| {
         b.iter(|| replay(&chain, black_box(&trajectory), &resistor(1e8)))
+    });
+    g.bench_function("electrical_10G_replay", |b| {
+        b.iter(|| replay(&chain, black_box(&trajectory), &resistor(1e10)))
     });
     g.bench_function("electrical_rectifier_replay", |b| {
         b.iter(|| replay(&chain, black_box(&trajectory), &rectifier))

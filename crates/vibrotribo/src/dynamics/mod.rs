@@ -9,6 +9,7 @@ mod oscillator;
 mod roots;
 mod signal;
 mod simulator;
+mod taylor;
 
 pub use observer::{
     ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, Segment, StateView, Trajectory,
@@ -16,3 +17,4 @@ pub use observer::{
 };
 pub use oscillator::Oscillator;
 pub use simulator::{ContactStatus, Simulator, initial_state};
+pub(crate) use taylor::GapPolynomial;

@@ -248,7 +248,111 @@ impl Oscillator {
     pub fn start_time(&self) -> f64 {
         self.t0
     }
+
+    /// A rate Λ, 1/s, that bounds how fast the Taylor coefficients of the motion can grow:
+    /// at least ω (the forced part) and 2α + ω_n (every root of `λ² + 2αλ + ω_n² = 0` in all
+    /// damping regimes, and the two coefficients of that recurrence). See [`taylor`](Self::taylor).
+    pub(crate) fn rate_bound(&self) -> f64 {
+        (2.0 * self.alpha + self.wn2.sqrt()).max(self.omega)
+    }
+
+    /// Scaled Taylor coefficients of the displacement about `tc` (phase `ph` of `tc`) with
+    /// radius `r`, s: `coef[j] = s⁽ʲ⁾(tc) rʲ / j!`, m, for as many `j` as needed to bring the
+    /// truncation error on `|t − tc| ≤ r` below `rel` times the size of the motion (static
+    /// offset + forced amplitude + `|h(tc)| + r|h'(tc)|`), at most `coef.len()` terms.
+    ///
+    /// Returns the number of terms written, the truncation bound reached, m, and the
+    /// tolerance it was held to, m. The
+    /// homogeneous part obeys `h⁽ʲ⁺²⁾ = −2α h⁽ʲ⁺¹⁾ − ω_n² h⁽ʲ⁾`; once `j + 1 ≥ KΛr`
+    /// ([`rate_bound`](Self::rate_bound), K = 8) each scaled coefficient is at most
+    /// `c = 1/K + 1/K²` of the larger of the two before it, so the tail after `j` is below
+    /// `2c/(1 − c)·max(|g_{j−1}|, |g_j|)`. The forced part's terms then fall by K per term,
+    /// so its tail is below `K/(K − 1)` times its next term. The first two coefficients are
+    /// the values [`state`](Self::state) returns.
+    pub(crate) fn taylor(&self, tc: f64, ph: Phase, r: f64, rel: f64, coef: &mut [f64]) -> (usize, f64, f64) {
+        let (sp, vp) = self.forced(ph);
+        let tau = tc - self.t0;
+        let (c, s) = self.propagator(tau);
+        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
+        let h = h0 * c + (h1 + self.alpha * h0) * s;
+        let hd = h1 * c - (self.wn2 * h0 + self.alpha * h1) * s;
+        let eh = e0 * c + (e1 + self.alpha * e0) * s;
+        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
+        let max_terms = coef.len();
+        // Homogeneous part g_j and forced part F_j = wⱼ·cyc(j) with wⱼ = (ωr)ʲ/j!.
+        let (mut g_prev, mut g) = (h + eh, (hd + ehd) * r);
+        // The forced part's scaled coefficients cycle through (A, B, −A, −B)·wⱼ: carry the
+        // pair (Fⱼ, Fⱼ₊₁ rotated back) and rotate it by a quarter turn per term.
+        let amp_a = self.pc * ph.cos + self.ps * ph.sin;
+        let amp_b = self.ps * ph.cos - self.pc * ph.sin;
+        // No overflow is possible at these magnitudes: no need for hypot.
+        let amp = (self.pc * self.pc + self.ps * self.ps).sqrt();
+        let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs());
+        // Terms beyond the reciprocal table are never needed (a sub-piece needs about 20).
+        let max_terms = max_terms.min(RECIPROCALS - 1);
+        if max_terms < 2 {
+            return (0, f64::INFINITY, tol);
+        }
+        coef[0] = (sp + h) + eh;
+        coef[1] = ((vp + hd) + ehd) * r;
+        let wr = self.omega * r;
+        // (p, q) = wⱼ·(cycⱼ, cycⱼ₊₁) with wⱼ = (ωr)ʲ/j!, at j = 1.
+        let (mut p, mut q) = (wr * amp_b, -wr * amp_a);
+        let mut w = wr;
+        let two_ar = 2.0 * self.alpha * r;
+        let wn2r2 = self.wn2 * r * r;
+        let min_terms = TAIL_K * self.rate_bound() * r;
+        let mut tail = f64::INFINITY;
+        let mut n = 2;
+        let mut inv_prev = 1.0;
+        for (j, slot) in coef.iter_mut().enumerate().take(max_terms).skip(2) {
+            let inv_j = INV[j];
+            let g_next = -(two_ar * g + wn2r2 * g_prev * inv_prev) * inv_j;
+            let step = wr * inv_j;
+            (p, q) = (q * step, -p * step);
+            w *= step;
+            *slot = p + g_next;
+            g_prev = g;
+            g = g_next;
+            inv_prev = inv_j;
+            n = j + 1;
+            // Terms 0..=j are written: bound the tail Σ_{i > j} (see the docs).
+            if j as f64 >= min_terms {
+                let forced_tail = FORCED_TAIL * amp * w * wr * INV[j + 1];
+                tail = forced_tail + HOMOGENEOUS_TAIL * g.abs().max(g_prev.abs());
+                if tail <= tol {
+                    break;
+                }
+            }
+        }
+        (n, tail, tol)
+    }
 }
+
+/// Terms of a Taylor expansion are bounded once `j + 1 ≥ TAIL_K·Λr` (see `Oscillator::taylor`).
+const TAIL_K: f64 = 8.0;
+
+/// Tail of the homogeneous part over the larger of the last two terms: `2c/(1 − c)`,
+/// `c = 1/K + 1/K²`.
+const HOMOGENEOUS_TAIL: f64 =
+    2.0 * (1.0 / TAIL_K + 1.0 / (TAIL_K * TAIL_K)) / (1.0 - (1.0 / TAIL_K + 1.0 / (TAIL_K * TAIL_K)));
+
+/// Tail of the forced part over its next term: `K/(K − 1)`.
+const FORCED_TAIL: f64 = TAIL_K / (TAIL_K - 1.0);
+
+/// Most Taylor terms with tabulated reciprocals.
+const RECIPROCALS: usize = 64;
+
+/// `1/j` for `j` in `0..RECIPROCALS` (`1/0` unused).
+static INV: [f64; RECIPROCALS] = {
+    let mut t = [0.0; RECIPROCALS];
+    let mut j = 1;
+    while j < RECIPROCALS {
+        t[j] = 1.0 / j as f64;
+        j += 1;
+    }
+    t
+};
 
 /// `a + b` and its exact rounding error (Knuth's TwoSum): `a + b = s + e` exactly.
 #[inline]

@@ -65,24 +65,77 @@ pub struct BridgeCurrents {
 impl Diode {
     /// Current i, A, and conductance di/dv, S, at terminal voltage `v`, V.
     pub fn current(&self, v: f64) -> (f64, f64) {
-        let is = self.saturation_current;
-        let a = self.ideality * self.thermal_voltage;
-        let rs = self.series_resistance;
-        // Forward branch, explicit through ω.
-        let x = (is * rs / a).ln() + (v + is * rs) / a;
-        let w = wright_omega(x);
-        let i = a * w / rs - is;
-        let gp = self.parallel_conductance;
-        let vj = v - i * rs;
-        if vj >= -3.0 * a {
+        DiodeLaw::new(self).current(v)
+    }
+
+    /// The full-wave bridge of four of these diodes at transducer voltage `v` and storage
+    /// voltage `vs`, V (see the module docs).
+    pub fn bridge(&self, v: f64, vs: f64) -> BridgeCurrents {
+        DiodeLaw::new(self).bridge(v, vs)
+    }
+}
+
+/// A [`Diode`] with the constants of its law computed once (the charge solver evaluates the
+/// bridge at every stage of every Newton iteration).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct DiodeLaw {
+    is: f64,
+    rs: f64,
+    gp: f64,
+    /// n·V_T and its inverse.
+    a: f64,
+    inv_a: f64,
+    /// `ln(I_s R_s/(nV_T)) + I_s R_s/(nV_T)`: the forward branch's ω argument is `x0 + v/(nV_T)`.
+    x0: f64,
+    /// nV_T/R_s.
+    a_over_rs: f64,
+    /// The terminal voltage where the junction voltage is −3nV_T: below it the reverse tail
+    /// applies.
+    v_tail: f64,
+    /// 3nV_T/e.
+    tail_k: f64,
+}
+
+impl DiodeLaw {
+    pub(crate) fn new(d: &Diode) -> Self {
+        let is = d.saturation_current;
+        let a = d.ideality * d.thermal_voltage;
+        let rs = d.series_resistance;
+        DiodeLaw {
+            is,
+            rs,
+            gp: d.parallel_conductance,
+            a,
+            inv_a: 1.0 / a,
+            x0: (is * rs / a).ln() + is * rs / a,
+            a_over_rs: a / rs,
+            v_tail: -3.0 * a + is * ((-3.0f64).exp() - 1.0) * rs,
+            tail_k: 3.0 * a / std::f64::consts::E,
+        }
+    }
+
+    /// n·V_T, V.
+    pub(crate) fn thermal_scale(&self) -> f64 {
+        self.a
+    }
+
+    /// Current i, A, and conductance di/dv, S, at terminal voltage `v`, V.
+    #[inline]
+    pub(crate) fn current(&self, v: f64) -> (f64, f64) {
+        let (is, rs, gp) = (self.is, self.rs, self.gp);
+        if v >= self.v_tail {
+            // Forward branch, explicit through ω.
+            let w = wright_omega(self.x0 + v * self.inv_a);
+            let i = self.a_over_rs * w - is;
             return (i + gp * v, w / ((1.0 + w) * rs) + gp);
         }
-        // Reverse tail: solve vj + R_s i(vj) = v (i ≈ −I_s, so R_s i is tiny).
-        let k = 3.0 * a / std::f64::consts::E;
+        // Reverse tail: solve vj + R_s i(vj) = v (i ≈ −I_s, so R_s i is tiny and one Newton
+        // step from vj = v + I_s R_s is exact to rounding; the second evaluates there).
+        let k = self.tail_k;
         let mut vj = v + is * rs;
         let mut i = 0.0;
         let mut g = 0.0;
-        for _ in 0..4 {
+        for _ in 0..2 {
             let arg = (k / vj).powi(3);
             i = -is * (1.0 + arg);
             g = 3.0 * is * arg / vj;
@@ -92,9 +145,16 @@ impl Diode {
         (i + gp * v, g / (1.0 + rs * g) + gp)
     }
 
-    /// The full-wave bridge of four of these diodes at transducer voltage `v` and storage
-    /// voltage `vs`, V (see the module docs).
-    pub fn bridge(&self, v: f64, vs: f64) -> BridgeCurrents {
+    /// The bridge's two junction voltages, in units of n·V_T, at transducer voltage `v` and
+    /// storage voltage `vs`, V: `(V − V_s)/2` and `−(V + V_s)/2`.
+    #[inline]
+    pub(crate) fn junction_exponents(&self, v: f64, vs: f64) -> [f64; 2] {
+        [0.5 * (v - vs) * self.inv_a, -0.5 * (v + vs) * self.inv_a]
+    }
+
+    /// The full-wave bridge at transducer voltage `v` and storage voltage `vs`, V.
+    #[inline]
+    pub(crate) fn bridge(&self, v: f64, vs: f64) -> BridgeCurrents {
         let (i_s, g_s) = self.current(0.5 * (v - vs));
         let (i_r, g_r) = self.current(-0.5 * (v + vs));
         BridgeCurrents {
@@ -110,10 +170,11 @@ impl Diode {
 
 /// Wright ω function: the real solution w of `w + ln w = x` (ω(x) = W₀(eˣ)), to full precision.
 pub(crate) fn wright_omega(x: f64) -> f64 {
-    if x < -40.0 {
-        // ω = eˣ − e²ˣ + …, exact to rounding here (and 0 once eˣ underflows).
-        let e = x.exp();
-        return e * (1.0 - e);
+    if x < -10.0 {
+        // ω = z − z² + 3z³/2 − 8z⁴/3 + …, z = eˣ: the next term is below 6e-17 of ω here (and
+        // ω is 0 once eˣ underflows).
+        let z = x.exp();
+        return z * (1.0 - z * (1.0 - z * (1.5 - z * (8.0 / 3.0))));
     }
     let mut w = if x < -2.0 {
         let e = x.exp();

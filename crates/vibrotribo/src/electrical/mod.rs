@@ -31,8 +31,9 @@
 //! ## Pieces
 //!
 //! - [`HarvesterParams`]: the `[harvester]` table, validated with key names.
-//! - [`ChargeSolver`]: 3-stage Radau IIA with error control, an [`Observer`](crate::Observer)
-//!   of the simulator, or driven by any [`GapWaveform`] (e.g. [`PwlGaps`]).
+//! - [`ChargeSolver`]: Radau IIA with error control (7 stages for the resistor, 3 for the
+//!   rectifier), an [`Observer`](crate::Observer) of the simulator, or driven by any
+//!   [`GapWaveform`] (e.g. [`PwlGaps`]).
 //! - [`load_sweep`]: average power against load resistance on a recorded trajectory, with
 //!   the optimum refined.
 //! - [`spice`]: ngspice netlists of the same circuit for cross-checking.

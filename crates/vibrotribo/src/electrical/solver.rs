@@ -16,18 +16,33 @@
 //!
 //! ## Method
 //!
-//! 3-stage Radau IIA (order 5, L-stable) on these equations, with the stage values of `Q`
-//! written as `u = Q − Q_eq = −C·V` and the exact increments `Q_eq(tᵢ) − Q_eq(t₀)` of the
-//! waveform: the unknowns then hold the load voltage without cancellation when it is a
+//! Radau IIA collocation (L-stable, stiffly accurate) on these equations, with the stage
+//! values of `Q` written as `u = Q − Q_eq = −C·V` and the exact increments `Q_eq(tᵢ) − Q_eq(t₀)`
+//! of the waveform: the unknowns then hold the load voltage without cancellation when it is a
 //! millionth of V_oc (small R), and `Q` stays exactly constant when nothing flows (R → ∞).
-//! For the resistor the stage system is a 3×3 linear solve (exact); for the rectifier it is
-//! solved by Newton's method with the exact Jacobian at every stage. The delivered energy is
-//! a quadrature component of the same collocation, `ΔE = h Σ bⱼ p(tⱼ, Yⱼ)` over the stage
-//! values, not a sampled sum.
+//! The delivered energy is a quadrature component of the same collocation,
+//! `ΔE = h Σ bⱼ p(tⱼ, Yⱼ)` over the stage values, not a sampled sum.
 //!
-//! Error control uses Hairer's embedded estimate (RADAU5's first estimate, without its
-//! second, "stiffly filtered" one, which in the quasi-static regime of a small load accepts
-//! steps 10⁴ times too long) on two things:
+//! - **Resistor**: 7 stages (order 13, stage order 7). The stage system is linear,
+//!   `(I + hA·diag(k)) Z = −ΔQ_eq − hA k u₀` with `k = 1/(RC)`, solved exactly by elimination
+//!   without pivoting (safe for these matrices, see [`radau`](super::radau)). The high order
+//!   lets a step span a good part of a flow piece: about 60 steps per period on the paper's
+//!   default case, for loads from 1 kΩ to 10 GΩ.
+//! - **Rectifier**: 3 stages (order 5). Its steps are short around every switching of the
+//!   bridge, where a low order is cheaper; the 6 × 6 stage system is solved by Newton's
+//!   method with the exact Jacobian at every iteration, started from the previous step's
+//!   collocation polynomial, and given up early (RADAU5's test on the contraction rate θ)
+//!   when the remaining iterations cannot converge. The diode law's constants are computed
+//!   once.
+//!
+//! The gaps come in as a [`GapWaveform`]; the simulator's flow is first expanded into
+//! piecewise Taylor polynomials accurate to the rounding of its closed form (see
+//! `dynamics::taylor`), so the stage points of a step cost one Horner sweep each instead of
+//! an exponential and a sine–cosine pair per cluster.
+//!
+//! Error control uses Hairer's embedded estimate (RADAU5's first estimate, of order S,
+//! without its second, "stiffly filtered" one, which in the quasi-static regime of a small
+//! load accepts steps 10⁴ times too long) on two things:
 //!
 //! - the load voltage `−u/C` (and the storage voltage), per step, `rtol·|V| + atol`; by
 //!   default `atol = rtol × (largest |V| seen)` for the resistor, `rtol × (largest V_s seen,
@@ -35,11 +50,23 @@
 //! - the energy, per unit step, against `rtol × (average power)`: summed over a period the
 //!   allowed error is `rtol ×` the period's energy. Without this the voltage test alone lets
 //!   a stiff load take steps of a tenth of a period, far too long for the quadrature of V².
+//!   Steps shorter than `T/1000` (boundary layers) are allowed `rtol × E/1000` each rather
+//!   than an error proportional to their length.
 //!
 //! A noise allowance keeps the tests above the precision of the input (gaps are differences
 //! of positions), so tight tolerances cannot drive the step to zero. The step size follows
-//! RADAU5's controller with Gustafsson's predictive variant; a failed stiff step jumps to
-//! `h·k ≈ 2` (a boundary layer after a kink).
+//! RADAU5's controller with Gustafsson's predictive variant (`h ∝ err^(−1/(S+1))`). Where the
+//! estimate cannot see the solution's structure, the step is shaped directly:
+//!
+//! - after a kink the resistor's charge crosses a boundary layer of width `RC`; its amplitude
+//!   is estimated from the quasi-static charge `u ≈ −I_sc/k`, the layer is entered at
+//!   `h·k = 2`, and once it has decayed below the tolerance the step returns to the size it
+//!   had before the kink;
+//! - a failed stiff rectifier step (the bridge switching) jumps to `h·k ≈ 2`, and a rectifier
+//!   step in which a conducting junction's voltage moves by more than 4 n·V_T is retried
+//!   shorter: the current changes by orders of magnitude there, which neither the collocation
+//!   polynomial nor its error estimate follows;
+//! - after a kink the rectifier's first step covers a sweep of 10 n·V_T of the voltage.
 //!
 //! Every call of [`ChargeSolver::advance`] restarts the integration (mechanical kinks such as
 //! impacts fall on flow boundaries), and excitation period boundaries are step boundaries, so
@@ -47,12 +74,12 @@
 //! polynomial with the transducer evaluated exactly at the sample time.
 
 use super::ElectricalError;
-use super::diode::Diode;
+use super::diode::DiodeLaw;
 use super::params::{HarvesterParams, LoadKind};
-use super::radau::{Tableau, solve_dense};
-use super::transducer::{Transducer, TransducerState};
+use super::radau::{Tableau, solve_fixed, solve_unpivoted};
+use super::transducer::{ChargeMap, Transducer, TransducerState};
 use super::waveform::{GapWaveform, PwlGaps};
-use crate::dynamics::{Flow, Observer, Trajectory};
+use crate::dynamics::{Flow, GapPolynomial, Observer, Trajectory};
 use crate::error::ParamError;
 use crate::model::ChainParams;
 
@@ -64,7 +91,8 @@ pub struct ChargeOptions {
     /// Relative tolerance of the local error on the load voltage (and storage voltage) per
     /// step and of the delivered energy per period (`electrical.rtol`), dimensionless.
     /// Default 1e-5, which keeps the energy per period within 1e-7 relative of a converged
-    /// solution on the paper's default and chatter cases for loads from 1 kΩ to 10 GΩ.
+    /// solution on the paper's default and chatter cases for loads from 1 kΩ to 10 GΩ and for
+    /// the rectifier.
     pub rtol: f64,
     /// Absolute voltage tolerance, V (`electrical.atol_voltage`). Absent (default): `rtol`
     /// times the largest load voltage seen so far (resistor) or the largest storage voltage,
@@ -179,11 +207,12 @@ impl ElectricalSamples {
 pub struct SolverStats {
     /// Accepted steps.
     pub steps: u64,
-    /// Rejected steps (error test or Newton failure).
+    /// Rejected steps (error test, Newton failure, or a rectifier step over a switching).
     pub rejected: u64,
     /// Newton iterations (rectifier).
     pub newton_iterations: u64,
-    /// Evaluations of the gap waveform.
+    /// Evaluations of the gap waveform (for the simulator's flow: of its Taylor expansion,
+    /// see [`GapWaveform`]).
     pub waveform_evaluations: u64,
     /// Smooth pieces integrated (flows, split at period boundaries).
     pub pieces: u64,
@@ -195,7 +224,7 @@ enum LoadModel {
         conductance: f64,
     },
     Rectifier {
-        diode: Diode,
+        diode: DiodeLaw,
         inv_cs: f64,
         load_conductance: f64,
     },
@@ -246,27 +275,37 @@ struct Row {
 /// One accepted Radau step: enough to evaluate its collocation polynomial.
 #[derive(Debug, Clone, Copy)]
 struct Step {
+    /// Stages of the method (the arrays hold that many entries).
+    stages: usize,
     t0: f64,
     h: f64,
     y0: [f64; 2],
-    z: [[f64; 2]; 3],
+    /// Stage increments `z[c][i]` of `u` (C, c = 0) and of the storage voltage (V, c = 1).
+    z: [[f64; MAX_STAGES]; 2],
     e0: f64,
-    ze: [f64; 3],
+    /// Stage values of the delivered power, W.
+    power: [f64; MAX_STAGES],
     /// `Q_eq` at t0 and its increments at the stages, C.
     qeq0: f64,
-    dq: [f64; 3],
+    dq: [f64; MAX_STAGES],
     stiff: bool,
 }
 
-/// Result of solving the stages of one trial step.
-#[derive(Debug, Clone, Copy, Default)]
-struct Trial {
-    z: [[f64; 2]; 3],
-    /// Stage increments of the delivered energy, J.
-    ze: [f64; 3],
-    /// Stage values of the terminal voltage, V, and current, A.
-    voltage: [f64; 3],
-    current: [f64; 3],
+/// Result of solving the stages of one trial step (one buffer reused for every trial).
+#[derive(Debug, Clone, Copy)]
+struct Trial<const S: usize> {
+    /// Stage increments `z[c][i]` of `u` (C, c = 0) and of the storage voltage (V, c = 1).
+    z: [[f64; S]; 2],
+    /// Stage values of the delivered power, W.
+    power: [f64; S],
+    /// Energy delivered over the step, J: `h Σ bⱼ pⱼ`.
+    energy: f64,
+    /// Largest |terminal voltage|, V, and |current|, A, at the stages.
+    peak_voltage: f64,
+    peak_current: f64,
+    /// Largest stage value of the voltage that scales the default absolute tolerance, V (the
+    /// load voltage for a resistor, the storage voltage for the rectifier).
+    scale_voltage: f64,
     /// Scaled error estimate (≤ 1 accepts).
     err: f64,
     /// Whether the step is stiff (h·|∂Q'/∂Q| ≥ 1): then `u` is interpolated directly in dense
@@ -274,9 +313,40 @@ struct Trial {
     stiff: bool,
     /// h·|∂Q'/∂Q| at t0.
     hk: f64,
+    /// Factor for the next step after a failed Newton iteration.
+    retry: f64,
     /// `Q_eq` at t0 and its increments at the stages, C.
     qeq0: f64,
-    dq: [f64; 3],
+    dq: [f64; S],
+}
+
+impl<const S: usize> Trial<S> {
+    fn new() -> Self {
+        Trial {
+            z: [[0.0; S]; 2],
+            power: [0.0; S],
+            energy: 0.0,
+            peak_voltage: 0.0,
+            peak_current: 0.0,
+            scale_voltage: 0.0,
+            err: 0.0,
+            stiff: false,
+            hk: 0.0,
+            retry: 0.25,
+            qeq0: 0.0,
+            dq: [0.0; S],
+        }
+    }
+}
+
+/// The rectifier's constants, as the stage solver takes them.
+#[derive(Debug, Clone, Copy)]
+struct RectifierLoad {
+    diode: DiodeLaw,
+    /// 1/C_s, 1/F.
+    inv_cs: f64,
+    /// 1/R_L, S (0 without a load resistor).
+    load_conductance: f64,
 }
 
 /// Integrates the transducer's charge and the load driven by gap waveforms (see the module
@@ -299,12 +369,19 @@ struct Trial {
 #[derive(Debug, Clone)]
 pub struct ChargeSolver {
     transducer: Transducer,
+    /// The transducer in the form evaluated at stage points.
+    charge_map: ChargeMap,
+    /// `NOISE_CHARGE / NOISE` times the charge scale σS, C (see `qeq_noise_scale`).
+    charge_noise: f64,
     load: LoadModel,
     options: ChargeOptions,
-    tab: Tableau,
+    tab_resistor: Tableau<RESISTOR_STAGES>,
+    tab_rectifier: Tableau<RECTIFIER_STAGES>,
     period: f64,
     gaps: Vec<f64>,
     rates: Vec<f64>,
+    /// Gaps at the stage points of a step, `node_gaps[i·n + k]`, m.
+    node_gaps: Vec<f64>,
     initial_charge: Option<f64>,
     storage_initial_voltage: f64,
     target_voltage: Option<f64>,
@@ -319,15 +396,20 @@ pub struct ChargeSolver {
     open_charge: f64,
     /// Energy delivered since the start, J.
     energy: f64,
+    /// Average power over the last complete period, W (0 before there is one).
+    last_period_power: f64,
     h: f64,
     h_acc: f64,
-    err_acc: f64,
+    /// `err^(1/(S+1))` of the last accepted step (at least that of 1e-2).
+    err_acc_root: f64,
     have_acc: bool,
     /// Voltage scale of the default absolute tolerance, V.
     v_scale: f64,
     /// Time the solver started, s.
     t_start: f64,
     last_step: Option<Step>,
+    /// Whether the waveform is smooth from `last_step` to now (no piece boundary since).
+    smooth_since_last_step: bool,
     periods: Vec<PeriodStats>,
     steps_in_period: u64,
     sampler: Option<Grid>,
@@ -335,10 +417,72 @@ pub struct ChargeSolver {
     target_time: Option<f64>,
     stats: SolverStats,
     error: Option<ElectricalError>,
+    /// The current piece of flow, expanded (buffers reused).
+    poly: GapPolynomial,
+}
+
+/// Stages of the Radau IIA method for the resistor: order 13, stage order 7.
+const RESISTOR_STAGES: usize = 7;
+
+/// Stages for the rectifier: its steps are short around every switching of the bridge, where
+/// a low order is cheaper (smaller Newton systems).
+const RECTIFIER_STAGES: usize = 3;
+
+/// Room for the stages of either method in a stored step.
+const MAX_STAGES: usize = 7;
+
+/// Steps per period below which the energy test stops shrinking with the step (see
+/// `ChargeSolver::energy_error`).
+const ENERGY_FLOOR_STEPS: f64 = 1000.0;
+
+/// A boundary layer being crossed (see `ChargeSolver::kink_start`).
+#[derive(Debug, Clone, Copy)]
+struct Layer {
+    conductance: f64,
+    /// ∫k dt since the kink.
+    decayed: f64,
+    /// ∫k dt after which the layer is below the tolerance.
+    needed: f64,
+    /// The step before the kink, s.
+    h_smooth: f64,
+}
+
+/// Sweep of the rectifier's voltage, in units of n·V_T, that the first step after a kink may
+/// cover.
+const KINK_SWING: f64 = 10.0;
+
+/// Largest change, in units of n·V_T, of a bridge junction's voltage over one rectifier step
+/// while that junction conducts.
+const SWITCH_SWEEP: f64 = 4.0;
+
+/// Reverse bias, in units of n·V_T, beyond which a junction counts as off (its current is
+/// then −I_s to within e⁻⁶).
+const SWITCH_FLOOR: f64 = -6.0;
+
+/// Growth per accepted step of the step size after a failure of Newton's method.
+const SOLVE_REGROWTH: f64 = 2.0;
+
+/// Decay (e-folds) beyond the tolerance before a layer counts as gone.
+const LAYER_MARGIN: f64 = 3.0;
+
+/// `x^(1/(S+1))`: the error estimate is O(h^(S+1)).
+#[inline]
+fn err_root<const S: usize>(x: f64) -> f64 {
+    if S == 7 {
+        x.sqrt().sqrt().sqrt()
+    } else if S == 3 {
+        x.sqrt().sqrt()
+    } else {
+        x.powf(1.0 / (S as f64 + 1.0))
+    }
 }
 
 /// Most Newton iterations per stage solve before the step is retried smaller.
 const MAX_NEWTON: usize = 12;
+
+/// Newton's iterations stop when the estimated remaining error of the stages is below this
+/// fraction of the error tolerance.
+const NEWTON_TOL: f64 = 1e-3;
 
 /// Relative noise allowance of the error estimates: an estimate below this fraction of the
 /// terms it is computed from is noise and never rejects a step. The floor is the precision of
@@ -370,12 +514,13 @@ impl ChargeSolver {
             });
         }
         let transducer = params.transducer();
+        let charge_map = ChargeMap::new(&transducer);
         let load = match params.load {
             LoadKind::Resistor => LoadModel::Resistor {
                 conductance: 1.0 / params.load_resistance,
             },
             LoadKind::Rectifier => LoadModel::Rectifier {
-                diode: params.diode(),
+                diode: DiodeLaw::new(&params.diode()),
                 inv_cs: 1.0 / params.storage_capacitance,
                 load_conductance: params.storage_load_resistance.map_or(0.0, |r| 1.0 / r),
             },
@@ -383,14 +528,18 @@ impl ChargeSolver {
             LoadKind::Short => LoadModel::Short,
         };
         let v_floor = match load {
-            LoadModel::Rectifier { diode, .. } => diode.ideality * diode.thermal_voltage,
+            LoadModel::Rectifier { diode, .. } => diode.thermal_scale(),
             _ => (1e-12 * transducer.voltage_scale()).max(f64::MIN_POSITIVE),
         };
         Ok(ChargeSolver {
             transducer,
+            charge_map,
+            charge_noise: NOISE_CHARGE / NOISE * transducer.charge_scale(),
+            node_gaps: vec![0.0; MAX_STAGES * gaps],
             load,
             options,
-            tab: Tableau::new(),
+            tab_resistor: Tableau::new(),
+            tab_rectifier: Tableau::new(),
             period,
             gaps: vec![0.0; gaps],
             rates: vec![0.0; gaps],
@@ -404,13 +553,15 @@ impl ChargeSolver {
             ts_now: TransducerState::default(),
             open_charge: 0.0,
             energy: 0.0,
+            last_period_power: 0.0,
             h: 1e-6 * period,
             h_acc: 0.0,
-            err_acc: 0.0,
+            err_acc_root: 0.0,
             have_acc: false,
             v_scale: 0.0,
             t_start: 0.0,
             last_step: None,
+            smooth_since_last_step: false,
             periods: Vec::new(),
             steps_in_period: 0,
             sampler: None,
@@ -418,6 +569,7 @@ impl ChargeSolver {
             target_time: None,
             stats: SolverStats::default(),
             error: None,
+            poly: GapPolynomial::default(),
         })
     }
 
@@ -548,9 +700,18 @@ impl ChargeSolver {
                 }
                 .into());
             }
-            self.advance(seg.t_start, seg.t_end, &flow)?;
+            self.advance_flow(&flow)?;
         }
         Ok(())
+    }
+
+    /// Advances over a piece of the simulator's flow, through its Taylor expansion.
+    fn advance_flow(&mut self, flow: &Flow<'_>) -> Result<(), ElectricalError> {
+        let mut poly = std::mem::take(&mut self.poly);
+        poly.build(flow);
+        let result = self.advance(flow.t_start, flow.t_end, &poly);
+        self.poly = poly;
+        result
     }
 
     /// The first error met while observing a simulation (an [`Observer`] cannot return one),
@@ -642,7 +803,7 @@ impl ChargeSolver {
     ) -> Result<TransducerState, ElectricalError> {
         wave.gaps(t, &mut self.gaps, &mut self.rates);
         self.stats.waveform_evaluations += 1;
-        let ts = self.transducer.state(&self.gaps, &self.rates);
+        let ts = self.charge_map.state_with_rates(&self.gaps, &self.rates);
         if ts.elastance > 0.0
             && ts.elastance.is_finite()
             && ts.equilibrium_current.is_finite()
@@ -652,6 +813,27 @@ impl ChargeSolver {
         } else {
             Err(ElectricalError::InvalidGaps { t })
         }
+    }
+
+    /// The transducer at the stage points `times` of a step: like [`eval`](Self::eval)
+    /// without the rates (the equilibrium current is left 0).
+    #[inline]
+    fn eval_nodes<W: GapWaveform + ?Sized, const S: usize>(
+        &mut self,
+        times: &[f64; S],
+        wave: &W,
+    ) -> Result<[TransducerState; S], ElectricalError> {
+        let n = self.gaps.len();
+        wave.gap_values_at(times, &mut self.node_gaps[..S * n]);
+        self.stats.waveform_evaluations += S as u64;
+        let mut nodes = [TransducerState::default(); S];
+        for (i, node) in nodes.iter_mut().enumerate() {
+            *node = self.charge_map.state(&self.node_gaps[i * n..(i + 1) * n]);
+            if !(node.elastance > 0.0 && node.elastance.is_finite() && node.equilibrium_charge.is_finite()) {
+                return Err(ElectricalError::InvalidGaps { t: times[i] });
+            }
+        }
+        Ok(nodes)
     }
 
     fn start<W: GapWaveform + ?Sized>(&mut self, t0: f64, wave: &W) -> Result<(), ElectricalError> {
@@ -714,6 +896,11 @@ impl ChargeSolver {
                 storage_voltage_v: None,
             });
             self.steps_in_period = 0;
+            if let [.., done, _] = self.periods.as_slice()
+                && done.is_complete(self.period)
+            {
+                self.last_period_power = done.energy_j / self.period;
+            }
         }
         let n0 = self.eval(ta, wave)?;
         let r0 = self.row(n0, self.y, self.energy);
@@ -723,7 +910,28 @@ impl ChargeSolver {
             self.sample_between(ta, ta, wave, None)?;
         }
         match self.load {
-            LoadModel::Resistor { .. } | LoadModel::Rectifier { .. } => self.integrate(ta, tb, n0, wave)?,
+            LoadModel::Resistor { conductance } => {
+                let tab = self.tab_resistor;
+                self.integrate(&tab, ta, tb, n0, wave, |s, h, n0, nodes, trial| {
+                    s.trial_resistor(&tab, conductance, h, n0, nodes, trial);
+                    true
+                })?;
+            }
+            LoadModel::Rectifier {
+                diode,
+                inv_cs,
+                load_conductance,
+            } => {
+                let tab = self.tab_rectifier;
+                let load = RectifierLoad {
+                    diode,
+                    inv_cs,
+                    load_conductance,
+                };
+                self.integrate(&tab, ta, tb, n0, wave, |s, h, n0, nodes, trial| {
+                    s.trial_rectifier(&tab, &load, h, n0, nodes, trial)
+                })?;
+            }
             LoadModel::Open | LoadModel::Short => {
                 let n1 = self.eval(tb, wave)?;
                 self.t = tb;
@@ -758,18 +966,31 @@ impl ChargeSolver {
             .unwrap_or(self.options.rtol * self.v_scale.max(self.v_floor))
     }
 
-    fn integrate<W: GapWaveform + ?Sized>(
+    /// Integrates `[ta, tb]` (smooth) with Radau IIA of `S` stages; `solve` solves the stage
+    /// system of one trial step (false if it failed, with `trial.retry` set).
+    fn integrate<W, const S: usize, F>(
         &mut self,
+        tab: &Tableau<S>,
         ta: f64,
         tb: f64,
         mut n0: TransducerState,
         wave: &W,
-    ) -> Result<(), ElectricalError> {
-        if matches!(self.load, LoadModel::Open | LoadModel::Short) {
-            return Ok(());
-        }
+        mut solve: F,
+    ) -> Result<(), ElectricalError>
+    where
+        W: GapWaveform + ?Sized,
+        F: FnMut(&mut Self, f64, &TransducerState, &[TransducerState; S], &mut Trial<S>) -> bool,
+    {
         let mut t = ta;
-        let c = self.tab.c;
+        let c = tab.c;
+        // A kink starts a new error history.
+        self.have_acc = false;
+        let mut layer = self.kink_start(&n0);
+        let mut trial = Trial::<S>::new();
+        // Step size at which the stage solver last failed.
+        let mut solve_cap = f64::INFINITY;
+        // The last step's polynomial does not extrapolate across a kink.
+        self.smooth_since_last_step = false;
         while t < tb {
             self.steps_in_period += 1;
             if self.steps_in_period > self.options.max_steps_per_period {
@@ -794,71 +1015,129 @@ impl ChargeSolver {
             if h <= 4.0 * f64::EPSILON * t.abs().max(self.period) && h < remaining {
                 return Err(ElectricalError::StepSizeUnderflow { t, h });
             }
-            let nodes = [
-                self.eval(t + c[0] * h, wave)?,
-                self.eval(t + c[1] * h, wave)?,
-                self.eval(t1, wave)?,
-            ];
-            let trial = match self.load {
-                LoadModel::Resistor { conductance } => Some(self.trial_resistor(conductance, h, &n0, &nodes)),
-                LoadModel::Rectifier {
-                    diode,
-                    inv_cs,
-                    load_conductance,
-                } => self.trial_rectifier(diode, inv_cs, load_conductance, h, &n0, &nodes),
-                LoadModel::Open | LoadModel::Short => None,
+            let times: [f64; S] = std::array::from_fn(|i| if i + 1 == S { t1 } else { t + c[i] * h });
+            let nodes = self.eval_nodes(&times, wave)?;
+            let solved = solve(self, h, &n0, &nodes, &mut trial);
+            let err = if solved && !trial.err.is_nan() {
+                trial.err
+            } else {
+                f64::INFINITY
             };
-            let err = trial.map_or(f64::INFINITY, |tr| {
-                if tr.err.is_nan() { f64::INFINITY } else { tr.err }
-            });
-            if let Some(trial) = trial.filter(|_| err <= 1.0) {
-                let step = self.accept(t, t1, &trial, nodes[2]);
-                self.record(step, wave)?;
-                let hnew = self.controller(h, err, true);
+            if err <= 1.0 {
+                self.accept(t, t1, &trial, nodes[S - 1]);
+                self.smooth_since_last_step = true;
+                self.record(wave)?;
+                let hnew = self.controller::<S>(h, err, true);
                 self.h = if clipped {
                     // A step shortened to meet the interval end says little about the next.
-                    (h * 0.9 * err.max(1e-10).powf(-0.25)).min(h_prop).max(hnew)
+                    (h * 0.9 / err_root::<S>(err.max(1e-10))).min(h_prop).max(hnew)
                 } else {
                     hnew
                 };
-                n0 = nodes[2];
+                if self.h > solve_cap {
+                    self.h = self.h.min(solve_cap.max(SOLVE_REGROWTH * h));
+                    solve_cap *= SOLVE_REGROWTH;
+                }
+                n0 = nodes[S - 1];
                 t = t1;
+                if let Some(l) = layer.as_mut() {
+                    let mean_el: f64 = (0..S).map(|j| tab.a[S - 1][j] * nodes[j].elastance).sum();
+                    l.decayed += mean_el * h * l.conductance;
+                    if l.decayed >= l.needed {
+                        // The layer is gone: resume the step of the smooth solution before the
+                        // kink.
+                        self.h = self.h.max(l.h_smooth);
+                        layer = None;
+                    }
+                }
             } else {
                 self.stats.rejected += 1;
                 self.h = if err.is_finite() {
-                    self.controller(h, err, false)
-                } else {
+                    self.controller::<S>(h, err, false)
+                } else if solved {
                     0.25 * h
+                } else {
+                    // The stage solver failed at h: grow back towards it only slowly.
+                    solve_cap = solve_cap.min(h);
+                    trial.retry * h
                 };
-                // A stiff step that fails has usually met a boundary layer (after a kink),
-                // where the estimate does not fall with h until h·k ~ 1: go there at once.
-                if let Some(tr) = trial
-                    && tr.hk > 2.0
-                {
-                    self.h = self.h.min(2.0 * h / tr.hk);
+                // A stiff step that fails has usually met a boundary layer, where the estimate
+                // does not fall with h until h·k ~ 1: go there at once. For the resistor only
+                // the first step of a piece meets one (after the kink); the rectifier meets
+                // one at every switching of the bridge.
+                let layer_possible = t == ta || matches!(self.load, LoadModel::Rectifier { .. });
+                if solved && layer_possible && trial.hk > 2.0 {
+                    self.h = self.h.min(2.0 * h / trial.hk);
                 }
+                // The predictive controller compares consecutive accepted steps.
+                self.have_acc = false;
             }
         }
         Ok(())
     }
 
+    /// Sets the first step of a piece (after a possible kink) and returns the boundary layer
+    /// to follow, if any.
+    ///
+    /// Resistor: the charge must cross a boundary layer of width RC if the kink moved the
+    /// quasi-static charge `u ≈ −I_sc/k` (k = 1/(RC), I_sc = dQ_eq/dt, valid when the step is
+    /// long against 1/k) by more than the tolerance; the step is set to `h·k = 2` and the
+    /// layer is followed until it has decayed below the tolerance. Rectifier: the first step
+    /// covers a sweep of `KINK_SWING` n·V_T of the voltage, over which the bridge switches.
+    fn kink_start(&mut self, n0: &TransducerState) -> Option<Layer> {
+        let conductance = match self.load {
+            LoadModel::Resistor { conductance } => conductance,
+            LoadModel::Rectifier { diode, .. } => {
+                // The bridge switches as the voltage sweeps a few n·V_T: start there.
+                let v0 = -self.y[0] * n0.elastance;
+                let b = diode.bridge(v0, self.y[1]);
+                let sweep = (n0.elastance * (n0.equilibrium_current - b.current)).abs();
+                let h_switch = KINK_SWING * diode.thermal_scale() / sweep;
+                if h_switch > 0.0 {
+                    self.h = self.h.min(h_switch);
+                }
+                return None;
+            }
+            _ => return None,
+        };
+        let k0 = conductance * n0.elastance;
+        if self.h * k0 <= 2.0 {
+            return None;
+        }
+        let jump = ((self.y[0] + n0.equilibrium_current / k0) * n0.elastance).abs();
+        let tol = self.options.rtol * (self.y[0] * n0.elastance).abs() + self.atol();
+        if jump.is_nan() || jump <= tol {
+            return None;
+        }
+        let h_smooth = self.h;
+        self.h = 2.0 / k0;
+        Some(Layer {
+            conductance,
+            decayed: 0.0,
+            needed: (jump / tol).ln() + LAYER_MARGIN,
+            h_smooth,
+        })
+    }
+
     /// Step-size controller of RADAU5 (with Gustafsson's predictive variant): the next step
     /// after a step of `h` with scaled error `err`.
-    fn controller(&mut self, h: f64, err: f64, accepted: bool) -> f64 {
+    fn controller<const S: usize>(&mut self, h: f64, err: f64, accepted: bool) -> f64 {
         const SAFE: f64 = 0.9;
         let err = err.max(1e-10);
         // A rejected step may shrink by up to 1000× at once: the estimate of a linear stage
         // system is reliable, and kinks leave boundary layers orders of magnitude thinner
         // than the step that met them.
         let max_shrink = if accepted { 5.0 } else { 1000.0 };
-        let mut quot = (err.powf(0.25) / SAFE).clamp(0.125, max_shrink);
+        let root = err_root::<S>(err);
+        let mut quot = (root / SAFE).clamp(0.125, max_shrink);
         if accepted {
             if self.have_acc {
-                let gus = ((self.h_acc / h) * (err * err / self.err_acc).powf(0.25) / SAFE).clamp(0.125, 5.0);
+                // (err²/err_acc)^(1/(S+1)), from the roots already taken.
+                let gus = ((self.h_acc / h) * root * root / self.err_acc_root / SAFE).clamp(0.125, 5.0);
                 quot = quot.max(gus);
             }
             self.h_acc = h;
-            self.err_acc = err.max(1e-2);
+            self.err_acc_root = root.max(err_root::<S>(1e-2));
             self.have_acc = true;
         }
         h / quot
@@ -867,102 +1146,119 @@ impl ChargeSolver {
     /// Resistor: Radau IIA on `Q' = −k (Q − Q_eq)`, `k = 1/(RC)`, solved for the stage
     /// increments `Zᵢ` of `u = Q − Q_eq` with the exact increments `ΔQ_eq,ᵢ` of the
     /// equilibrium charge: `(I + hA·diag(k)) Z = −ΔQ_eq − hA k u₀` (linear, solved exactly).
-    fn trial_resistor(
+    fn trial_resistor<const S: usize>(
         &self,
+        tab: &Tableau<S>,
         conductance: f64,
         h: f64,
         n0: &TransducerState,
-        nodes: &[TransducerState; 3],
-    ) -> Trial {
-        let tab = &self.tab;
+        nodes: &[TransducerState; S],
+        trial: &mut Trial<S>,
+    ) {
         let u0 = self.y[0];
-        let k = nodes.map(|n| conductance * n.elastance);
-        let dq = nodes.map(|n| n.equilibrium_charge - n0.equilibrium_charge);
-        let mut m = [[0.0; 3]; 3];
-        let mut rhs = [0.0; 3];
-        for i in 0..3 {
-            rhs[i] = -dq[i];
-            for j in 0..3 {
-                let ha = h * tab.a[i][j];
-                m[i][j] = ha * k[j] + if i == j { 1.0 } else { 0.0 };
-                rhs[i] -= ha * k[j] * u0;
+        let mut hk = [0.0; S];
+        let mut dq = [0.0; S];
+        for j in 0..S {
+            hk[j] = h * conductance * nodes[j].elastance;
+            dq[j] = nodes[j].equilibrium_charge - n0.equilibrium_charge;
+        }
+        let mut m = [[0.0; S]; S];
+        let mut z = [0.0; S];
+        for i in 0..S {
+            let mut row_sum = 0.0;
+            for j in 0..S {
+                let v = tab.a[i][j] * hk[j];
+                m[i][j] = v;
+                row_sum += v;
             }
+            m[i][i] += 1.0;
+            z[i] = -dq[i] - row_sum * u0;
         }
-        let mut trial = Trial {
-            qeq0: n0.equilibrium_charge,
-            dq,
-            ..Trial::default()
-        };
-        if !solve_dense(&mut m, &mut rhs, 3) {
+        trial.qeq0 = n0.equilibrium_charge;
+        trial.dq = dq;
+        if !solve_unpivoted(&mut m, &mut z) {
             trial.err = f64::INFINITY;
-            return trial;
+            return;
         }
-        let mut power = [0.0; 3];
-        for j in 0..3 {
-            trial.z[j][0] = rhs[j];
-            let v = -(u0 + rhs[j]) * nodes[j].elastance;
-            trial.voltage[j] = v;
-            trial.current[j] = v * conductance;
-            power[j] = v * v * conductance;
+        let v0 = -u0 * n0.elastance;
+        let mut v_max = v0.abs();
+        for j in 0..S {
+            let v = -(u0 + z[j]) * nodes[j].elastance;
+            trial.power[j] = v * v * conductance;
+            v_max = v_max.max(v.abs());
         }
-        trial.stiff = h * k[2] >= 1.0;
-        trial.hk = h * conductance * n0.elastance;
-        // Error estimate for Q: (1 + γ₀hk₀) e = γ₀ (h Q'₀ + Σ dᵢ ΔQᵢ), ΔQᵢ = Zᵢ + ΔQ_eq,ᵢ.
+        let v1 = -(u0 + z[S - 1]) * nodes[S - 1].elastance;
+        trial.z[0] = z;
+        trial.peak_voltage = v_max;
+        trial.peak_current = v_max * conductance;
+        trial.scale_voltage = v_max;
+        trial.stiff = hk[S - 1] >= 1.0;
         let k0 = conductance * n0.elastance;
+        trial.hk = h * k0;
+        // Error estimate for Q: (1 + γ₀hk₀) e = γ₀ (h Q'₀ + Σ dᵢ ΔQᵢ), ΔQᵢ = Zᵢ + ΔQ_eq,ᵢ.
         let f0 = -k0 * u0;
-        let dz: f64 = (0..3).map(|i| tab.dd[i] * (rhs[i] + dq[i])).sum();
         let g = tab.gamma0;
         let den = 1.0 + g * h * k0;
-        let e = g * (h * f0 + dz) / den;
-        // Noise level of the estimate, in volts.
+        let mut dz = 0.0;
+        let mut terms = (h * f0).abs();
         // (ΔQ_eq carries the noise of Q_eq itself, not of its small increment.)
         let qeq_mag = self.qeq_noise_scale(n0, &dq);
-        let terms = (h * f0).abs()
-            + (0..3)
-                .map(|i| tab.dd[i].abs() * (rhs[i].abs() + qeq_mag))
-                .sum::<f64>();
-        let noise = NOISE * g * terms / den * nodes[2].elastance;
-        let v0 = -u0 * n0.elastance;
-        let scale = self.options.rtol * v0.abs().max(trial.voltage[2].abs()) + self.atol() + noise;
-        let err_v = (e * nodes[2].elastance).abs() / scale;
+        for i in 0..S {
+            dz += tab.dd[i] * (z[i] + dq[i]);
+            terms += tab.dd[i].abs() * (z[i].abs() + qeq_mag);
+        }
+        let g_den = g / den;
+        let e = g_den * (h * f0 + dz);
+        // Noise level of the estimate, in volts.
+        let el1 = nodes[S - 1].elastance;
+        let noise = NOISE * g_den * terms * el1;
+        let scale = self.options.rtol * v0.abs().max(v1.abs()) + self.atol() + noise;
+        let err_v = (e * el1).abs() / scale;
         // Energy: p = G V²; a voltage noise δV makes a power noise 2G|V|δV.
         let p0 = conductance * v0 * v0;
-        let v_max = trial.voltage.iter().fold(v0.abs(), |m, v| m.max(v.abs()));
         let p_noise = conductance * noise * (2.0 * v_max + noise);
         // ∂p/∂u = 2 G u / C², and the noise of e (in charge) through it.
         let dp_du = -2.0 * conductance * v0 * n0.elastance;
-        let coupling = (dp_du * e, (dp_du * noise / nodes[2].elastance).abs());
-        trial.err = err_v.max(self.energy_error(h, p0, &power, &mut trial.ze, p_noise, coupling));
-        trial
+        let coupling = (dp_du * e, (dp_du * noise / el1).abs());
+        let err_e = self.energy_error(tab, h, p0, trial, p_noise, coupling);
+        trial.err = err_v.max(err_e);
     }
 
     /// Rectifier: Radau IIA on `Q' = I(V, V_s)`, `C_s V_s' = I_out − V_s/R_L`, with the stages
     /// of Q written as `u = Q − Q_eq` (exact `ΔQ_eq` as for the resistor); Newton's method on
-    /// the 6 × 6 stage system with the exact Jacobian at every stage. `None` if Newton fails.
-    #[allow(clippy::too_many_arguments)]
+    /// the 2S × 2S stage system with the exact Jacobian at every stage. False if Newton fails.
     fn trial_rectifier(
         &mut self,
-        diode: Diode,
-        inv_cs: f64,
-        gl: f64,
+        tab: &Tableau<RECTIFIER_STAGES>,
+        load: &RectifierLoad,
         h: f64,
         n0: &TransducerState,
-        nodes: &[TransducerState; 3],
-    ) -> Option<Trial> {
-        let tab = self.tab;
+        nodes: &[TransducerState; RECTIFIER_STAGES],
+        trial: &mut Trial<RECTIFIER_STAGES>,
+    ) -> bool {
+        const S: usize = RECTIFIER_STAGES;
+        let RectifierLoad {
+            diode,
+            inv_cs,
+            load_conductance: gl,
+        } = *load;
         let y0 = self.y;
         let atol = self.atol();
         let rtol = self.options.rtol;
         // Predictor: extrapolate the previous collocation polynomial.
-        let mut z = [[0.0; 2]; 3];
-        if let Some(last) = &self.last_step {
+        let mut z = [[0.0; S]; 2];
+        if let Some(last) = self
+            .last_step
+            .as_ref()
+            .filter(|l| self.smooth_since_last_step && l.stages == S)
+        {
             let ratio = h / last.h;
-            if ratio <= 2.0 && (last.t0 + last.h - self.t).abs() <= 1e-12 * self.period {
-                for (i, zi) in z.iter_mut().enumerate() {
+            if ratio <= 8.0 && (last.t0 + last.h - self.t).abs() <= 1e-12 * self.period {
+                for i in 0..S {
                     let w = tab.dense_weights(1.0 + tab.c[i] * ratio);
-                    *zi = std::array::from_fn(|comp| {
-                        w[0] * last.z[0][comp] + w[1] * last.z[1][comp] + (w[2] - 1.0) * last.z[2][comp]
-                    });
+                    for (zc, lc) in z.iter_mut().zip(&last.z) {
+                        zc[i] = (0..S).map(|m| w[m] * lc[m]).sum::<f64>() - lc[S - 1];
+                    }
                 }
             }
         }
@@ -984,20 +1280,20 @@ impl ChargeSolver {
         let mut prev_norm = f64::INFINITY;
         for iter in 0..MAX_NEWTON {
             self.stats.newton_iterations += 1;
-            let mut fs = [[0.0; 2]; 3];
-            let mut js = [[[0.0; 2]; 2]; 3];
-            for j in 0..3 {
-                let yj = [y0[0] + z[j][0], y0[1] + z[j][1]];
+            let mut fs = [[0.0; 2]; S];
+            let mut js = [[[0.0; 2]; 2]; S];
+            for j in 0..S {
+                let yj = [y0[0] + z[0][j], y0[1] + z[1][j]];
                 let (r, jac, _, _) = f(yj, &nodes[j]);
                 fs[j] = r;
                 js[j] = jac;
             }
-            let mut m = [[0.0; 6]; 6];
-            let mut rhs = [0.0; 6];
-            for i in 0..3 {
+            let mut m = [[0.0; 2 * RECTIFIER_STAGES]; 2 * RECTIFIER_STAGES];
+            let mut rhs = [0.0; 2 * RECTIFIER_STAGES];
+            for i in 0..S {
                 for c in 0..2 {
-                    let mut acc = z[i][c] + if c == 0 { dq[i] } else { 0.0 };
-                    for j in 0..3 {
+                    let mut acc = z[c][i] + if c == 0 { dq[i] } else { 0.0 };
+                    for j in 0..S {
                         let ha = h * tab.a[i][j];
                         acc -= ha * fs[j][c];
                         for d in 0..2 {
@@ -1008,72 +1304,121 @@ impl ChargeSolver {
                     rhs[2 * i + c] = -acc;
                 }
             }
-            if !solve_dense(&mut m, &mut rhs, 6) {
-                return None;
+            if !solve_fixed(&mut m, &mut rhs) {
+                trial.retry = 0.25;
+                return false;
             }
             let mut norm: f64 = 0.0;
-            for i in 0..3 {
-                z[i][0] += rhs[2 * i];
-                z[i][1] += rhs[2 * i + 1];
+            for i in 0..S {
+                z[0][i] += rhs[2 * i];
+                z[1][i] += rhs[2 * i + 1];
                 norm = norm
                     .max((rhs[2 * i] * nodes[i].elastance).abs() / sc_v)
                     .max(rhs[2 * i + 1].abs() / sc_s);
             }
-            if !norm.is_finite() || (iter >= 2 && norm > prev_norm) {
-                return None;
+            if !norm.is_finite() {
+                trial.retry = 0.25;
+                return false;
             }
-            prev_norm = norm;
-            if norm <= 1e-3 {
+            // Convergence rate θ (RADAU5): stop when the remaining error θ/(1−θ)·‖ΔZ‖ is small,
+            // give up early when the iterations left cannot get there.
+            if norm <= NEWTON_TOL {
                 converged = true;
                 break;
             }
+            if iter > 0 {
+                let theta = norm / prev_norm;
+                if iter >= 2 && theta >= 0.99 {
+                    trial.retry = 0.5;
+                    return false;
+                }
+                if theta < 0.99 {
+                    let left = (MAX_NEWTON - 1 - iter) as i32;
+                    let predicted = norm * theta.powi(left) / (1.0 - theta) / NEWTON_TOL;
+                    if iter >= 2 && predicted >= 1.0 {
+                        let q = predicted.clamp(1e-4, 20.0);
+                        trial.retry = 0.8 * q.powf(-1.0 / (4.0 + left as f64));
+                        return false;
+                    }
+                }
+            }
+            prev_norm = norm;
         }
         if !converged {
-            return None;
+            trial.retry = 0.5;
+            return false;
         }
-        let mut trial = Trial {
-            z,
-            qeq0: n0.equilibrium_charge,
-            dq,
-            ..Trial::default()
+        // A bridge that switches within the step: its current changes by orders of magnitude
+        // between the stage points, which the collocation polynomial and the error estimate
+        // cannot follow. Retry so that each junction's voltage moves by at most SWITCH_SWEEP
+        // n·V_T (its current by e⁴) above SWITCH_FLOOR.
+        let sweep = {
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for j in 0..=S {
+                let (u, vs, el) = if j == 0 {
+                    (y0[0], y0[1], n0.elastance)
+                } else {
+                    (y0[0] + z[0][j - 1], y0[1] + z[1][j - 1], nodes[j - 1].elastance)
+                };
+                let v = -u * el;
+                for (k, x) in diode.junction_exponents(v, vs).into_iter().enumerate() {
+                    lo[k] = lo[k].min(x);
+                    hi[k] = hi[k].max(x);
+                }
+            }
+            (0..2)
+                .filter(|&k| hi[k] > SWITCH_FLOOR)
+                .map(|k| hi[k] - lo[k].max(SWITCH_FLOOR))
+                .fold(0.0, f64::max)
         };
-        let mut power = [0.0; 3];
-        for j in 0..3 {
-            let yj = [y0[0] + z[j][0], y0[1] + z[j][1]];
-            let (_, _, v, b) = f(yj, &nodes[j]);
-            trial.voltage[j] = v;
-            trial.current[j] = b.current;
-            power[j] = yj[1] * b.output;
+        if sweep > SWITCH_SWEEP {
+            trial.retry = (0.9 * SWITCH_SWEEP / sweep).clamp(0.1, 0.9);
+            return false;
         }
+        trial.z = z;
+        trial.qeq0 = n0.equilibrium_charge;
+        trial.dq = dq;
+        let (mut peak_v, mut peak_i, mut scale_v) = (0.0f64, 0.0f64, y0[1].abs());
+        let mut v1 = 0.0;
+        for j in 0..S {
+            let yj = [y0[0] + z[0][j], y0[1] + z[1][j]];
+            let (_, _, v, b) = f(yj, &nodes[j]);
+            peak_v = peak_v.max(v.abs());
+            peak_i = peak_i.max(b.current.abs());
+            scale_v = scale_v.max(yj[1].abs());
+            trial.power[j] = yj[1] * b.output;
+            v1 = v;
+        }
+        trial.peak_voltage = peak_v;
+        trial.peak_current = peak_i;
+        trial.scale_voltage = scale_v;
         // Error estimate: (I − γ₀hJ₀) e = γ₀ (h f₀ + Σ dᵢ ΔYᵢ), ΔYᵢ = (Zᵢ + ΔQ_eq,ᵢ, Z_s,ᵢ).
         let (f0, j0, _, _) = f(y0, n0);
         trial.stiff = h * j0[0][0].abs() >= 1.0;
         trial.hk = h * j0[0][0].abs();
         let g = tab.gamma0;
-        let dy = |i: usize, c: usize| z[i][c] + if c == 0 { dq[i] } else { 0.0 };
-        let dz = [0, 1].map(|c| (0..3).map(|i| tab.dd[i] * dy(i, c)).sum::<f64>());
+        let dy = |i: usize, c: usize| z[c][i] + if c == 0 { dq[i] } else { 0.0 };
+        let dz = [0, 1].map(|c| (0..S).map(|i| tab.dd[i] * dy(i, c)).sum::<f64>());
         let qeq_mag = self.qeq_noise_scale(n0, &dq);
         let noise = [0, 1].map(|c| {
             let q = if c == 0 { qeq_mag } else { 0.0 };
             NOISE
                 * g
-                * ((h * f0[c]).abs() + (0..3).map(|i| tab.dd[i].abs() * (z[i][c].abs() + q)).sum::<f64>())
+                * ((h * f0[c]).abs() + (0..S).map(|i| tab.dd[i].abs() * (z[c][i].abs() + q)).sum::<f64>())
         });
         let lhs = [
             [1.0 - g * h * j0[0][0], -g * h * j0[0][1]],
             [-g * h * j0[1][0], 1.0 - g * h * j0[1][1]],
         ];
-        let solve2 = |b: [f64; 2]| {
-            let mut m = lhs;
-            let mut b = b;
-            solve_dense(&mut m, &mut b, 2).then_some(b)
-        };
-        let y1 = [y0[0] + z[2][0], y0[1] + z[2][1]];
-        let el1 = nodes[2].elastance;
-        let sc_v = rtol * v0.abs().max(trial.voltage[2].abs()) + atol + noise[0] * el1;
+        let mut e = [g * (h * f0[0] + dz[0]), g * (h * f0[1] + dz[1])];
+        if !solve_fixed(&mut { lhs }, &mut e) {
+            return false;
+        }
+        let y1 = [y0[0] + z[0][S - 1], y0[1] + z[1][S - 1]];
+        let el1 = nodes[S - 1].elastance;
+        let sc_v = rtol * v0.abs().max(v1.abs()) + atol + noise[0] * el1;
         let sc_s = rtol * y0[1].abs().max(y1[1].abs()) + atol + noise[1];
-        let norm = |e: [f64; 2]| ((e[0] * el1).abs() / sc_v).max(e[1].abs() / sc_s);
-        let e = solve2([g * (h * f0[0] + dz[0]), g * (h * f0[1] + dz[1])])?;
+        let err_y = ((e[0] * el1).abs() / sc_v).max(e[1].abs() / sc_s);
         // Energy: p = V_s I_out; noise from the voltage and storage-voltage noise.
         let b0 = diode.bridge(v0, y0[1]);
         let p0 = y0[1] * b0.output;
@@ -1085,101 +1430,92 @@ impl ChargeSolver {
             dp_du * e[0] + dp_dvs * e[1],
             (dp_du * noise[0]).abs() + (dp_dvs * noise[1]).abs(),
         );
-        trial.err = norm(e).max(self.energy_error(h, p0, &power, &mut trial.ze, p_noise, coupling));
-        Some(trial)
+        let err_e = self.energy_error(tab, h, p0, trial, p_noise, coupling);
+        trial.err = err_y.max(err_e);
+        true
     }
 
     /// The magnitude whose `NOISE` fraction bounds the noise of `Q_eq` over a step, C.
-    fn qeq_noise_scale(&self, n0: &TransducerState, dq: &[f64; 3]) -> f64 {
-        n0.equilibrium_charge.abs() + dq[2].abs() + NOISE_CHARGE / NOISE * self.transducer.charge_scale()
+    fn qeq_noise_scale<const S: usize>(&self, n0: &TransducerState, dq: &[f64; S]) -> f64 {
+        n0.equilibrium_charge.abs() + dq[S - 1].abs() + self.charge_noise
     }
 
-    /// Fills the energy stage increments `ze` from the stage powers (W) and returns the scaled
-    /// error estimate of the energy increment.
+    /// Sets the energy of a trial step from its stage powers (W) and returns the scaled error
+    /// estimate of that energy.
     ///
     /// The estimate is Hairer's for the quadrature component of the augmented system,
-    /// `γ₀(h p₀ + Σ dᵢ ZEᵢ) + γ₀h (∂p/∂y)·e_y` with `coupling = ((∂p/∂y)·e_y, its noise)`. The
-    /// coupling term matters: after a step whose accepted error left the state slightly off
-    /// the slow manifold of a stiff load, the quadrature part alone reads the decayed layer as
-    /// an O(h) error, and the coupling term cancels it. The estimate is tested against an
-    /// error per unit step `rtol·h·P_ref`, P_ref the larger of the average power since the
-    /// start and over the last complete period (so the allowed error summed over a period is
-    /// `rtol × its energy`), plus the estimate's noise from a stage-power noise `p_noise`, W.
-    /// Inactive during the first 1e-3 of a period after the start, where no power scale
-    /// exists yet.
-    fn energy_error(
+    /// `γ₀(h p₀ + Σ dᵢ ZEᵢ) + γ₀h (∂p/∂y)·e_y` with `ZE = hA·p` and
+    /// `coupling = ((∂p/∂y)·e_y, its noise)`. The coupling term matters: after a step whose
+    /// accepted error left the state slightly off the slow manifold of a stiff load, the
+    /// quadrature part alone reads the decayed layer as an O(h) error, and the coupling term
+    /// cancels it. The estimate is tested against `rtol·max(h, T/ENERGY_FLOOR_STEPS)·P_ref`,
+    /// P_ref the larger of the average power since the start and over the last complete
+    /// period, plus the estimate's noise from a stage-power noise `p_noise`, W: an error per
+    /// unit step, so that the allowed error summed over a period is `rtol × its energy`, except
+    /// that steps shorter than `T/ENERGY_FLOOR_STEPS` (boundary layers) may each use
+    /// `rtol × E/ENERGY_FLOOR_STEPS`. Inactive during the first 1e-3 of a period after the
+    /// start, where no power scale exists yet.
+    fn energy_error<const S: usize>(
         &self,
+        tab: &Tableau<S>,
         h: f64,
         p0: f64,
-        power: &[f64; 3],
-        ze: &mut [f64; 3],
+        trial: &mut Trial<S>,
         p_noise: f64,
         coupling: (f64, f64),
     ) -> f64 {
-        let tab = &self.tab;
-        for (i, zi) in ze.iter_mut().enumerate() {
-            *zi = h * (0..3).map(|j| tab.a[i][j] * power[j]).sum::<f64>();
-        }
-        let elapsed = self.t - self.t_start;
-        if elapsed < 1e-3 * self.period {
+        let power = &trial.power;
+        trial.energy = h * (0..S).map(|j| tab.a[S - 1][j] * power[j]).sum::<f64>();
+        let Some(p_ref) = self.power_ref() else {
             return 0.0;
-        }
-        let mut p_ref = self.energy / elapsed;
-        if let Some(last) = self.periods.iter().rev().find(|p| p.is_complete(self.period)) {
-            p_ref = p_ref.max(last.energy_j / self.period);
-        }
-        if p_ref.is_nan() || p_ref <= 0.0 {
-            return 0.0;
-        }
-        let dz: f64 = (0..3).map(|i| tab.dd[i] * ze[i]).sum();
+        };
+        let dz: f64 = h * (0..S).map(|j| tab.dd_a[j] * power[j]).sum::<f64>();
         let g = tab.gamma0;
         let e = g * (h * p0 + dz) + g * h * coupling.0;
-        let dd_sum: f64 = tab.dd.iter().map(|d| d.abs()).sum();
-        let terms = (h * p0).abs() + (0..3).map(|i| (tab.dd[i] * ze[i]).abs()).sum::<f64>();
-        let noise = g * (NOISE * terms + (1.0 + dd_sum) * h * p_noise + h * coupling.1);
-        e.abs() / (self.options.rtol * h * p_ref + noise)
+        let terms = (h * p0).abs() + h * (0..S).map(|j| tab.dd_a_abs[j] * power[j].abs()).sum::<f64>();
+        let noise = g * (NOISE * terms + (1.0 + tab.dd_abs_sum) * h * p_noise + h * coupling.1);
+        let floor = self.period / ENERGY_FLOOR_STEPS;
+        e.abs() / (self.options.rtol * h.max(floor) * p_ref + noise)
     }
 
-    /// Commits an accepted step and returns its polynomial.
-    fn accept(&mut self, t0: f64, t1: f64, trial: &Trial, n1: TransducerState) -> Step {
-        let h = t1 - t0;
-        let ze = trial.ze;
-        let step = Step {
+    /// The power scale of the energy test, W: the larger of the average power since the start
+    /// and over the last complete period; `None` during the first 1e-3 of a period, before
+    /// there is one.
+    fn power_ref(&self) -> Option<f64> {
+        let elapsed = self.t - self.t_start;
+        if elapsed < 1e-3 * self.period {
+            return None;
+        }
+        let p_ref = (self.energy / elapsed).max(self.last_period_power);
+        (p_ref > 0.0).then_some(p_ref)
+    }
+
+    /// Commits an accepted step (its polynomial becomes `last_step`).
+    fn accept<const S: usize>(&mut self, t0: f64, t1: f64, trial: &Trial<S>, n1: TransducerState) {
+        let pad =
+            |a: &[f64; S]| -> [f64; MAX_STAGES] { std::array::from_fn(|i| if i < S { a[i] } else { 0.0 }) };
+        self.last_step = Some(Step {
+            stages: S,
             t0,
-            h,
+            h: t1 - t0,
             y0: self.y,
-            z: trial.z,
+            z: [pad(&trial.z[0]), pad(&trial.z[1])],
             e0: self.energy,
-            ze,
+            power: pad(&trial.power),
             qeq0: trial.qeq0,
-            dq: trial.dq,
+            dq: pad(&trial.dq),
             stiff: trial.stiff,
-        };
+        });
         self.stats.steps += 1;
         self.t = t1;
         self.ts_now = n1;
-        self.y = [self.y[0] + trial.z[2][0], self.y[1] + trial.z[2][1]];
-        self.energy += ze[2];
+        self.y = [self.y[0] + trial.z[0][S - 1], self.y[1] + trial.z[1][S - 1]];
+        self.energy += trial.energy;
         if let Some(p) = self.periods.last_mut() {
-            p.energy_j += ze[2];
+            p.energy_j += trial.energy;
         }
-        for j in 0..3 {
-            self.note_peaks(trial.current[j], trial.voltage[j]);
-        }
-        match self.load {
-            LoadModel::Rectifier { .. } => {
-                for zj in &trial.z {
-                    self.v_scale = self.v_scale.max((step.y0[1] + zj[1]).abs());
-                }
-            }
-            _ => {
-                for v in &trial.voltage {
-                    self.v_scale = self.v_scale.max(v.abs());
-                }
-            }
-        }
-        self.last_step = Some(step);
-        step
+        self.note_peaks(trial.peak_current, trial.peak_voltage);
+        self.v_scale = self.v_scale.max(trial.scale_voltage);
     }
 
     /// State and energy at `t` inside an accepted step, from its collocation polynomial.
@@ -1188,23 +1524,21 @@ impl ChargeSolver {
     /// quasi-static `u` is smooth where `Q` nearly equals `Q_eq`); a non-stiff one evaluates the
     /// collocation polynomial of `Q` and subtracts the exact `Q_eq(t)`.
     fn dense(&self, step: &Step, t: f64, qeq: f64) -> ([f64; 2], f64) {
-        let w = self.tab.dense_weights((t - step.t0) / step.h);
-        let mut y = step.y0;
-        let mut e = step.e0;
-        for ((wi, zi), zei) in w.iter().zip(&step.z).zip(&step.ze) {
-            y[0] += wi * zi[0];
-            y[1] += wi * zi[1];
-            e += wi * zei;
+        if step.stages == RESISTOR_STAGES {
+            dense_with(&self.tab_resistor, step, t, qeq)
+        } else {
+            dense_with(&self.tab_rectifier, step, t, qeq)
         }
-        if !step.stiff {
-            let interp: f64 = w.iter().zip(&step.dq).map(|(wi, dqi)| wi * dqi).sum();
-            y[0] += interp - (qeq - step.qeq0);
-        }
-        (y, e)
     }
 
-    /// Outputs of an accepted step: samples, V–Q points, target crossing.
-    fn record<W: GapWaveform + ?Sized>(&mut self, step: Step, wave: &W) -> Result<(), ElectricalError> {
+    /// Outputs of the last accepted step: samples, V–Q points, target crossing.
+    fn record<W: GapWaveform + ?Sized>(&mut self, wave: &W) -> Result<(), ElectricalError> {
+        if self.sampler.is_none() && self.vq.is_none() && self.target_voltage.is_none() {
+            return Ok(());
+        }
+        let Some(step) = self.last_step else {
+            return Ok(());
+        };
         let t1 = step.t0 + step.h;
         self.sample_between(step.t0, t1, wave, Some(&step))?;
         if let (Some(target), None, LoadModel::Rectifier { .. }) =
@@ -1240,6 +1574,9 @@ impl ChargeSolver {
         wave: &W,
         step: Option<&Step>,
     ) -> Result<(), ElectricalError> {
+        if self.sampler.is_none() && self.vq.is_none() {
+            return Ok(());
+        }
         let rectifier = matches!(self.load, LoadModel::Rectifier { .. });
         for which in 0..2 {
             let mut grid = match which {
@@ -1278,11 +1615,30 @@ impl ChargeSolver {
     }
 }
 
+/// [`ChargeSolver::dense`] with the tableau of the step's method.
+fn dense_with<const S: usize>(tab: &Tableau<S>, step: &Step, t: f64, qeq: f64) -> ([f64; 2], f64) {
+    debug_assert_eq!(step.stages, S);
+    let w = tab.dense_weights((t - step.t0) / step.h);
+    let mut y = step.y0;
+    let mut e = step.e0;
+    for (i, wi) in w.iter().enumerate() {
+        y[0] += wi * step.z[0][i];
+        y[1] += wi * step.z[1][i];
+        // The energy's stage increment ZEᵢ = h Σⱼ aᵢⱼ pⱼ.
+        e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
+    }
+    if !step.stiff {
+        let interp: f64 = w.iter().zip(&step.dq).map(|(wi, dqi)| wi * dqi).sum();
+        y[0] += interp - (qeq - step.qeq0);
+    }
+    (y, e)
+}
+
 impl Observer for ChargeSolver {
     fn flow(&mut self, flow: &Flow<'_>) {
         if self.error.is_none()
             && flow.t_end > flow.t_start
-            && let Err(e) = self.advance(flow.t_start, flow.t_end, flow)
+            && let Err(e) = self.advance_flow(flow)
         {
             self.error = Some(e);
         }

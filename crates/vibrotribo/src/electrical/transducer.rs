@@ -186,3 +186,82 @@ impl Transducer {
         (sigma * d0 / EPSILON_0).abs()
     }
 }
+
+/// Both transducers in the form the solver evaluates at every stage point: with
+/// `s = d₀ + Σ σₖ Dₖ` and `L = Σ λₖ Dₖ` over (at most) two contacts, the elastance is `s/(ε₀S)`,
+/// `V_oc = σL/ε₀` and `Q_eq = σS·L/s` (one division).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ChargeMap {
+    contacts: [usize; 2],
+    /// Weights of the gaps in `s` and in `L`.
+    s_weights: [f64; 2],
+    l_weights: [f64; 2],
+    d0: f64,
+    inv_eps_area: f64,
+    /// σ/ε₀, V/m.
+    sigma_over_eps: f64,
+    /// σS, C.
+    sigma_area: f64,
+}
+
+impl ChargeMap {
+    pub(crate) fn new(t: &Transducer) -> Self {
+        match t {
+            Transducer::Freestanding(f) => {
+                let l_weights = match f.voc_model {
+                    VocModel::Paper => [0.0, 2.0],
+                    VocModel::Exact => [-1.0, 1.0],
+                };
+                ChargeMap {
+                    contacts: f.contacts,
+                    s_weights: [1.0, 1.0],
+                    l_weights,
+                    d0: f.d0,
+                    inv_eps_area: 1.0 / f.eps_area,
+                    sigma_over_eps: f.charge_density / EPSILON_0,
+                    sigma_area: f.eps_area * f.charge_density / EPSILON_0,
+                }
+            }
+            Transducer::ContactSeparation(c) => ChargeMap {
+                contacts: [c.contact, c.contact],
+                s_weights: [1.0, 0.0],
+                l_weights: [1.0, 0.0],
+                d0: c.d0,
+                inv_eps_area: 1.0 / c.eps_area,
+                sigma_over_eps: c.charge_density / EPSILON_0,
+                sigma_area: c.eps_area * c.charge_density / EPSILON_0,
+            },
+        }
+    }
+
+    /// Elastance, open-circuit voltage and equilibrium charge at the chain's gaps (m); the
+    /// equilibrium current is not computed (left 0).
+    #[inline]
+    pub(crate) fn state(&self, gaps: &[f64]) -> TransducerState {
+        let [a, b] = self.contacts;
+        let (da, db) = (gaps[a], gaps[b]);
+        let s = self.d0 + (self.s_weights[0] * da + self.s_weights[1] * db);
+        let l = self.l_weights[0] * da + self.l_weights[1] * db;
+        TransducerState {
+            elastance: s * self.inv_eps_area,
+            voc: self.sigma_over_eps * l,
+            equilibrium_charge: self.sigma_area * l / s,
+            equilibrium_current: 0.0,
+        }
+    }
+
+    /// The full state at the chain's gaps (m) and their rates (m/s), with the same rounding as
+    /// [`state`](Self::state).
+    #[inline]
+    pub(crate) fn state_with_rates(&self, gaps: &[f64], rates: &[f64]) -> TransducerState {
+        let [a, b] = self.contacts;
+        let s = self.d0 + (self.s_weights[0] * gaps[a] + self.s_weights[1] * gaps[b]);
+        let l = self.l_weights[0] * gaps[a] + self.l_weights[1] * gaps[b];
+        let ds = self.s_weights[0] * rates[a] + self.s_weights[1] * rates[b];
+        let dl = self.l_weights[0] * rates[a] + self.l_weights[1] * rates[b];
+        TransducerState {
+            equilibrium_current: self.sigma_area * (dl * s - l * ds) / (s * s),
+            ..self.state(gaps)
+        }
+    }
+}

@@ -1,7 +1,8 @@
-//! Gap waveforms that drive the charge solver: the simulator's exact [`Flow`], any closure,
-//! and piecewise-linear tables (the form ngspice reads).
+//! Gap waveforms that drive the charge solver: the simulator's exact [`Flow`] (which the
+//! solver, as an observer or replaying a trajectory, expands into piecewise Taylor polynomials
+//! first), any closure, and piecewise-linear tables (the form ngspice reads).
 
-use crate::dynamics::{Flow, Trajectory};
+use crate::dynamics::{Flow, GapPolynomial, Trajectory};
 use crate::error::ParamError;
 
 /// Gaps as a smooth function of time on the interval the solver is advanced over.
@@ -13,6 +14,48 @@ use crate::error::ParamError;
 pub trait GapWaveform {
     /// Writes every gap d_k, m, and its rate d_k', m/s, at time `t`, s (slices of length N − 1).
     fn gaps(&self, t: f64, gaps: &mut [f64], rates: &mut [f64]);
+
+    /// Writes every gap d_k, m, at time `t`, s, where the rates are not needed (the solver's
+    /// stage points). The default calls [`gaps`](Self::gaps) and drops the rates.
+    fn gap_values(&self, t: f64, gaps: &mut [f64]) {
+        let n = gaps.len();
+        if n <= 64 {
+            let mut rates = [0.0; 64];
+            self.gaps(t, gaps, &mut rates[..n]);
+        } else {
+            let mut rates = vec![0.0; n];
+            self.gaps(t, gaps, &mut rates);
+        }
+    }
+
+    /// Writes the gaps, m, at each of `times`, s: `gaps[i·n + k]` is gap k at `times[i]`, n the
+    /// number of gaps (`gaps.len() = times.len()·n`). The solver asks for all stage points of a
+    /// step at once. The default calls [`gap_values`](Self::gap_values) for each time.
+    fn gap_values_at(&self, times: &[f64], gaps: &mut [f64]) {
+        let n = gaps.len() / times.len().max(1);
+        for (t, g) in times.iter().zip(gaps.chunks_exact_mut(n.max(1))) {
+            self.gap_values(*t, g);
+        }
+    }
+}
+
+/// The simulator's flow as piecewise Taylor polynomials, accurate to the rounding of the closed
+/// form and much cheaper to evaluate (see `dynamics::taylor`).
+impl GapWaveform for GapPolynomial {
+    #[inline]
+    fn gaps(&self, t: f64, gaps: &mut [f64], rates: &mut [f64]) {
+        self.values_and_rates(t, gaps, rates)
+    }
+
+    #[inline]
+    fn gap_values(&self, t: f64, gaps: &mut [f64]) {
+        self.values(t, gaps)
+    }
+
+    #[inline]
+    fn gap_values_at(&self, times: &[f64], gaps: &mut [f64]) {
+        self.values_many(times, gaps)
+    }
 }
 
 impl GapWaveform for Flow<'_> {
