@@ -218,7 +218,9 @@ fn electrical_outputs_match_the_reference_power() {
     for key in ["energy_per_period_j", "peak_current_a", "peak_voltage_v"] {
         assert!(summary[key].as_f64().unwrap() > 0.0, "{key}");
     }
-    let ratio = summary["air_breakdown"]["worst_ratio"].as_f64().expect("air breakdown check");
+    let ratio = summary["air_breakdown"]["worst_ratio"]
+        .as_f64()
+        .expect("air breakdown check");
     assert!(ratio > 0.0 && ratio.is_finite());
 }
 
