@@ -407,11 +407,11 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
     create_dir(&args.out)?;
     let budget = if args.quick {
         Budget {
-            transient: 200,
-            recorded: 64,
-            coarse: 121,
-            fine: 81,
-            series: 60,
+            transient: 300,
+            recorded: 128,
+            coarse: 201,
+            fine: 101,
+            series: 100,
         }
     } else {
         Budget {
@@ -1359,6 +1359,29 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     Ok(())
 }
 
+/// Runs of period p, 2p, 4p (consecutive runs of equal detected period) along a sweep, in
+/// either direction of the parameter, described as "p → 2p → 4p at R_m = a–b".
+fn doubling_runs(values: &[f64], results: &[PointResult]) -> Vec<String> {
+    let mut runs: Vec<(usize, f64, f64)> = Vec::new();
+    for (v, r) in values.iter().zip(results) {
+        let p = r.period();
+        match runs.last_mut() {
+            Some(last) if last.0 == p => last.2 = *v,
+            _ => runs.push((p, *v, *v)),
+        }
+    }
+    let mut out = Vec::new();
+    for w in runs.windows(3) {
+        let (a, b, c) = (w[0].0, w[1].0, w[2].0);
+        let up = a > 0 && b == 2 * a && c == 2 * b;
+        let down = c > 0 && b == 2 * c && a == 2 * b;
+        if up || down {
+            out.push(format!("{a} → {b} → {c} at R_m = {:.3}–{:.3}", w[0].1, w[2].2));
+        }
+    }
+    out
+}
+
 fn describe_ranges(values: &[f64], step: f64) -> String {
     if values.is_empty() {
         return "none".into();
@@ -1509,12 +1532,13 @@ fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         .map(PointResult::period)
         .chain(fres.iter().map(PointResult::period))
         .collect();
-    let mut distinct: Vec<usize> = periods.clone();
-    distinct.sort_unstable();
-    distinct.dedup();
-    let doubling = [1usize, 2, 4].iter().all(|p| distinct.contains(p))
-        || [2usize, 4, 8].iter().all(|p| distinct.contains(p));
     let non_periodic = periods.contains(&0);
+    // A cascade: consecutive runs of period p, 2p, 4p along the parameter (either way).
+    let cascades: Vec<String> = [(&values, &res), (&fine, &fres)]
+        .iter()
+        .flat_map(|(v, r)| doubling_runs(v, r))
+        .collect();
+    let doubling = !cascades.is_empty();
     // Fig. 19: Poincaré sections at R_m = 4.21.
     let long = PointRunner::new(
         base.clone(),
@@ -1557,8 +1581,12 @@ fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         "18–19",
         "At Ω = 0.30 a period-doubling cascade with non-periodic windows as R_m varies; non-periodic at R_m = 4.21.",
         format!(
-            "Detected periods across the two sweeps: {:?} (0 = non-periodic); R_m = 4.21: {}.",
-            distinct,
+            "Period-doubling sequences (runs of period p → 2p → 4p along R_m): {}; non-periodic values: {}; R_m = 4.21: {}.",
+            if cascades.is_empty() { "none".to_string() } else { cascades.join("; ") },
+            describe_ranges(
+                &values.iter().zip(&res).filter(|(_, r)| r.period() == 0).map(|(v, _)| *v).collect::<Vec<_>>(),
+                values[1] - values[0]
+            ),
             if period_421 == 0 { "non-periodic".to_string() } else { format!("period {period_421}") }
         ),
         if doubling && non_periodic && period_421 == 0 {
