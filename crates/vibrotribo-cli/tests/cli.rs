@@ -96,17 +96,27 @@ fn output_files_follow_the_contract() {
     assert_eq!(summary["impacts_per_period"], 6.0);
 }
 
+fn config_file(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../configs")
+        .join(name)
+}
+
 #[test]
 fn chatter_case_from_a_config_file() {
     let dir = tempdir();
-    let cfg = dir.path().join("chatter.toml");
-    std::fs::write(
-        &cfg,
-        "[oscillator]\nmasses = [0.05, 0.15, 0.05]\ngaps = [0.005, 0.005]\n\n[excitation]\nomega_ratio = 0.60\n\n[run]\nperiods = 20\ntransient_periods = 10\n",
-    )
-    .unwrap();
+    let cfg = config_file("chatter.toml");
     let out = dir.path().join("out");
-    let o = vibrotribo(&["simulate", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = vibrotribo(&[
+        "simulate",
+        cfg.to_str().unwrap(),
+        "--set",
+        "run.periods=20",
+        "--set",
+        "run.transient_periods=10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
@@ -114,6 +124,35 @@ fn chatter_case_from_a_config_file() {
     assert!(summary["sticks"].as_u64().unwrap() > 0);
     let (_, rows) = read_csv(&out.join("events.csv"));
     assert!(rows.iter().any(|r| r[1] == "chatter"));
+}
+
+/// `configs/default.toml` spells out every key with the README's values; it must describe
+/// exactly the run vibrotribo makes with no configuration file.
+#[test]
+fn documented_default_config_is_the_default() {
+    let dir = tempdir();
+    let run = |cfg: Option<&Path>, out: &Path| {
+        let mut args = vec!["simulate".to_string()];
+        args.extend(cfg.map(|c| c.to_str().unwrap().to_string()));
+        args.extend(["--out".to_string(), out.to_str().unwrap().to_string()]);
+        args.extend(["--set".to_string(), "run.periods=20".to_string()]);
+        args.extend(["--set".to_string(), "run.transient_periods=10".to_string()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = vibrotribo(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read_to_string(out.join("events.csv")).unwrap()
+    };
+    let from_file = run(Some(&config_file("default.toml")), &dir.path().join("a"));
+    let built_in = run(None, &dir.path().join("b"));
+    assert_eq!(from_file, built_in);
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md")).unwrap();
+    let file = std::fs::read_to_string(config_file("default.toml")).unwrap();
+    let body = file.split_once("[oscillator]").unwrap().1;
+    assert!(
+        readme.contains(body),
+        "README's configuration block and configs/default.toml differ"
+    );
 }
 
 #[test]
