@@ -11,7 +11,7 @@ use serde_json::json;
 use vibrotribo::analysis::{PointResult, QuadraticFit, fit_quadratic};
 
 use crate::config::ConfigArgs;
-use crate::output::{CsvFile, create_dir, csv_text, write_json};
+use crate::output::{CsvFile, create_dir, csv_text, point_cells, point_columns, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::{Progress, interrupted};
 use crate::sweep::{PointRunner, RunArgs, grid, set_threads};
@@ -121,20 +121,8 @@ pub fn run(args: &MapArgs) -> Result<()> {
     let mut csv = match &args.out {
         Some(dir) => {
             create_dir(dir)?;
-            let mut cols: Vec<String> = [
-                "x",
-                "y",
-                "average_power_w",
-                "impacts_per_period",
-                "period",
-                "chatter",
-                "sticking",
-                "grazing",
-            ]
-            .map(String::from)
-            .to_vec();
-            cols.extend(crate::output::numbered("impacts_per_period_", contacts, ""));
-            cols.push("error".into());
+            let mut cols = vec!["x".to_string(), "y".to_string()];
+            cols.extend(point_columns(contacts));
             Some(CsvFile::create(&dir.join("map.csv"), &cols)?)
         }
         None => None,
@@ -149,24 +137,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         |&(x, y), r| {
             let Some(csv) = csv.as_mut() else { return Ok(()) };
             let mut row = vec![x.to_string(), y.to_string()];
-            match r {
-                Ok(p) => {
-                    row.extend([
-                        p.average_power_w.map_or(String::new(), |v| v.to_string()),
-                        p.total_impacts_per_period().to_string(),
-                        p.period().to_string(),
-                        p.chatter.to_string(),
-                        p.sticking.to_string(),
-                        p.grazing.to_string(),
-                    ]);
-                    row.extend(p.impacts_per_period.iter().map(f64::to_string));
-                    row.push(p.electrical_error.as_deref().map_or(String::new(), csv_text));
-                }
-                Err(e) => {
-                    row.extend(std::iter::repeat_n(String::new(), 6 + contacts));
-                    row.push(csv_text(e));
-                }
-            }
+            row.extend(point_cells(r, contacts));
             csv.row(row)
         },
     )?;
@@ -356,7 +327,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                         p.average_power_w.map_or(String::new(), |v| v.to_string()),
                         p.total_impacts_per_period().to_string(),
                         p.period().to_string(),
-                        String::new(),
+                        p.electrical_error.as_deref().map_or(String::new(), csv_text),
                     ],
                     Err(e) => vec![
                         w.to_string(),

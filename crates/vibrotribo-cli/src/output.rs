@@ -5,6 +5,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use vibrotribo::analysis::PointResult;
 
 /// A CSV file written row by row.
 pub struct CsvFile {
@@ -166,6 +167,50 @@ pub fn si(value: f64, unit: &str) -> String {
         3
     };
     format!("{x:.digits$} {prefix}{unit}")
+}
+
+/// The columns describing one sweep or map point, after its key columns: `average_power_w`,
+/// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
+/// `impacts_per_period_1..contacts`, `error`.
+pub fn point_columns(contacts: usize) -> Vec<String> {
+    let mut cols: Vec<String> = [
+        "average_power_w",
+        "impacts_per_period",
+        "period",
+        "chatter",
+        "sticking",
+        "grazing",
+    ]
+    .map(String::from)
+    .to_vec();
+    cols.extend(numbered("impacts_per_period_", contacts, ""));
+    cols.push("error".into());
+    cols
+}
+
+/// The cells of [`point_columns`] for one point: its results, or blanks and the reason it
+/// failed. `error` also holds an electrical failure of a point whose mechanics succeeded.
+pub fn point_cells(result: &Result<PointResult, String>, contacts: usize) -> Vec<String> {
+    match result {
+        Ok(p) => {
+            let mut row = vec![
+                p.average_power_w.map_or(String::new(), |v| v.to_string()),
+                p.total_impacts_per_period().to_string(),
+                p.period().to_string(),
+                p.chatter.to_string(),
+                p.sticking.to_string(),
+                p.grazing.to_string(),
+            ];
+            row.extend(p.impacts_per_period.iter().map(f64::to_string));
+            row.push(p.electrical_error.as_deref().map_or(String::new(), csv_text));
+            row
+        }
+        Err(e) => {
+            let mut row = vec![String::new(); 6 + contacts];
+            row.push(csv_text(e));
+            row
+        }
+    }
 }
 
 #[cfg(test)]

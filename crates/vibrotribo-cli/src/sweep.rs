@@ -12,7 +12,7 @@ use vibrotribo::ChainState;
 use vibrotribo::analysis::{PointOptions, PointResult, run_point};
 
 use crate::config::{ConfigArgs, Loaded};
-use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
+use crate::output::{CsvFile, create_dir, numbered, point_cells, point_columns, write_json};
 use crate::progress::{Progress, interrupted};
 
 /// Direction of parameter continuation.
@@ -267,19 +267,8 @@ impl SweepFiles {
         create_dir(dir)?;
         let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
         orbit_cols.extend(numbered("x", masses, "_m"));
-        let mut summary_cols: Vec<String> = [
-            "param",
-            "average_power_w",
-            "impacts_per_period",
-            "period",
-            "chatter",
-            "sticking",
-            "grazing",
-        ]
-        .map(String::from)
-        .to_vec();
-        summary_cols.extend(numbered("impacts_per_period_", masses - 1, ""));
-        summary_cols.push("error".into());
+        let mut summary_cols = vec!["param".to_string()];
+        summary_cols.extend(point_columns(masses - 1));
         Ok(SweepFiles {
             orbit: CsvFile::create(&dir.join("orbit.csv"), &orbit_cols)?,
             impacts: CsvFile::create(
@@ -293,42 +282,25 @@ impl SweepFiles {
 
     fn write(&mut self, value: f64, result: &Result<PointResult, String>) -> Result<()> {
         let p = value.to_string();
-        match result {
-            Ok(r) => {
-                let n = self.contacts + 1;
-                for (j, &period) in r.strobe_periods.iter().enumerate() {
-                    let mut row = vec![p.clone(), period.to_string()];
-                    row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
-                    self.orbit.row(row)?;
-                }
-                for i in &r.impacts {
-                    self.impacts.row([
-                        p.clone(),
-                        i.time.to_string(),
-                        (i.contact + 1).to_string(),
-                        i.closing_speed.to_string(),
-                    ])?;
-                }
-                let mut row = vec![
-                    p,
-                    r.average_power_w.map_or(String::new(), |x| x.to_string()),
-                    r.total_impacts_per_period().to_string(),
-                    r.period().to_string(),
-                    r.chatter.to_string(),
-                    r.sticking.to_string(),
-                    r.grazing.to_string(),
-                ];
-                row.extend(r.impacts_per_period.iter().map(f64::to_string));
-                row.push(r.electrical_error.as_deref().map_or(String::new(), csv_text));
-                self.summary.row(row)
+        if let Ok(r) = result {
+            let n = self.contacts + 1;
+            for (j, &period) in r.strobe_periods.iter().enumerate() {
+                let mut row = vec![p.clone(), period.to_string()];
+                row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
+                self.orbit.row(row)?;
             }
-            Err(e) => {
-                let mut row = vec![p];
-                row.extend(std::iter::repeat_n(String::new(), 6 + self.contacts));
-                row.push(csv_text(e));
-                self.summary.row(row)
+            for i in &r.impacts {
+                self.impacts.row([
+                    p.clone(),
+                    i.time.to_string(),
+                    (i.contact + 1).to_string(),
+                    i.closing_speed.to_string(),
+                ])?;
             }
         }
+        let mut row = vec![p];
+        row.extend(point_cells(result, self.contacts));
+        self.summary.row(row)
     }
 
     fn flush(&mut self) -> Result<()> {
