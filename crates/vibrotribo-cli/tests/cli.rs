@@ -131,23 +131,29 @@ fn chatter_case_from_a_config_file() {
 #[test]
 fn documented_default_config_is_the_default() {
     let dir = tempdir();
-    let run = |cfg: Option<&Path>, out: &Path| {
-        let mut args = vec!["simulate".to_string()];
-        args.extend(cfg.map(|c| c.to_str().unwrap().to_string()));
-        args.extend(["--out".to_string(), out.to_str().unwrap().to_string()]);
-        args.extend(["--set".to_string(), "run.periods=20".to_string()]);
-        args.extend(["--set".to_string(), "run.transient_periods=10".to_string()]);
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let run = |cfg: Option<&str>, out: &Path| {
+        let mut args = vec!["simulate"];
+        args.extend(cfg);
+        let out_arg = out.to_str().unwrap();
+        args.extend([
+            "--out",
+            out_arg,
+            "--set",
+            "run.periods=20",
+            "--set",
+            "run.transient_periods=10",
+        ]);
         let o = vibrotribo(&args);
         assert!(o.status.success(), "{}", stderr(&o));
         std::fs::read_to_string(out.join("events.csv")).unwrap()
     };
-    let from_file = run(Some(&config_file("default.toml")), &dir.path().join("a"));
+    let config = config_file("default.toml");
+    let from_file = run(Some(config.to_str().unwrap()), &dir.path().join("a"));
     let built_in = run(None, &dir.path().join("b"));
     assert_eq!(from_file, built_in);
     let readme =
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md")).unwrap();
-    let file = std::fs::read_to_string(config_file("default.toml")).unwrap();
+    let file = std::fs::read_to_string(&config).unwrap();
     let body = file.split_once("[oscillator]").unwrap().1;
     assert!(
         readme.contains(body),
