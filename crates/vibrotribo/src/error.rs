@@ -48,6 +48,48 @@ pub enum ParamError {
     Conflict(String),
 }
 
+impl ParamError {
+    /// `name = value` is rejected because it `reason` (e.g. "must be positive").
+    pub(crate) fn invalid(name: impl Into<String>, value: f64, reason: &'static str) -> Self {
+        ParamError::Invalid {
+            name: name.into(),
+            value,
+            reason,
+        }
+    }
+}
+
+/// `Ok` if `ok`, otherwise [`ParamError::Invalid`] for `name = value` with `reason`.
+pub(crate) fn check(
+    name: impl Into<String>,
+    value: f64,
+    ok: bool,
+    reason: &'static str,
+) -> Result<(), ParamError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ParamError::invalid(name, value, reason))
+    }
+}
+
+/// Checks that `value` is a finite number.
+pub(crate) fn check_finite(name: &str, value: f64) -> Result<(), ParamError> {
+    check(name, value, value.is_finite(), "must be a finite number")
+}
+
+/// Checks that `value` is finite and positive.
+pub(crate) fn check_positive(name: &str, value: f64) -> Result<(), ParamError> {
+    check_finite(name, value)?;
+    check(name, value, value > 0.0, "must be positive")
+}
+
+/// Checks that `value` is finite and not negative.
+pub(crate) fn check_non_negative(name: &str, value: f64) -> Result<(), ParamError> {
+    check_finite(name, value)?;
+    check(name, value, value >= 0.0, "must not be negative")
+}
+
 /// A simulation could not continue.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]

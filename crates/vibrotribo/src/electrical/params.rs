@@ -3,7 +3,7 @@
 
 use super::diode::Diode;
 use super::transducer::{ContactSeparation, Freestanding, Transducer};
-use crate::error::ParamError;
+use crate::error::{ParamError, check_finite, check_non_negative, check_positive};
 
 /// Vacuum permittivity ε₀, F/m (CODATA 2018).
 pub const EPSILON_0: f64 = 8.854_187_812_8e-12;
@@ -179,80 +179,46 @@ impl Default for HarvesterParams {
     }
 }
 
-fn invalid(name: &str, value: f64, reason: &'static str) -> ParamError {
-    ParamError::Invalid {
-        name: name.to_string(),
-        value,
-        reason,
-    }
-}
-
-fn finite(name: &str, value: f64) -> Result<(), ParamError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(invalid(name, value, "must be a finite number"))
-    }
-}
-
-fn positive(name: &str, value: f64) -> Result<(), ParamError> {
-    finite(name, value)?;
-    if value > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(name, value, "must be positive"))
-    }
-}
-
-fn non_negative(name: &str, value: f64) -> Result<(), ParamError> {
-    finite(name, value)?;
-    if value >= 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(name, value, "must not be negative"))
-    }
-}
-
 impl HarvesterParams {
     /// Checks every parameter on its own; returns the first problem, naming its key
     /// (`harvester.area`, `harvester.relative_permittivity[1]`, …).
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("harvester.area", self.area)?;
-        finite("harvester.charge_density", self.charge_density)?;
+        check_positive("harvester.area", self.area)?;
+        check_finite("harvester.charge_density", self.charge_density)?;
         for (i, &d) in self.dielectric_thickness.iter().enumerate() {
-            non_negative(&format!("harvester.dielectric_thickness[{i}]"), d)?;
+            check_non_negative(&format!("harvester.dielectric_thickness[{i}]"), d)?;
         }
         for (i, &e) in self.relative_permittivity.iter().enumerate() {
-            positive(&format!("harvester.relative_permittivity[{i}]"), e)?;
+            check_positive(&format!("harvester.relative_permittivity[{i}]"), e)?;
         }
         if self.effective_thickness() <= 0.0 {
-            return Err(invalid(
+            return Err(ParamError::invalid(
                 "harvester.dielectric_thickness",
                 0.0,
                 "at least one film must have positive thickness (the capacitance at contact \
                  would be infinite)",
             ));
         }
-        positive("harvester.load_resistance", self.load_resistance)?;
-        positive("harvester.storage_capacitance", self.storage_capacitance)?;
+        check_positive("harvester.load_resistance", self.load_resistance)?;
+        check_positive("harvester.storage_capacitance", self.storage_capacitance)?;
         if let Some(r) = self.storage_load_resistance {
-            positive("harvester.storage_load_resistance", r)?;
+            check_positive("harvester.storage_load_resistance", r)?;
         }
-        finite("harvester.storage_initial_voltage", self.storage_initial_voltage)?;
+        check_finite("harvester.storage_initial_voltage", self.storage_initial_voltage)?;
         if let Some(v) = self.target_voltage {
-            finite("harvester.target_voltage", v)?;
+            check_finite("harvester.target_voltage", v)?;
         }
         if let Some(q) = self.initial_charge {
-            finite("harvester.initial_charge", q)?;
+            check_finite("harvester.initial_charge", q)?;
         }
-        positive(
+        check_positive(
             "harvester.diode_saturation_current",
             self.diode_saturation_current,
         )?;
-        positive("harvester.diode_ideality", self.diode_ideality)?;
-        positive("harvester.diode_series_resistance", self.diode_series_resistance)?;
-        positive("harvester.diode_thermal_voltage", self.diode_thermal_voltage)?;
-        non_negative(
+        check_positive("harvester.diode_ideality", self.diode_ideality)?;
+        check_positive("harvester.diode_series_resistance", self.diode_series_resistance)?;
+        check_positive("harvester.diode_thermal_voltage", self.diode_thermal_voltage)?;
+        check_non_negative(
             "harvester.diode_parallel_conductance",
             self.diode_parallel_conductance,
         )?;
@@ -273,7 +239,7 @@ impl HarvesterParams {
                     )));
                 }
                 if self.contact + 1 >= gaps {
-                    return Err(invalid(
+                    return Err(ParamError::invalid(
                         "harvester.contact",
                         self.contact as f64,
                         "freestanding mode uses contacts `contact` and `contact + 1`, which must \
@@ -283,7 +249,7 @@ impl HarvesterParams {
             }
             TransducerMode::ContactSeparation => {
                 if self.contact >= gaps {
-                    return Err(invalid(
+                    return Err(ParamError::invalid(
                         "harvester.contact",
                         self.contact as f64,
                         "no such contact in the chain (0-based, at most N − 2)",

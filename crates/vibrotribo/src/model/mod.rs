@@ -14,7 +14,7 @@
 //! Physical inputs live in [`ChainParams`]; numerical settings in
 //! [`SimOptions`]. Validate once with [`ChainParams::validate`].
 
-use crate::error::ParamError;
+use crate::error::{ParamError, check, check_finite, check_non_negative, check_positive};
 
 /// How the excitation frequency is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,32 +102,6 @@ impl ChainParams {
             ..ChainParams::default()
         }
     }
-}
-
-fn check(name: impl Into<String>, value: f64, ok: bool, reason: &'static str) -> Result<(), ParamError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(ParamError::Invalid {
-            name: name.into(),
-            value,
-            reason,
-        })
-    }
-}
-
-fn check_finite(name: &str, value: f64) -> Result<(), ParamError> {
-    check(name, value, value.is_finite(), "must be a finite number")
-}
-
-fn check_positive(name: &str, value: f64) -> Result<(), ParamError> {
-    check_finite(name, value)?;
-    check(name, value, value > 0.0, "must be positive")
-}
-
-fn check_non_negative(name: &str, value: f64) -> Result<(), ParamError> {
-    check_finite(name, value)?;
-    check(name, value, value >= 0.0, "must not be negative")
 }
 
 fn check_len(name: &str, v: &[f64], expected: usize) -> Result<(), ParamError> {
