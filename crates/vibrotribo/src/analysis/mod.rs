@@ -11,9 +11,10 @@
 //! - **Functions on series** that the observers (or the electrical solver) produce:
 //!   [`detect_period`] finds the period of a stroboscopic series, [`welch_psd`] the power
 //!   spectral density of a uniformly sampled signal, [`fit_quadratic`] the least-squares
-//!   parabola (the paper's optimal mass ratio `R_mo = 11.43Ω² − 28.46Ω + 18.03`, Sect. 4.3),
-//!   and [`running_average_power`] / [`mean_power`] the paper's running average power
-//!   `P_a(N) = Σ_{n≤N} E_n / (N T)`.
+//!   parabola (the paper's optimal mass ratio `R_mo = 11.43Ω² − 28.46Ω + 18.03`, Sect. 4.3).
+//!   The paper's running average power `P_a(N) = Σ_{n≤N} E_n / (N T)` is computed by the
+//!   electrical solver ([`power_curve`](crate::electrical::power_curve),
+//!   [`summarize`](crate::electrical::summarize)).
 //!
 //! Every function validates its input and returns an [`AnalysisError`] instead of panicking
 //! on empty, too short or non-finite data.
@@ -21,7 +22,6 @@
 mod fit;
 mod period;
 mod poincare;
-mod power;
 mod spectrum;
 mod stats;
 mod sweep;
@@ -29,12 +29,11 @@ mod sweep;
 pub use fit::{QuadraticFit, fit_quadratic};
 pub use period::{PeriodOptions, Periodicity, detect_period};
 pub use poincare::{ImpactPoint, ImpactSection, StroboscopicOptions, StroboscopicSection};
-pub use power::{mean_power, running_average_power};
 pub use spectrum::{Detrend, Psd, WelchOptions, Window, welch_psd};
 pub use stats::RunStats;
 pub use sweep::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 
-use crate::error::ParamError;
+use crate::error::{ParamError, check_positive};
 use thiserror::Error;
 
 /// An analysis could not be carried out on the data or options given.
@@ -100,22 +99,7 @@ fn check_finite(what: &'static str, data: &[f64], index_offset: usize) -> Result
 
 /// An `InvalidParameter`-style error for option `name`.
 fn invalid(name: &str, value: f64, reason: &'static str) -> AnalysisError {
-    AnalysisError::Option(ParamError::Invalid {
-        name: name.to_string(),
-        value,
-        reason,
-    })
-}
-
-/// Checks that `value` is finite and positive.
-fn check_positive(name: &str, value: f64) -> Result<(), AnalysisError> {
-    if !value.is_finite() {
-        Err(invalid(name, value, "must be a finite number"))
-    } else if value <= 0.0 {
-        Err(invalid(name, value, "must be positive"))
-    } else {
-        Ok(())
-    }
+    AnalysisError::Option(ParamError::invalid(name, value, reason))
 }
 
 /// Compensated (Neumaier) running sum, for long sums of terms of mixed size.
