@@ -299,6 +299,11 @@ impl Trajectory {
         &self.segments
     }
 
+    /// Number of gaps (contacts), N − 1 for a chain of N masses.
+    pub fn gap_count(&self) -> usize {
+        self.gaps.len()
+    }
+
     /// Time span covered, s.
     pub fn span(&self) -> Option<(f64, f64)> {
         Some((self.segments.first()?.t_start, self.segments.last()?.t_end))

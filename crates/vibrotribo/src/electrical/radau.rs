@@ -1,9 +1,9 @@
-//! Radau IIA collocation methods with S = 3, 5 or 7 stages (order 2S − 1, stage order S,
+//! Radau IIA collocation methods with S = 3 or 7 stages (order 2S − 1, stage order S,
 //! stiffly accurate, L-stable) with Hairer's embedded error estimate of order S (Hairer &
 //! Wanner, *Solving ODEs II*, Sect. IV.8, codes RADAU5 and RADAU), and the small dense solves
 //! their stage systems need.
 
-/// Coefficients of `S`-stage Radau IIA (S = 3, 5 or 7) and of its error estimate.
+/// Coefficients of `S`-stage Radau IIA (S = 3 or 7) and of its error estimate.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Tableau<const S: usize> {
     /// Nodes c₁ … c_S = 1.
@@ -31,7 +31,6 @@ impl<const S: usize> Tableau<S> {
     pub fn new() -> Self {
         match S {
             3 => Self::from_coefficients(&C3, |i, j| A3[i][j], GAMMA0_3, &DD3),
-            5 => Self::from_coefficients(&C5, |i, j| A5[i][j], GAMMA0_5, &DD5),
             7 => Self::from_coefficients(&C7, |i, j| A7[i][j], GAMMA0_7, &DD7),
             _ => panic!("Radau IIA with {S} stages is not tabulated"),
         }
@@ -84,59 +83,6 @@ const A3: [[f64; 3]; 3] = [
 ];
 const GAMMA0_3: f64 = 0.27488882959567734;
 const DD3: [f64; 3] = [-10.048809399827416, 1.382142733160749, -0.3333333333333333];
-/// Radau IIA with 5 stages (order 9).
-const C5: [f64; 5] = [
-    0.05710419611451768,
-    0.2768430136381238,
-    0.5835904323689168,
-    0.8602401356562195,
-    1.0,
-];
-const A5: [[f64; 5]; 5] = [
-    [
-        0.07299886431790333,
-        -0.02673533110794557,
-        0.018676929763984353,
-        -0.01287910609330644,
-        0.005042839233882015,
-    ],
-    [
-        0.15377523147918246,
-        0.14621486784749352,
-        -0.03644456890512809,
-        0.02123306311930472,
-        -0.007935579902728777,
-    ],
-    [
-        0.14006304568480987,
-        0.29896712949128346,
-        0.16758507013524895,
-        -0.03396910168661774,
-        0.010944288744192253,
-    ],
-    [
-        0.14489430810953477,
-        0.2765000687601592,
-        0.32579792291042103,
-        0.12875675325490976,
-        -0.015708917378805327,
-    ],
-    [
-        0.14371356079122594,
-        0.28135601514946207,
-        0.31182652297574126,
-        0.22310390108357075,
-        0.04,
-    ],
-];
-const GAMMA0_5: f64 = 0.15906584442746913;
-const DD5: [f64; 5] = [
-    -27.78093394406464,
-    3.641478498049213,
-    -1.2525477211691187,
-    0.5920031671845428,
-    -0.2,
-];
 /// Radau IIA with 7 stages (order 13).
 const C7: [f64; 7] = [
     0.029316427159784893,
@@ -355,7 +301,6 @@ mod tests {
     #[test]
     fn tableaus_are_collocation_with_embedded_estimates() {
         check_tableau::<3>();
-        check_tableau::<5>();
         check_tableau::<7>();
     }
 

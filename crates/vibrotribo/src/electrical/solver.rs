@@ -193,7 +193,7 @@ impl ElectricalSamples {
         self.charge_c.push(row.charge);
         self.current_a.push(row.current);
         self.voltage_v.push(row.voltage);
-        self.capacitance_f.push(1.0 / row.ts.elastance);
+        self.capacitance_f.push(row.ts.capacitance());
         self.voc_v.push(row.ts.voc);
         if rectifier {
             self.storage_voltage_v.push(row.storage);
@@ -220,14 +220,8 @@ pub struct SolverStats {
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum LoadModel {
-    Resistor {
-        conductance: f64,
-    },
-    Rectifier {
-        diode: DiodeLaw,
-        inv_cs: f64,
-        load_conductance: f64,
-    },
+    Resistor { conductance: f64 },
+    Rectifier(RectifierLoad),
     Open,
     Short,
 }
@@ -340,7 +334,7 @@ impl<const S: usize> Trial<S> {
 }
 
 /// The rectifier's constants, as the stage solver takes them.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct RectifierLoad {
     diode: DiodeLaw,
     /// 1/C_s, 1/F.
@@ -468,12 +462,11 @@ const LAYER_MARGIN: f64 = 3.0;
 /// `x^(1/(S+1))`: the error estimate is O(h^(S+1)).
 #[inline]
 fn err_root<const S: usize>(x: f64) -> f64 {
+    // Only S = 3 and S = 7 are tabulated (`Tableau::new`).
     if S == 7 {
         x.sqrt().sqrt().sqrt()
-    } else if S == 3 {
-        x.sqrt().sqrt()
     } else {
-        x.powf(1.0 / (S as f64 + 1.0))
+        x.sqrt().sqrt()
     }
 }
 
@@ -519,16 +512,16 @@ impl ChargeSolver {
             LoadKind::Resistor => LoadModel::Resistor {
                 conductance: 1.0 / params.load_resistance,
             },
-            LoadKind::Rectifier => LoadModel::Rectifier {
+            LoadKind::Rectifier => LoadModel::Rectifier(RectifierLoad {
                 diode: DiodeLaw::new(&params.diode()),
                 inv_cs: 1.0 / params.storage_capacitance,
                 load_conductance: params.storage_load_resistance.map_or(0.0, |r| 1.0 / r),
-            },
+            }),
             LoadKind::Open => LoadModel::Open,
             LoadKind::Short => LoadModel::Short,
         };
         let v_floor = match load {
-            LoadModel::Rectifier { diode, .. } => diode.thermal_scale(),
+            LoadModel::Rectifier(RectifierLoad { diode, .. }) => diode.thermal_scale(),
             _ => (1e-12 * transducer.voltage_scale()).max(f64::MIN_POSITIVE),
         };
         Ok(ChargeSolver {
@@ -688,18 +681,18 @@ impl ChargeSolver {
         if trajectory.segments().is_empty() {
             return Err(ElectricalError::EmptyTrajectory);
         }
+        if trajectory.gap_count() != self.gaps.len() {
+            return Err(ParamError::Length {
+                name: "trajectory.gaps".into(),
+                expected: self.gaps.len(),
+                got: trajectory.gap_count(),
+            }
+            .into());
+        }
         for seg in trajectory.segments() {
             let flow = trajectory
                 .flow_at(seg.t_start)
                 .ok_or(ElectricalError::EmptyTrajectory)?;
-            if flow.len() - 1 != self.gaps.len() {
-                return Err(ParamError::Length {
-                    name: "trajectory.gaps".into(),
-                    expected: self.gaps.len(),
-                    got: flow.len() - 1,
-                }
-                .into());
-            }
             self.advance_flow(&flow)?;
         }
         Ok(())
@@ -750,7 +743,7 @@ impl ChargeSolver {
 
     /// Storage capacitor voltage at the current time, V (rectifier only).
     pub fn storage_voltage(&self) -> Option<f64> {
-        matches!(self.load, LoadModel::Rectifier { .. }).then_some(self.y[1])
+        matches!(self.load, LoadModel::Rectifier(_)).then_some(self.y[1])
     }
 
     /// Energy delivered to the load since the start, J.
@@ -841,15 +834,13 @@ impl ChargeSolver {
         let q0 = self.initial_charge.unwrap_or(ts.equilibrium_charge);
         self.t = t0;
         self.t_start = t0;
+        // Open and short circuits are closed forms (`row`) that never read `y`.
         self.y = [q0 - ts.equilibrium_charge, self.storage_initial_voltage];
-        if matches!(self.load, LoadModel::Short) {
-            self.y[0] = 0.0;
-        }
         self.open_charge = q0;
         self.ts_now = ts;
         self.started = true;
         self.v_scale = match self.load {
-            LoadModel::Rectifier { .. } => self.storage_initial_voltage.abs(),
+            LoadModel::Rectifier(_) => self.storage_initial_voltage.abs(),
             _ => (self.y[0] * ts.elastance).abs(),
         };
         Ok(())
@@ -863,7 +854,7 @@ impl ChargeSolver {
             LoadModel::Resistor { conductance } => {
                 (u + ts.equilibrium_charge, voltage * conductance, voltage)
             }
-            LoadModel::Rectifier { diode, .. } => (
+            LoadModel::Rectifier(RectifierLoad { diode, .. }) => (
                 u + ts.equilibrium_charge,
                 diode.bridge(voltage, vs).current,
                 voltage,
@@ -917,17 +908,8 @@ impl ChargeSolver {
                     true
                 })?;
             }
-            LoadModel::Rectifier {
-                diode,
-                inv_cs,
-                load_conductance,
-            } => {
+            LoadModel::Rectifier(load) => {
                 let tab = self.tab_rectifier;
-                let load = RectifierLoad {
-                    diode,
-                    inv_cs,
-                    load_conductance,
-                };
                 self.integrate(&tab, ta, tb, n0, wave, |s, h, n0, nodes, trial| {
                     s.trial_rectifier(&tab, &load, h, n0, nodes, trial)
                 })?;
@@ -936,10 +918,6 @@ impl ChargeSolver {
                 let n1 = self.eval(tb, wave)?;
                 self.t = tb;
                 self.ts_now = n1;
-                self.y[0] = match self.load {
-                    LoadModel::Open => self.open_charge - n1.equilibrium_charge,
-                    _ => 0.0,
-                };
                 let r1 = self.row(n1, self.y, self.energy);
                 self.note_peaks(r1.current, r1.voltage);
                 self.sample_between(ta, tb, wave, None)?;
@@ -1065,7 +1043,7 @@ impl ChargeSolver {
                 // does not fall with h until h·k ~ 1: go there at once. For the resistor only
                 // the first step of a piece meets one (after the kink); the rectifier meets
                 // one at every switching of the bridge.
-                let layer_possible = t == ta || matches!(self.load, LoadModel::Rectifier { .. });
+                let layer_possible = t == ta || matches!(self.load, LoadModel::Rectifier(_));
                 if solved && layer_possible && trial.hk > 2.0 {
                     self.h = self.h.min(2.0 * h / trial.hk);
                 }
@@ -1087,7 +1065,7 @@ impl ChargeSolver {
     fn kink_start(&mut self, n0: &TransducerState) -> Option<Layer> {
         let conductance = match self.load {
             LoadModel::Resistor { conductance } => conductance,
-            LoadModel::Rectifier { diode, .. } => {
+            LoadModel::Rectifier(RectifierLoad { diode, .. }) => {
                 // The bridge switches as the voltage sweeps a few n·V_T: start there.
                 let v0 = -self.y[0] * n0.elastance;
                 let b = diode.bridge(v0, self.y[1]);
@@ -1393,9 +1371,9 @@ impl ChargeSolver {
         trial.peak_current = peak_i;
         trial.scale_voltage = scale_v;
         // Error estimate: (I − γ₀hJ₀) e = γ₀ (h f₀ + Σ dᵢ ΔYᵢ), ΔYᵢ = (Zᵢ + ΔQ_eq,ᵢ, Z_s,ᵢ).
-        let (f0, j0, _, _) = f(y0, n0);
-        trial.stiff = h * j0[0][0].abs() >= 1.0;
+        let (f0, j0, _, b0) = f(y0, n0);
         trial.hk = h * j0[0][0].abs();
+        trial.stiff = trial.hk >= 1.0;
         let g = tab.gamma0;
         let dy = |i: usize, c: usize| z[c][i] + if c == 0 { dq[i] } else { 0.0 };
         let dz = [0, 1].map(|c| (0..S).map(|i| tab.dd[i] * dy(i, c)).sum::<f64>());
@@ -1420,7 +1398,6 @@ impl ChargeSolver {
         let sc_s = rtol * y0[1].abs().max(y1[1].abs()) + atol + noise[1];
         let err_y = ((e[0] * el1).abs() / sc_v).max(e[1].abs() / sc_s);
         // Energy: p = V_s I_out; noise from the voltage and storage-voltage noise.
-        let b0 = diode.bridge(v0, y0[1]);
         let p0 = y0[1] * b0.output;
         let p_noise = (y0[1] * b0.output_dv).abs() * noise[0] * el1
             + (b0.output.abs() + (y0[1] * b0.output_dvs).abs()) * noise[1];
@@ -1541,7 +1518,7 @@ impl ChargeSolver {
         };
         let t1 = step.t0 + step.h;
         self.sample_between(step.t0, t1, wave, Some(&step))?;
-        if let (Some(target), None, LoadModel::Rectifier { .. }) =
+        if let (Some(target), None, LoadModel::Rectifier(_)) =
             (self.target_voltage, self.target_time, self.load)
         {
             let before = step.y0[1] - target;
@@ -1577,7 +1554,7 @@ impl ChargeSolver {
         if self.sampler.is_none() && self.vq.is_none() {
             return Ok(());
         }
-        let rectifier = matches!(self.load, LoadModel::Rectifier { .. });
+        let rectifier = matches!(self.load, LoadModel::Rectifier(_));
         for which in 0..2 {
             let mut grid = match which {
                 0 => self.sampler.take(),
@@ -1593,13 +1570,10 @@ impl ChargeSolver {
                             break;
                         }
                     };
-                    let (mut y, e) = match step {
+                    let (y, e) = match step {
                         Some(s) => self.dense(s, t, ts.equilibrium_charge),
                         None => (self.y, self.energy),
                     };
-                    if step.is_none() && matches!(self.load, LoadModel::Open) {
-                        y[0] = self.open_charge - ts.equilibrium_charge;
-                    }
                     let row = self.row(ts, y, e);
                     self.note_peaks(row.current, row.voltage);
                     g.data.push(t, &row, rectifier);

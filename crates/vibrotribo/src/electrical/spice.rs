@@ -34,7 +34,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use super::params::{BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, LoadKind, VocModel};
-use super::transducer::Transducer;
+use super::transducer::{ChargeMap, Transducer};
 use super::waveform::PwlGaps;
 use crate::error::ParamError;
 use thiserror::Error;
@@ -179,10 +179,11 @@ fn num(x: f64) -> String {
 /// The initial charge the library uses: `initial_charge` or `C(t₀)·V_oc(t₀)`, C.
 pub fn initial_charge(params: &HarvesterParams, pwl: &PwlGaps) -> f64 {
     let gaps: Vec<f64> = (0..pwl.gap_count()).map(|k| pwl.value(0, k)).collect();
-    let t = params.transducer();
-    params
-        .initial_charge
-        .unwrap_or_else(|| t.capacitance(&gaps) * t.open_circuit_voltage(&gaps))
+    params.initial_charge.unwrap_or_else(|| {
+        ChargeMap::new(&params.transducer())
+            .state(&gaps)
+            .equilibrium_charge
+    })
 }
 
 /// An ngspice netlist of the harvester `params` driven by the gaps `pwl` from its first time

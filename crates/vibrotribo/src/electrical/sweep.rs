@@ -78,12 +78,10 @@ pub fn load_sweep(
             .into());
         }
     }
-    let gaps = trajectory
-        .segments()
-        .first()
-        .and_then(|s| trajectory.flow_at(s.t_start))
-        .map(|f| f.len() - 1)
-        .ok_or(ElectricalError::EmptyTrajectory)?;
+    if trajectory.segments().is_empty() {
+        return Err(ElectricalError::EmptyTrajectory);
+    }
+    let gaps = trajectory.gap_count();
     let evaluate = |r: f64| -> Result<LoadPoint, ElectricalError> {
         let mut p = params.clone();
         p.load = LoadKind::Resistor;

@@ -65,23 +65,6 @@ impl Freestanding {
             VocModel::Exact => d2 - d1,
         }
     }
-
-    /// Full state from gaps D₁, D₂ (m) and their rates (m/s).
-    #[inline]
-    pub fn state(&self, d1: f64, d2: f64, r1: f64, r2: f64) -> TransducerState {
-        let s = self.d0 + d1 + d2;
-        let ds = r1 + r2;
-        let l = self.voc_length(d1, d2);
-        let dl = self.voc_length(r1, r2);
-        // The surface charge σS = ε₀S·σ/ε₀.
-        let sigma_s = self.eps_area * self.charge_density / EPSILON_0;
-        TransducerState {
-            elastance: s / self.eps_area,
-            voc: self.charge_density * l / EPSILON_0,
-            equilibrium_charge: sigma_s * l / s,
-            equilibrium_current: sigma_s * (dl * s - l * ds) / (s * s),
-        }
-    }
 }
 
 /// Two-plate contact-separation mode on one contact: `C = ε₀S/(d₀ + D)`, `V_oc = σD/ε₀`.
@@ -106,19 +89,6 @@ impl ContactSeparation {
     /// Open-circuit voltage V_oc, V, at gap D (m).
     pub fn open_circuit_voltage(&self, d: f64) -> f64 {
         self.charge_density * d / EPSILON_0
-    }
-
-    /// Full state from gap D (m) and its rate (m/s).
-    #[inline]
-    pub fn state(&self, d: f64, rate: f64) -> TransducerState {
-        let s = self.d0 + d;
-        let sigma_s = self.eps_area * self.charge_density / EPSILON_0;
-        TransducerState {
-            elastance: s / self.eps_area,
-            voc: self.charge_density * d / EPSILON_0,
-            equilibrium_charge: sigma_s * d / s,
-            equilibrium_current: sigma_s * self.d0 * rate / (s * s),
-        }
     }
 }
 
@@ -148,16 +118,10 @@ impl Transducer {
         }
     }
 
-    /// Full state from the chain's gaps (m) and their rates (m/s), indexed by contact.
-    #[inline]
+    /// Full state from the chain's gaps (m) and their rates (m/s), indexed by contact (the
+    /// charge solver's own evaluation, [`ChargeMap`]).
     pub fn state(&self, gaps: &[f64], rates: &[f64]) -> TransducerState {
-        match self {
-            Transducer::Freestanding(f) => {
-                let [a, b] = f.contacts;
-                f.state(gaps[a], gaps[b], rates[a], rates[b])
-            }
-            Transducer::ContactSeparation(c) => c.state(gaps[c.contact], rates[c.contact]),
-        }
+        ChargeMap::new(self).state_with_rates(gaps, rates)
     }
 
     /// The contacts (0-based) whose gaps this transducer reads.
@@ -262,6 +226,52 @@ impl ChargeMap {
         TransducerState {
             equilibrium_current: self.sigma_area * (dl * s - l * ds) / (s * s),
             ..self.state(gaps)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::electrical::{HarvesterParams, TransducerMode};
+
+    /// The solver's evaluation against the textbook formulas: C and V_oc directly, and the
+    /// short-circuit current as the derivative of C·V_oc along a gap path (central difference).
+    #[test]
+    fn state_matches_the_closed_forms() {
+        for (mode, voc_model) in [
+            (TransducerMode::Freestanding, VocModel::Paper),
+            (TransducerMode::Freestanding, VocModel::Exact),
+            (TransducerMode::ContactSeparation, VocModel::Paper),
+        ] {
+            let t = HarvesterParams {
+                mode,
+                voc_model,
+                ..HarvesterParams::default()
+            }
+            .transducer();
+            let path = |tau: f64| [0.012 + 0.004 * tau, 0.007 - 0.003 * tau];
+            let rates = [0.004, -0.003];
+            let gaps = path(0.0);
+            let s = t.state(&gaps, &rates);
+            let qeq = |tau: f64| t.capacitance(&path(tau)) * t.open_circuit_voltage(&path(tau));
+            let h = 1e-4;
+            let dq = (qeq(h) - qeq(-h)) / (2.0 * h);
+            let what = format!("{mode:?}, {voc_model:?}");
+            assert!(
+                (s.capacitance() / t.capacitance(&gaps) - 1.0).abs() < 1e-14,
+                "{what}"
+            );
+            assert!(
+                (s.voc / t.open_circuit_voltage(&gaps) - 1.0).abs() < 1e-14,
+                "{what}"
+            );
+            assert!((s.equilibrium_charge / qeq(0.0) - 1.0).abs() < 1e-14, "{what}");
+            assert!(
+                (s.equilibrium_current / dq - 1.0).abs() < 1e-7,
+                "{what}: {} vs {dq}",
+                s.equilibrium_current
+            );
         }
     }
 }

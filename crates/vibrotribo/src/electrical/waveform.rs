@@ -136,7 +136,7 @@ impl PwlGaps {
             });
         }
         let t_end = t_end.min(t_last);
-        let n = trajectory.flow_at(t_start).map_or(0, |f| f.len() - 1);
+        let n = trajectory.gap_count();
         let mut candidates: Vec<f64> = Vec::new();
         let steps = ((t_end - t_start) / dt).floor() as usize;
         candidates.extend((0..=steps).map(|j| t_start + j as f64 * dt));
