@@ -235,7 +235,7 @@ pub fn run_point(
         None
     };
     Ok(PointResult {
-        strobe_periods: strobe.indices.clone(),
+        strobe_periods: strobe.indices,
         strobe: strobe.positions,
         impacts_per_period: stats.impacts_per_period(total),
         impacts: impacts.records,

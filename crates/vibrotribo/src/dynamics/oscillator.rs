@@ -113,6 +113,21 @@ pub(crate) struct OscConstants {
     pub force: f64,
 }
 
+/// The homogeneous part of an [`Oscillator`] at one instant (see `Oscillator::homogeneous`).
+#[derive(Debug, Clone, Copy)]
+struct Homogeneous {
+    /// h, m.
+    h: f64,
+    /// h', m/s.
+    hd: f64,
+    /// The propagated rounding error of the initial conditions in h, m, and in h', m/s.
+    eh: f64,
+    ehd: f64,
+    /// Sums of the magnitudes of the terms of h, m, and of h', m/s.
+    mag_h: f64,
+    mag_hd: f64,
+}
+
 impl Oscillator {
     /// The flow through state (`s0`, `v0`) at time `t0`.
     pub(crate) fn new(
@@ -185,19 +200,30 @@ impl Oscillator {
         )
     }
 
+    /// Homogeneous part at time `t`: `h` and `h'`, the rounding-error initial conditions
+    /// propagated by the same flow, and the magnitudes of the terms of `h` and `h'`.
+    #[inline(always)]
+    fn homogeneous(&self, t: f64) -> Homogeneous {
+        let (c, s) = self.propagator(t - self.t0);
+        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
+        let (p, q) = (h0 * c, (h1 + self.alpha * h0) * s);
+        let (r, u) = (h1 * c, (self.wn2 * h0 + self.alpha * h1) * s);
+        Homogeneous {
+            h: p + q,
+            hd: r - u,
+            eh: e0 * c + (e1 + self.alpha * e0) * s,
+            ehd: e1 * c - (self.wn2 * e0 + self.alpha * e1) * s,
+            mag_h: p.abs() + q.abs(),
+            mag_hd: r.abs() + u.abs(),
+        }
+    }
+
     /// Homogeneous part at time `t` with the magnitudes of the terms summed for each,
     /// `(h, h', |h₀c| + |(h₁+αh₀)s|, |h₁c| + |(ω_n²h₀+αh₁)s|)`, for rounding estimates.
     #[inline]
     pub(crate) fn homogeneous_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
-        let tau = t - self.t0;
-        let (c, s) = self.propagator(tau);
-        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
-        let (p, q) = (h0 * c, (h1 + self.alpha * h0) * s);
-        let (r, u) = (h1 * c, (self.wn2 * h0 + self.alpha * h1) * s);
-        // The rounding-error initial conditions, propagated by the same flow.
-        let eh = e0 * c + (e1 + self.alpha * e0) * s;
-        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
-        ((p + q) + eh, (r - u) + ehd, p.abs() + q.abs(), r.abs() + u.abs())
+        let g = self.homogeneous(t);
+        (g.h + g.eh, g.hd + g.ehd, g.mag_h, g.mag_hd)
     }
 
     /// `e^{−ατ}c(τ)` and `e^{−ατ}s(τ)` of the module docs.
@@ -234,14 +260,8 @@ impl Oscillator {
     #[inline]
     pub(crate) fn state(&self, t: f64, ph: Phase) -> (f64, f64) {
         let (sp, vp) = self.forced(ph);
-        let tau = t - self.t0;
-        let (c, s) = self.propagator(tau);
-        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
-        let h = h0 * c + (h1 + self.alpha * h0) * s;
-        let hd = h1 * c - (self.wn2 * h0 + self.alpha * h1) * s;
-        let eh = e0 * c + (e1 + self.alpha * e0) * s;
-        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
-        ((sp + h) + eh, (vp + hd) + ehd)
+        let g = self.homogeneous(t);
+        ((sp + g.h) + g.eh, (vp + g.hd) + g.ehd)
     }
 
     /// Start time of this flow, s.
@@ -271,13 +291,7 @@ impl Oscillator {
     /// the values [`state`](Self::state) returns.
     pub(crate) fn taylor(&self, tc: f64, ph: Phase, r: f64, rel: f64, coef: &mut [f64]) -> (usize, f64, f64) {
         let (sp, vp) = self.forced(ph);
-        let tau = tc - self.t0;
-        let (c, s) = self.propagator(tau);
-        let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
-        let h = h0 * c + (h1 + self.alpha * h0) * s;
-        let hd = h1 * c - (self.wn2 * h0 + self.alpha * h1) * s;
-        let eh = e0 * c + (e1 + self.alpha * e0) * s;
-        let ehd = e1 * c - (self.wn2 * e0 + self.alpha * e1) * s;
+        let Homogeneous { h, hd, eh, ehd, .. } = self.homogeneous(tc);
         let max_terms = coef.len();
         // Homogeneous part g_j and forced part F_j = wⱼ·cyc(j) with wⱼ = (ωr)ʲ/j!.
         let (mut g_prev, mut g) = (h + eh, (hd + ehd) * r);

@@ -547,7 +547,7 @@ impl Simulator {
                 if self.closure[k].is_closed() {
                     continue;
                 }
-                let gap = self.params.gaps[k] - (self.x[k + 1] - self.x[k]);
+                let gap = self.gap(k);
                 if gap >= 0.0 {
                     continue;
                 }
@@ -563,7 +563,7 @@ impl Simulator {
                     self.x[i] -= overlap * mu / (mu + ml);
                 }
                 // Rounding of the shift itself: make the lower side exact.
-                let residual = self.params.gaps[k] - (self.x[k + 1] - self.x[k]);
+                let residual = self.gap(k);
                 if residual < 0.0 {
                     for i in low.0..=low.1 {
                         self.x[i] += residual;
@@ -586,6 +586,12 @@ impl Simulator {
             velocity_after: after,
             sequence_impacts: seq,
         });
+    }
+
+    /// Current gap at contact k, m (negative: overlap).
+    #[inline]
+    fn gap(&self, k: usize) -> f64 {
+        self.params.gaps[k] - (self.x[k + 1] - self.x[k])
     }
 
     /// Total mass and range of the cluster containing mass `i`, following the current
@@ -623,7 +629,7 @@ impl Simulator {
                 if self.closure[k].is_closed() {
                     continue;
                 }
-                let gap = self.params.gaps[k] - (self.x[k + 1] - self.x[k]);
+                let gap = self.gap(k);
                 // The trigger is at zero gap by the search's verdict.
                 if gap > self.pos_tol && k != trigger {
                     continue;
@@ -783,7 +789,7 @@ impl Simulator {
             } else if self.closure[k].is_closed() {
                 true
             } else {
-                let gap = self.params.gaps[k] - (self.x[k + 1] - self.x[k]);
+                let gap = self.gap(k);
                 gap <= self.pos_tol && (self.v[k + 1] - self.v[k]).abs() <= self.vel_tol
             };
             self.scratch_candidate[k] = cand;
