@@ -6,15 +6,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use rayon::prelude::*;
 use serde_json::json;
-use vibrotribo::analysis::{PointResult, QuadraticFit, fit_quadratic};
+use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, csv_text, point_cells, point_columns, write_json};
 use crate::plot::{self, Figure, Series};
-use crate::progress::{Progress, interrupted};
-use crate::sweep::{PointRunner, RunArgs, grid, set_threads};
+use crate::sweep::{PointRunner, RunArgs, grid, run_grid, set_threads};
 
 /// Options of `vibrotribo map`.
 #[derive(Debug, clap::Args)]
@@ -65,40 +63,6 @@ fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
     Ok(())
 }
 
-/// Runs `points` in parallel chunks, calling `write` in order; stops early on Ctrl-C.
-/// Returns how many were written.
-pub fn run_grid<'k, P, W>(
-    runner: &PointRunner,
-    points: &[P],
-    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
-    quiet: bool,
-    mut write: W,
-) -> Result<usize>
-where
-    P: Sync,
-    W: FnMut(&P, &Result<PointResult, String>) -> Result<()>,
-{
-    let progress = Progress::new(points.len() as u64, "points", quiet);
-    let chunk = rayon::current_num_threads() * 4;
-    let mut done = 0;
-    for block in points.chunks(chunk) {
-        let results: Vec<Result<PointResult, String>> = block
-            .par_iter()
-            .map(|p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")))
-            .collect();
-        for (p, r) in block.iter().zip(&results) {
-            write(p, r)?;
-            done += 1;
-            progress.inc(1);
-        }
-        if interrupted() {
-            break;
-        }
-    }
-    progress.finish();
-    Ok(done)
-}
-
 /// Runs `vibrotribo map`.
 pub fn run(args: &MapArgs) -> Result<()> {
     check_axis("x", args.x_from, args.x_to, args.x_steps)?;
@@ -117,7 +81,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     runner.check_all(&points, |&(x, y)| {
         vec![(args.x.as_str(), x), (args.y.as_str(), y)]
     })?;
-    let contacts = runner.base().config.chain_params()?.len() - 1;
+    let contacts = runner.masses() - 1;
     let mut csv = match &args.out {
         Some(dir) => {
             create_dir(dir)?;
@@ -133,6 +97,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         &runner,
         &points,
         |&(x, y)| vec![(xk, x), (yk, y)],
+        "points",
         args.run.quiet,
         |&(x, y), r| {
             let Some(csv) = csv.as_mut() else { return Ok(()) };
@@ -313,6 +278,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         &runner,
         &points,
         |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)],
+        "points",
         args.run.quiet,
         |&(w, r), res| {
             if let Ok(p) = res {
