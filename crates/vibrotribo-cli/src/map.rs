@@ -10,7 +10,7 @@ use serde_json::json;
 use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 
 use crate::config::ConfigArgs;
-use crate::output::{CsvFile, create_dir, csv_text, point_cells, point_columns, write_json};
+use crate::output::{CsvFile, create_dir, point_cells, point_columns, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::sweep::{PointRunner, RunArgs, grid, run_grid, set_threads};
 
@@ -192,7 +192,7 @@ pub fn plot_optimal_mass_ratio(
     let paper: Vec<f64> = fine.iter().map(|&w| paper_fit(w)).collect();
     let ours: Vec<f64> = fine
         .iter()
-        .map(|w| fit.map_or(f64::NAN, |f| f.a * w * w + f.b * w + f.c))
+        .map(|&w| fit.map_or(f64::NAN, |f| f.eval(w)))
         .collect();
     let fig = Figure::new("Optimal mass ratio R_mo(Ω)", "Ω = ω/Ω1", "R_mo = m2/m1");
     plot::phase_portrait(
@@ -244,6 +244,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     let runner = PointRunner::new(base, &args.run)?;
+    let contacts = runner.masses() - 1;
     let (omegas, ratios) = (
         grid(args.omega_from, args.omega_to, args.omega_steps),
         grid(args.rm_from, args.rm_to, args.rm_steps),
@@ -286,25 +287,16 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             }
             index += 1;
             if let Some(csv) = grid_csv.as_mut() {
-                let row = match res {
-                    Ok(p) => vec![
-                        w.to_string(),
-                        r.to_string(),
-                        p.average_power_w.map_or(String::new(), |v| v.to_string()),
-                        p.total_impacts_per_period().to_string(),
-                        p.period().to_string(),
-                        p.electrical_error.as_deref().map_or(String::new(), csv_text),
-                    ],
-                    Err(e) => vec![
-                        w.to_string(),
-                        r.to_string(),
-                        String::new(),
-                        String::new(),
-                        String::new(),
-                        csv_text(e),
-                    ],
-                };
-                csv.row(row)?;
+                // Of the point's columns: average_power_w, impacts_per_period, period, error.
+                let mut cells = point_cells(res, contacts);
+                let error = cells.pop().unwrap_or_default();
+                cells.truncate(3);
+                csv.row(
+                    [w.to_string(), r.to_string()]
+                        .into_iter()
+                        .chain(cells)
+                        .chain([error]),
+                )?;
             }
             Ok(())
         },
