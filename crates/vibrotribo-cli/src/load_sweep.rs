@@ -12,6 +12,7 @@ use vibrotribo::{Simulator, Trajectory};
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot;
+use crate::plots::both;
 use crate::progress::Progress;
 
 /// Options of `vibrotribo load-sweep`.
@@ -201,33 +202,26 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         if args.plot {
             let xs: Vec<f64> = sweep.points.iter().map(|p| p.resistance_ohm.log10()).collect();
             let ys: Vec<f64> = sweep.points.iter().map(|p| p.average_power_w).collect();
-            for ext in ["png", "svg"] {
-                let mut fig = plot::Figure::new(
-                    "Average power against load resistance",
-                    "log10(R / Ω)",
-                    "average power P_a [W]",
-                );
-                fig.y_scale = plot::Scale::Log;
-                plot::line_plot(
-                    &dir.join(format!("load_sweep.{ext}")),
-                    &fig,
-                    &[plot::Series::new("P_a(R)", &xs, &ys)],
-                )?;
-                let labels: Vec<String> = cycles
-                    .iter()
-                    .map(|(r, _, _)| format!("R = {}", si(*r, "Ω")))
-                    .collect();
-                let series: Vec<plot::Series> = cycles
-                    .iter()
-                    .zip(&labels)
-                    .map(|((_, q, v), l)| plot::Series::new(l, q, v))
-                    .collect();
-                plot::line_plot(
-                    &dir.join(format!("vq_cycle.{ext}")),
-                    &plot::Figure::new("V–Q cycle (last period)", "charge Q [C]", "voltage V [V]"),
-                    &series,
-                )?;
-            }
+            let mut fig = plot::Figure::new(
+                "Average power against load resistance",
+                "log10(R / Ω)",
+                "average power P_a [W]",
+            );
+            fig.y_scale = plot::Scale::Log;
+            both(dir, "load_sweep", |path| {
+                plot::line_plot(path, &fig, &[plot::Series::new("P_a(R)", &xs, &ys)])
+            })?;
+            let labels: Vec<String> = cycles
+                .iter()
+                .map(|(r, _, _)| format!("R = {}", si(*r, "Ω")))
+                .collect();
+            let series: Vec<plot::Series> = cycles
+                .iter()
+                .zip(&labels)
+                .map(|((_, q, v), l)| plot::Series::new(l, q, v))
+                .collect();
+            let fig = plot::Figure::new("V–Q cycle (last period)", "charge Q [C]", "voltage V [V]");
+            both(dir, "vq_cycle", |path| plot::line_plot(path, &fig, &series))?;
         }
         println!(
             "  wrote {0}/load_sweep.csv, {0}/vq_cycle.csv, {0}/load_sweep.json",

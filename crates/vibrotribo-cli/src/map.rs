@@ -389,15 +389,9 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             }),
         )?;
         if args.plot {
-            for ext in ["png", "svg"] {
-                plot_optimal_mass_ratio(
-                    &dir.join(format!("optimal_mass_ratio.{ext}")),
-                    &ws,
-                    &rs,
-                    fit.as_ref(),
-                    (args.omega_from, args.omega_to),
-                )?;
-            }
+            crate::plots::both(dir, "optimal_mass_ratio", |path| {
+                plot_optimal_mass_ratio(path, &ws, &rs, fit.as_ref(), (args.omega_from, args.omega_to))
+            })?;
         }
     }
     Ok(())

@@ -11,7 +11,7 @@ use crate::output::{CsvFile, column, numbers, read_csv, si};
 use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series};
 
 /// Writes `name.png` and `name.svg` in `dir` with `draw`.
-fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<()> {
+pub(crate) fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<()> {
     for ext in ["png", "svg"] {
         draw(&dir.join(format!("{name}.{ext}")))?;
     }

@@ -301,14 +301,9 @@ fn run_series(loaded: &Loaded, periods: u64, keep: u64, spp: u64, electrical: bo
     })
 }
 
-fn png(ctx: &Ctx, name: &str) -> PathBuf {
-    ctx.path(&format!("{name}.png"))
-}
-
-/// Draws `draw` as PNG and SVG; returns the PNG's file name.
+/// Draws `draw` as PNG and SVG in the output directory; returns the PNG's file name.
 fn both(ctx: &Ctx, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<String> {
-    draw(&png(ctx, name))?;
-    draw(&ctx.path(&format!("{name}.svg")))?;
+    crate::plots::both(&ctx.out, name, draw)?;
     Ok(format!("{name}.png"))
 }
 
