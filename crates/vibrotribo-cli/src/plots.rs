@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use vibrotribo::analysis::{WelchOptions, welch_psd};
 
-use crate::output::{CsvFile, column, numbers, read_csv, si};
+use crate::output::{CsvFile, column, numbers, read_csv, read_json, si};
 use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series};
 
 /// Writes `name.png` and `name.svg` in `dir` with `draw`.
@@ -16,11 +16,6 @@ pub(crate) fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -
         draw(&dir.join(format!("{name}.{ext}")))?;
     }
     Ok(())
-}
-
-fn read_json(path: &Path) -> Result<serde_json::Value> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
 }
 
 /// Draws whatever `dir` holds: a `simulate`, `sweep` or `map` output directory.

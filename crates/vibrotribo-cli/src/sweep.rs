@@ -12,7 +12,7 @@ use vibrotribo::analysis::{PointOptions, PointResult, run_point};
 use vibrotribo::{ChainParams, ChainState};
 
 use crate::config::{ConfigArgs, Loaded, RunSpec};
-use crate::output::{CsvFile, create_dir, numbered, point_cells, point_columns, write_json};
+use crate::output::{CsvFile, create_dir, numbered, point_cells, point_columns, read_json, write_json};
 use crate::progress::{Progress, interrupted};
 
 /// Direction of parameter continuation.
@@ -529,11 +529,7 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let mut seen = vec![];
     let mut complete = true;
     for dir in &args.shards {
-        let path = dir.join("sweep.json");
-        let text =
-            std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let mut s: serde_json::Value =
-            serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))?;
+        let mut s = read_json(&dir.join("sweep.json"))?;
         let shard = s["shard"].clone();
         if shard.is_null() {
             bail!("{} is not a shard (it was run without --shard)", dir.display());
