@@ -126,7 +126,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         create_dir(dir)?;
         let mut csv = CsvFile::create(
             &dir.join("load_sweep.csv"),
-            &["load_resistance_ohm", "average_power_w", "energy_per_period_j"].map(String::from),
+            &["load_resistance_ohm", "average_power_w", "energy_per_period_j"],
         )?;
         for p in &sweep.points {
             csv.row([p.resistance_ohm, p.average_power_w, p.energy_per_period_j])?;
@@ -136,7 +136,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         let last = spec.periods - 1;
         let mut vq = CsvFile::create(
             &dir.join("vq_cycle.csv"),
-            &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"].map(String::from),
+            &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"],
         )?;
         let mut cycles = Vec::new();
         let mut margins = Vec::new();

@@ -268,8 +268,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                     "impacts_per_period",
                     "period",
                     "error",
-                ]
-                .map(String::from),
+                ],
             )?)
         }
         None => None,
@@ -362,8 +361,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                 "average_power_w",
                 "at_edge",
                 "paper_fit",
-            ]
-            .map(String::from),
+            ],
         )?;
         for (w, r, p, edge) in &optimum {
             let paper = paper_fit(*w);

@@ -16,14 +16,15 @@ pub struct CsvFile {
 
 impl CsvFile {
     /// Creates `path` and writes the header `columns`.
-    pub fn create(path: &Path, columns: &[String]) -> Result<Self> {
+    pub fn create(path: &Path, columns: &[impl AsRef<str>]) -> Result<Self> {
         let file = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
         let mut f = CsvFile {
             path: path.to_path_buf(),
             out: BufWriter::new(file),
             line: String::new(),
         };
-        f.out.write_all(columns.join(",").as_bytes())?;
+        let header: Vec<&str> = columns.iter().map(AsRef::as_ref).collect();
+        f.out.write_all(header.join(",").as_bytes())?;
         f.out.write_all(b"\n")?;
         Ok(f)
     }

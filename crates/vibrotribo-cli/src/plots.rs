@@ -299,7 +299,7 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
     );
     let mut csv = CsvFile::create(
         &dir.join("poincare_impacts.csv"),
-        &["time_s", "phase", "contact", "rel_velocity_m_s"].map(String::from),
+        &["time_s", "phase", "contact", "rel_velocity_m_s"],
     )?;
     let mut per_contact: Vec<(Vec<f64>, Vec<f64>)> = vec![(vec![], vec![]); masses - 1];
     for r in erows.iter().filter(|r| r[kc] == "impact") {
@@ -357,7 +357,7 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         };
         let mut csv = CsvFile::create(
             &dir.join(format!("psd_x{}.csv", i + 1)),
-            &["frequency_hz", "psd_m2_per_hz"].map(String::from),
+            &["frequency_hz", "psd_m2_per_hz"],
         )?;
         for (f, p) in psd.frequencies.iter().zip(&psd.density) {
             csv.row([*f, *p])?;

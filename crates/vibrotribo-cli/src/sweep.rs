@@ -317,7 +317,7 @@ impl SweepFiles {
             orbit: CsvFile::create(&dir.join("orbit.csv"), &orbit_cols)?,
             impacts: CsvFile::create(
                 &dir.join("impacts.csv"),
-                &["param", "time_s", "contact", "rel_velocity_m_s"].map(String::from),
+                &["param", "time_s", "contact", "rel_velocity_m_s"],
             )?,
             summary: CsvFile::create(&dir.join("summary.csv"), &summary_cols)?,
             contacts: masses - 1,
