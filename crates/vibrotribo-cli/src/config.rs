@@ -260,7 +260,6 @@ impl Loaded {
     }
 
     /// A copy with `key` set to a number (used by sweeps).
-    #[allow(dead_code)] // used by the sweep commands
     pub fn with(&self, key: &str, value: f64) -> Result<Self> {
         let mut table = self.table.clone();
         set_key(&mut table, key, Value::Float(value))?;
