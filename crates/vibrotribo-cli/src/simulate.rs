@@ -8,7 +8,9 @@ use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
 use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
-use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, TransducerMode};
+use vibrotribo::electrical::{
+    ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, PowerSummary, TransducerMode,
+};
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
 use crate::config::{ConfigArgs, Loaded, RunSpec};
@@ -272,19 +274,19 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     progress.finish();
-    let elapsed = started.elapsed().as_secs_f64();
-    let summary = summary_json(
-        &loaded,
-        &params,
-        &spec,
-        &rec,
-        harvester.as_ref(),
+    let outcome = Outcome {
         done,
-        elapsed,
-        failure.as_ref(),
-    );
+        elapsed: started.elapsed().as_secs_f64(),
+        impacts_per_period: rec.stats.impacts_per_period(done),
+        power: rec
+            .solver
+            .as_ref()
+            .and_then(|s| s.summary(spec.transient_periods as usize)),
+        failure,
+    };
     if let (Some(files), Some(dir)) = (rec.files.as_mut(), &args.out) {
         files.flush()?;
+        let summary = summary_json(&loaded, &params, &spec, &rec, harvester.as_ref(), &outcome);
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
             crate::plots::analyze_run(dir, None)?;
@@ -295,11 +297,10 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         &spec,
         &rec,
         harvester.as_ref(),
-        done,
-        elapsed,
+        &outcome,
         args.out.as_deref(),
     );
-    if let Some(e) = failure {
+    if let Some(e) = outcome.failure {
         return Err(e).context(format!("simulation stopped after {done} complete periods"));
     }
     if done < spec.periods {
@@ -311,19 +312,32 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
+/// How a run ended and what it found, for the printed summary and `summary.json`.
+struct Outcome {
+    /// Complete periods simulated.
+    done: u64,
+    /// Wall time, s.
+    elapsed: f64,
+    /// Impacts per period after the transient, per contact.
+    impacts_per_period: Vec<f64>,
+    /// The harvester's power after the transient (`None` without a harvester or a complete
+    /// period after the transient).
+    power: Option<PowerSummary>,
+    /// Why the run stopped early, if it failed.
+    failure: Option<anyhow::Error>,
+}
+
 fn summary_json(
     loaded: &Loaded,
     params: &ChainParams,
     spec: &RunSpec,
     rec: &Recorder,
     harvester: Option<&HarvesterParams>,
-    done: u64,
-    elapsed: f64,
-    failure: Option<&anyhow::Error>,
+    outcome: &Outcome,
 ) -> serde_json::Value {
     let stats = &rec.stats;
-    let per_contact = stats.impacts_per_period(done);
+    let done = outcome.done;
+    let per_contact = &outcome.impacts_per_period;
     let after = stats.impacts_after_transient();
     let mut out = json!({
         "periods": done,
@@ -345,7 +359,7 @@ fn summary_json(
     });
     let obj = out.as_object_mut().expect("object");
     if let (Some(solver), Some(h)) = (&rec.solver, harvester) {
-        let s = solver.summary(spec.transient_periods as usize);
+        let s = &outcome.power;
         obj.insert(
             "average_power_w".into(),
             json!(s.as_ref().map(|s| s.average_power_w)),
@@ -389,12 +403,15 @@ fn summary_json(
     obj.insert("nondimensional".into(), json!(params.nondimensional()));
     obj.insert("parameters".into(), json!(params));
     obj.insert("settings".into(), json!(loaded.table));
-    obj.insert("wall_time_s".into(), json!(elapsed));
+    obj.insert("wall_time_s".into(), json!(outcome.elapsed));
     obj.insert(
         "interrupted".into(),
-        json!(done < spec.periods && failure.is_none()),
+        json!(done < spec.periods && outcome.failure.is_none()),
     );
-    obj.insert("error".into(), json!(failure.map(|e| format!("{e:#}"))));
+    obj.insert(
+        "error".into(),
+        json!(outcome.failure.as_ref().map(|e| format!("{e:#}"))),
+    );
     out
 }
 
@@ -403,13 +420,12 @@ fn print_summary(
     spec: &RunSpec,
     rec: &Recorder,
     harvester: Option<&HarvesterParams>,
-    done: u64,
-    elapsed: f64,
+    outcome: &Outcome,
     out: Option<&Path>,
 ) {
     let stats = &rec.stats;
     let n = params.len();
-    let per_contact = stats.impacts_per_period(done);
+    let per_contact = &outcome.impacts_per_period;
     println!(
         "vibrotribo simulate: {n} masses {:?} kg, Ω = {:.4} (ω = {:.3} rad/s, f = {:.4} Hz, T = {:.6} s)",
         params.masses,
@@ -419,8 +435,8 @@ fn print_summary(
         params.period()
     );
     println!(
-        "  simulated {done} periods ({} transient) in {:.3} s: {} events",
-        spec.transient_periods, elapsed, stats.events
+        "  simulated {} periods ({} transient) in {:.3} s: {} events",
+        outcome.done, spec.transient_periods, outcome.elapsed, stats.events
     );
     let contacts: Vec<String> = per_contact
         .iter()
@@ -447,7 +463,7 @@ fn print_summary(
             LoadKind::Rectifier => format!("rectifier into {}", si(h.storage_capacitance, "F")),
             other => other.as_str().to_string(),
         };
-        match solver.summary(spec.transient_periods as usize) {
+        match &outcome.power {
             Some(s) => println!(
                 "  harvester ({}, V_oc {}, {load}): average power {} after the transient, {} per period, peak current {}, peak voltage {}",
                 h.mode.as_str(),
