@@ -11,7 +11,6 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use toml::{Table, Value};
 use vibrotribo::analysis::{PointResult, WelchOptions, fit_quadratic, welch_psd};
-use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
 use vibrotribo::electrical::{
     ChargeOptions, ChargeSolver, HarvesterParams, VocModel, load_sweep, log_spaced,
 };
@@ -20,6 +19,7 @@ use vibrotribo::{
 };
 
 use crate::config::{Loaded, set_key};
+use crate::load_sweep::breakdown_over_vq_cycle;
 use crate::map::{paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::{create_dir, si};
 use crate::plot::{self, Figure, Legend, Scale, Series};
@@ -1842,16 +1842,28 @@ fn extras(ctx: &mut Ctx) -> Result<()> {
     let mut traj = Trajectory::new(&sim);
     sim.run_until(periods as f64 * chain.period(), &mut traj)?;
     let transient = periods as usize / 2;
-    let mut powers = Vec::new();
-    for model in [VocModel::Paper, VocModel::Exact] {
+    let average_power = |s: &ChargeSolver| s.summary(transient).map_or(f64::NAN, |s| s.average_power_w);
+    // Air breakdown over the last period at a load resistance, on the paper's harvester.
+    let breakdown_at = |r: f64| {
         let h = HarvesterParams {
-            voc_model: model,
+            load_resistance: r,
             ..HarvesterParams::default()
         };
-        let mut s = ChargeSolver::for_chain(&h, &chain, ChargeOptions::default())?;
-        s.run_trajectory(&traj)?;
-        powers.push(s.summary(transient).map_or(f64::NAN, |s| s.average_power_w));
-    }
+        breakdown_over_vq_cycle(&h, &chain, &ChargeOptions::default(), &traj, periods - 1, 2000)
+    };
+    // The paper's case (100 kΩ, the paper's V_oc): its power comes from the same run (the
+    // V–Q recording does not change the solver's steps).
+    let (paper, paper_margin) = breakdown_at(1e5)?;
+    let mut exact = ChargeSolver::for_chain(
+        &HarvesterParams {
+            voc_model: VocModel::Exact,
+            ..HarvesterParams::default()
+        },
+        &chain,
+        ChargeOptions::default(),
+    )?;
+    exact.run_trajectory(&traj)?;
+    let powers = [average_power(&paper), average_power(&exact)];
     let sweep = load_sweep(
         &traj,
         &HarvesterParams::default(),
@@ -1871,29 +1883,10 @@ fn extras(ctx: &mut Ctx) -> Result<()> {
     fig.legend = Legend::Hidden;
     let img = lines(ctx, "extra_load_sweep", &fig, &[("P_a", &xs, &ys)])?;
     let best = sweep.optimum;
-    // Air breakdown over the last period at the paper's load and at the optimum.
-    let mut margins = Vec::new();
-    for r in [1e5, best.resistance_ohm] {
-        let h = HarvesterParams {
-            load_resistance: r,
-            ..HarvesterParams::default()
-        };
-        let last = periods - 1;
-        let mut s =
-            ChargeSolver::for_chain(&h, &chain, ChargeOptions::default())?.with_vq_cycle(last, 2000)?;
-        s.run_trajectory(&traj)?;
-        let mut margin = BreakdownMargin::default();
-        let (mut d, mut rates) = ([0.0; 2], [0.0; 2]);
-        if let Some(c) = s.vq_cycle() {
-            for (j, &t) in c.times.iter().enumerate() {
-                if let Some(flow) = traj.flow_at(t) {
-                    flow.gaps_at(t, &mut d, &mut rates);
-                    margin.add(&h, &PaschenParams::default(), t, c.charge_c[j], d[0], d[1]);
-                }
-            }
-        }
-        margins.push(margin.worst_ratio);
-    }
+    let margins = [
+        paper_margin.worst_ratio,
+        breakdown_at(best.resistance_ohm)?.1.worst_ratio,
+    ];
     ctx.figure(
         "extra",
         "Average power against the load resistance",

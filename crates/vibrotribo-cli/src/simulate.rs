@@ -7,13 +7,14 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
-use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
+use vibrotribo::electrical::breakdown::BreakdownMargin;
 use vibrotribo::electrical::{
     ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, PowerSummary, TransducerMode,
 };
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
 use crate::config::{ConfigArgs, Loaded, RunSpec};
+use crate::harvester::add_breakdown_sample;
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Progress, interrupted};
 
@@ -47,10 +48,12 @@ struct Files {
     gaps: Vec<f64>,
     x: Vec<f64>,
     v: Vec<f64>,
+    /// The gaps d_k at the current sample, m.
+    d: Vec<f64>,
     row: Vec<f64>,
-    electrical: bool,
     rectifier: bool,
-    /// Air breakdown check over the samples after the transient (with a harvester).
+    /// With a harvester (electrical columns): the air breakdown check over the samples after
+    /// the transient (harvester, margin so far, end of the transient in s).
     breakdown: Option<(HarvesterParams, BreakdownMargin, f64)>,
     error: Option<anyhow::Error>,
 }
@@ -97,8 +100,8 @@ impl Files {
             gaps: params.gaps.clone(),
             x: vec![0.0; n],
             v: vec![0.0; n],
+            d: vec![0.0; n - 1],
             row: Vec::with_capacity(tr_cols.len()),
-            electrical: harvester.is_some(),
             rectifier,
             breakdown: harvester.map(|h| {
                 (
@@ -136,12 +139,14 @@ impl Files {
             }
             flow.state_at(t, &mut self.x, &mut self.v);
             let (y, _) = flow.base_at(t);
-            let n = self.x.len();
+            for (k, d) in self.d.iter_mut().enumerate() {
+                *d = self.gaps[k] - (self.x[k + 1] - self.x[k]);
+            }
             self.row.clear();
             self.row.push(t);
             self.row.extend_from_slice(&self.x);
             self.row.extend_from_slice(&self.v);
-            if self.electrical {
+            if let Some((h, margin, from)) = self.breakdown.as_mut() {
                 let idx = j as usize;
                 let at = |v: &[f64]| v.get(idx).copied().unwrap_or(f64::NAN);
                 let e = samples.filter(|s| s.times.get(idx).is_some_and(|&ts| ts == t));
@@ -154,22 +159,12 @@ impl Files {
                 if self.rectifier {
                     self.row.push(get(|s| &s.storage_voltage_v));
                 }
-                if let Some((h, margin, from)) = self.breakdown.as_mut()
-                    && t >= *from
-                {
-                    let (d1, d2) = (
-                        self.gaps[h.contact] - (self.x[h.contact + 1] - self.x[h.contact]),
-                        self.gaps.get(h.contact + 1).map_or(0.0, |g| {
-                            g - (self.x[(h.contact + 2).min(n - 1)] - self.x[h.contact + 1])
-                        }),
-                    );
-                    margin.add(h, &PaschenParams::default(), t, get(|s| &s.charge_c), d1, d2);
+                if t >= *from {
+                    add_breakdown_sample(margin, h, t, get(|s| &s.charge_c), &self.d);
                 }
             }
             self.row.push(y);
-            for k in 0..n - 1 {
-                self.row.push(self.gaps[k] - (self.x[k + 1] - self.x[k]));
-            }
+            self.row.extend_from_slice(&self.d);
             let r = self.trajectory.row(self.row.iter());
             self.keep(r);
             self.next_sample += 1;
