@@ -228,6 +228,22 @@ pub fn refine_maximum(grid: &[f64], values: &[f64]) -> Option<(f64, f64)> {
     Some((grid[best] + shift * h, b - 0.25 * (a - c) * shift))
 }
 
+/// The optimal mass ratio at each Ω of `omegas`: the maximum of its row of `power` (row-major,
+/// `ratios.len()` mass ratios per Ω) refined by [`refine_maximum`], as (Ω, R_mo, power there
+/// in W, whether R_mo is at an end of `ratios`). An Ω without a finite power is left out.
+pub(crate) fn optima(omegas: &[f64], ratios: &[f64], power: &[f64]) -> Vec<(f64, f64, f64, bool)> {
+    let (first, last) = (ratios[0], ratios[ratios.len() - 1]);
+    omegas
+        .iter()
+        .zip(power.chunks(ratios.len()))
+        .filter_map(|(&w, row)| {
+            let (r, p) = refine_maximum(ratios, row)?;
+            let at_edge = (r - first).abs() < 1e-12 || (r - last).abs() < 1e-12;
+            Some((w, r, p, at_edge))
+        })
+        .collect()
+}
+
 /// Runs `vibrotribo optimize-mass-ratio`.
 pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     check_axis("omega", args.omega_from, args.omega_to, args.omega_steps)?;
@@ -304,14 +320,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         bail!("interrupted after {done} of {} points", points.len());
     }
     let n = ratios.len();
-    let mut optimum = Vec::new();
-    for (i, &w) in omegas.iter().enumerate() {
-        let row = &power[i * n..(i + 1) * n];
-        if let Some((r, p)) = refine_maximum(&ratios, row) {
-            let at_edge = (r - ratios[0]).abs() < 1e-12 || (r - ratios[n - 1]).abs() < 1e-12;
-            optimum.push((w, r, p, at_edge));
-        }
-    }
+    let optimum = optima(&omegas, &ratios, &power);
     let ws: Vec<f64> = optimum.iter().map(|o| o.0).collect();
     let rs: Vec<f64> = optimum.iter().map(|o| o.1).collect();
     let fit = fit_quadratic(&ws, &rs).ok();

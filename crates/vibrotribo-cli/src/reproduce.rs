@@ -20,7 +20,7 @@ use vibrotribo::{
 
 use crate::config::{Loaded, set_key};
 use crate::load_sweep::breakdown_over_vq_cycle;
-use crate::map::{paper_fit, plot_optimal_mass_ratio, refine_maximum};
+use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::{create_dir, si};
 use crate::plot::{self, Figure, Legend, Scale, Series};
 use crate::progress::interrupted;
@@ -1297,12 +1297,7 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
                 .map(|p| p.average_power_w.unwrap_or(f64::NAN))
         })
         .collect::<Result<_>>()?;
-    let mut opt = Vec::new();
-    for (i, &w) in omegas.iter().enumerate() {
-        if let Some((r, _)) = refine_maximum(&ratios, &pw[i * ratios.len()..(i + 1) * ratios.len()]) {
-            opt.push((w, r));
-        }
-    }
+    let opt = optima(&omegas, &ratios, &pw);
     let ws: Vec<f64> = opt.iter().map(|o| o.0).collect();
     let rs: Vec<f64> = opt.iter().map(|o| o.1).collect();
     let fit = fit_quadratic(&ws, &rs).ok();
