@@ -625,8 +625,9 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         ("oscillator.masses", arr(&[0.09, 0.12, 0.09])),
         ("omega_ratio", f(0.70)),
     ])?;
+    // Orbit and impact-velocity diagrams only: the mechanics (the coupling is one-way).
     let values = grid(1.0, 1.6, ctx.budget.coarse);
-    let results = sweep(ctx, &base, "gap_ratio", &values, false)?;
+    let results = sweep(ctx, &base, "gap_ratio", &values, true)?;
     let a = orbit_figure(
         ctx,
         "fig07a_orbit_x2",
@@ -638,7 +639,7 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         1.0 / 0.020,
     )?;
     let fine = grid(1.40, 1.52, ctx.budget.fine);
-    let fres = sweep(ctx, &base, "gap_ratio", &fine, false)?;
+    let fres = sweep(ctx, &base, "gap_ratio", &fine, true)?;
     let b = orbit_figure(
         ctx,
         "fig07b_orbit_x2_zoom",
