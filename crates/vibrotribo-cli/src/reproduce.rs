@@ -311,10 +311,9 @@ fn orbit_points(values: &[f64], results: &[PointResult], mass: usize, scale: f64
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     for (v, r) in values.iter().zip(results) {
-        let n = r.strobe.len() / r.strobe_periods.len().max(1);
-        for j in 0..r.strobe_periods.len() {
+        for x in r.position_series(mass) {
             xs.push(*v);
-            ys.push(r.strobe[j * n + mass] * scale);
+            ys.push(x * scale);
         }
     }
     (xs, ys)
@@ -894,10 +893,7 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
             let de: Vec<f64> = psd.density[1..].to_vec();
             images.push(lines(ctx, &format!("fig10_psd_{r}"), &fig, &[("PSD", &fr, &de)])?);
         }
-        let n = p.strobe.len() / p.strobe_periods.len().max(1);
-        let x2: Vec<f64> = (0..p.strobe_periods.len())
-            .map(|j| p.strobe[j * n + 1] / 0.020)
-            .collect();
+        let x2: Vec<f64> = p.position_series(1).map(|x| x / 0.020).collect();
         let next: Vec<f64> = x2.iter().skip(1).copied().collect();
         let mut fig = Figure::new(
             format!("Poincaré section of X2 at R_δ = {r}: X2(n+1) against X2(n)"),
@@ -1019,12 +1015,7 @@ fn fig_12(ctx: &mut Ctx) -> Result<()> {
     // Amplitude: largest |x2| over the recorded samples, and its trend (Spearman's ρ).
     let amp: Vec<f64> = res
         .iter()
-        .map(|r| {
-            let n = r.strobe.len() / r.strobe_periods.len().max(1);
-            (0..r.strobe_periods.len())
-                .map(|j| r.strobe[j * n + 1].abs())
-                .fold(0.0, f64::max)
-        })
+        .map(|r| r.position_series(1).map(f64::abs).fold(0.0, f64::max))
         .collect();
     let rho = spearman(&values, &amp);
     ctx.finding(
@@ -1540,12 +1531,9 @@ fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         },
     )?;
     let p = long.run(&[("mass_ratio", 4.21)], None)?;
-    let n = 3;
     let mut images = Vec::new();
     for i in 0..3 {
-        let xi: Vec<f64> = (0..p.strobe_periods.len())
-            .map(|j| p.strobe[j * n + i] / 0.020)
-            .collect();
+        let xi: Vec<f64> = p.position_series(i).map(|x| x / 0.020).collect();
         let next: Vec<f64> = xi.iter().skip(1).copied().collect();
         let mut fig = Figure::new(
             format!("Poincaré section of X{} at Ω = 0.30, R_m = 4.21", i + 1),
