@@ -344,7 +344,7 @@ fn orbit_figure(
     scale: f64,
 ) -> Result<String> {
     let (x, y) = orbit_points(values, results, 1, scale);
-    scatter(ctx, name, title, xl, yl, &[("X2", &x, &y)])
+    scatter(ctx, name, Figure::new(title, xl, yl), &x, &y, 2)
 }
 
 /// An impact-velocity diagram (closing speeds at `contact` against the parameter).
@@ -360,25 +360,33 @@ fn impact_figure(
     contact: usize,
 ) -> Result<String> {
     let (x, y) = impact_points(values, results, contact);
-    scatter(ctx, name, title, xl, yl, &[("V", &x, &y)])
+    scatter(ctx, name, Figure::new(title, xl, yl), &x, &y, 2)
 }
 
-fn scatter(
+/// The points (`x`, `y`) as marks of `marker_px` pixels, without a legend.
+fn scatter(ctx: &Ctx, name: &str, mut fig: Figure, x: &[f64], y: &[f64], marker_px: u32) -> Result<String> {
+    fig.legend = Legend::Hidden;
+    both(ctx, name, |p| {
+        plot::scatter_plot(p, &fig, &[Series::unlabelled(x, y)], marker_px)
+    })
+}
+
+/// The return map (Poincaré section) X(n+1) against X(n) of mass `mass` (0-based) of `p`,
+/// X = x/`delta1` at t = nT.
+fn return_map(
     ctx: &Ctx,
     name: &str,
-    title: &str,
-    xl: &str,
-    yl: &str,
-    series: &[(&str, &[f64], &[f64])],
+    title: String,
+    p: &PointResult,
+    mass: usize,
+    delta1: f64,
+    marker_px: u32,
 ) -> Result<String> {
-    let mut fig = Figure::new(title, xl, yl);
-    if series.len() == 1 {
-        fig.legend = Legend::Hidden;
-    }
-    both(ctx, name, |p| {
-        let s: Vec<Series> = series.iter().map(|(l, x, y)| Series::new(l, x, y)).collect();
-        plot::scatter_plot(p, &fig, &s, 2)
-    })
+    let x: Vec<f64> = p.position_series(mass).map(|x| x / delta1).collect();
+    let next = &x[x.len().min(1)..];
+    let label = format!("X{}", mass + 1);
+    let fig = Figure::new(title, format!("{label}(n)"), format!("{label}(n+1)"));
+    scatter(ctx, name, fig, &x[..next.len()], next, marker_px)
 }
 
 fn lines(ctx: &Ctx, name: &str, fig: &Figure, series: &[(&str, &[f64], &[f64])]) -> Result<String> {
@@ -893,17 +901,15 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
             let de: Vec<f64> = psd.density[1..].to_vec();
             images.push(lines(ctx, &format!("fig10_psd_{r}"), &fig, &[("PSD", &fr, &de)])?);
         }
-        let x2: Vec<f64> = p.position_series(1).map(|x| x / 0.020).collect();
-        let next: Vec<f64> = x2.iter().skip(1).copied().collect();
-        let mut fig = Figure::new(
+        images.push(return_map(
+            ctx,
+            &format!("fig10_poincare_{r}"),
             format!("Poincaré section of X2 at R_δ = {r}: X2(n+1) against X2(n)"),
-            "X2(n)",
-            "X2(n+1)",
-        );
-        fig.legend = Legend::Hidden;
-        images.push(both(ctx, &format!("fig10_poincare_{r}"), |path| {
-            plot::scatter_plot(path, &fig, &[Series::unlabelled(&x2[..next.len()], &next)], 5)
-        })?);
+            p,
+            1,
+            0.020,
+            5,
+        )?);
     }
     ctx.figure(
         "10",
@@ -937,15 +943,12 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         .iter()
         .map(|p| p.average_power_w.unwrap_or(f64::NAN))
         .collect();
-    let mut fig = Figure::new(
+    let fig = Figure::new(
         format!("Average power of the four motions (R_δ = {})", labels.join(", ")),
         "motion (0: 1.415, 1: 1.423, 2: 1.430, 3: 1.512)",
         "P_a [W]",
     );
-    fig.legend = Legend::Hidden;
-    let img = both(ctx, "fig11_power", |p| {
-        plot::scatter_plot(p, &fig, &[Series::unlabelled(&xs, &ys)], 9)
-    })?;
+    let img = scatter(ctx, "fig11_power", fig, &xs, &ys, 9)?;
     ctx.figure(
         "11",
         "Average power of the four motions",
@@ -1533,17 +1536,15 @@ fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
     let p = long.run(&[("mass_ratio", 4.21)], None)?;
     let mut images = Vec::new();
     for i in 0..3 {
-        let xi: Vec<f64> = p.position_series(i).map(|x| x / 0.020).collect();
-        let next: Vec<f64> = xi.iter().skip(1).copied().collect();
-        let mut fig = Figure::new(
+        images.push(return_map(
+            ctx,
+            &format!("fig19_poincare_x{}", i + 1),
             format!("Poincaré section of X{} at Ω = 0.30, R_m = 4.21", i + 1),
-            format!("X{}(n)", i + 1),
-            format!("X{}(n+1)", i + 1),
-        );
-        fig.legend = Legend::Hidden;
-        images.push(both(ctx, &format!("fig19_poincare_x{}", i + 1), |path| {
-            plot::scatter_plot(path, &fig, &[Series::unlabelled(&xi[..next.len()], &next)], 3)
-        })?);
+            &p,
+            i,
+            0.020,
+            3,
+        )?);
     }
     let period_421 = p.period();
     ctx.figure(
