@@ -195,25 +195,29 @@ fn sweep(
     Ok(results)
 }
 
-/// Samples and events of one run, for time histories.
+/// Samples and impacts of one run, for time histories.
 #[derive(Default)]
 struct Series1 {
     t: Vec<f64>,
     x: Vec<Vec<f64>>,
     v: Vec<Vec<f64>>,
+    /// The gaps d_k, m.
     d: Vec<Vec<f64>>,
-    events: Vec<(f64, EventKind, usize, f64, Vec<f64>)>,
+    /// Their rates d_k', m/s.
+    rate: Vec<Vec<f64>>,
+    /// Each impact's contact (0-based) and the positions of the masses then.
+    impacts: Vec<(usize, Vec<f64>)>,
 }
 
 struct SeriesObserver {
     keep_from: f64,
     dt: f64,
     next: u64,
-    n: usize,
-    gaps: Vec<f64>,
     data: Series1,
     xbuf: Vec<f64>,
     vbuf: Vec<f64>,
+    dbuf: Vec<f64>,
+    rbuf: Vec<f64>,
 }
 
 impl Observer for SeriesObserver {
@@ -228,27 +232,26 @@ impl Observer for SeriesObserver {
                 continue;
             }
             flow.state_at(t, &mut self.xbuf, &mut self.vbuf);
+            flow.gaps_at(t, &mut self.dbuf, &mut self.rbuf);
             self.data.t.push(t);
-            for i in 0..self.n {
-                self.data.x[i].push(self.xbuf[i]);
-                self.data.v[i].push(self.vbuf[i]);
-            }
-            for k in 0..self.n - 1 {
-                self.data.d[k].push(self.gaps[k] - (self.xbuf[k + 1] - self.xbuf[k]));
-            }
+            push_each(&mut self.data.x, &self.xbuf);
+            push_each(&mut self.data.v, &self.vbuf);
+            push_each(&mut self.data.d, &self.dbuf);
+            push_each(&mut self.data.rate, &self.rbuf);
         }
     }
 
     fn event(&mut self, e: &Event, state: &StateView<'_>) {
-        if e.time >= self.keep_from {
-            self.data.events.push((
-                e.time,
-                e.kind,
-                e.contact,
-                e.velocity_before,
-                state.positions.to_vec(),
-            ));
+        if e.kind == EventKind::Impact && e.time >= self.keep_from {
+            self.data.impacts.push((e.contact, state.positions.to_vec()));
         }
+    }
+}
+
+/// Appends `values[i]` to `series[i]`.
+fn push_each(series: &mut [Vec<f64>], values: &[f64]) {
+    for (s, &v) in series.iter_mut().zip(values) {
+        s.push(v);
     }
 }
 
@@ -272,16 +275,17 @@ fn run_series(loaded: &Loaded, periods: u64, keep: u64, spp: u64, electrical: bo
         keep_from,
         dt,
         next: 0,
-        n,
-        gaps: params.gaps.clone(),
         data: Series1 {
             x: vec![Vec::new(); n],
             v: vec![Vec::new(); n],
             d: vec![Vec::new(); n - 1],
+            rate: vec![Vec::new(); n - 1],
             ..Series1::default()
         },
         xbuf: vec![0.0; n],
         vbuf: vec![0.0; n],
+        dbuf: vec![0.0; n - 1],
+        rbuf: vec![0.0; n - 1],
     };
     let mut solver = if electrical {
         let h = loaded.harvester(&params)?;
@@ -396,6 +400,28 @@ fn lines(ctx: &Ctx, name: &str, fig: &Figure, series: &[(&str, &[f64], &[f64])])
     })
 }
 
+/// The gap D1 of `s` at `at` (e.g. `R_δ = 1.085`): its time history (title ending in
+/// `history`) and its phase plot, as `{fig}_d1_{tag}` and `{fig}_phase_{tag}`.
+fn d1_figures(
+    ctx: &Ctx,
+    s: &Series1,
+    (fig, tag): (&str, f64),
+    at: &str,
+    history: &str,
+) -> Result<[String; 2]> {
+    let time = Figure::new(format!("D1 at {at}{history}"), "time t [s]", "D1 [m]");
+    let phase = Figure::new(format!("D1 at {at}: phase plot"), "D1 [m]", "dD1/dt [m/s]");
+    Ok([
+        lines(ctx, &format!("{fig}_d1_{tag}"), &time, &[("D1", &s.t, &s.d[0])])?,
+        lines(
+            ctx,
+            &format!("{fig}_phase_{tag}"),
+            &phase,
+            &[("D1", &s.d[0], &s.rate[0])],
+        )?,
+    ])
+}
+
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
 }
@@ -485,10 +511,7 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
         let run = run_series(&loaded, periods, 20, 200, false)?;
         let s = &run.series;
         let mut side = [[false; 2]; 3]; // [mass][below, above]
-        for (_, kind, contact, _, x) in &s.events {
-            if *kind != EventKind::Impact {
-                continue;
-            }
+        for (contact, x) in &s.impacts {
             for i in [*contact, contact + 1] {
                 side[i][usize::from(x[i] > 0.0)] = true;
             }
@@ -715,25 +738,12 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     let mut images = Vec::new();
     for r in [1.085, 1.090] {
         let run = run_series(&base.with("gap_ratio", r)?, ctx.budget.series, 2, 400, false)?;
-        let s = &run.series;
-        let fig = Figure::new(
-            format!("D1 at R_δ = {r}: time history (last two periods)"),
-            "time t [s]",
-            "D1 [m]",
-        );
-        images.push(lines(
+        images.extend(d1_figures(
             ctx,
-            &format!("fig08_d1_{r}"),
-            &fig,
-            &[("D1", &s.t, &s.d[0])],
-        )?);
-        let rate: Vec<f64> = (0..s.t.len()).map(|j| s.v[0][j] - s.v[1][j]).collect();
-        let fig = Figure::new(format!("D1 at R_δ = {r}: phase plot"), "D1 [m]", "dD1/dt [m/s]");
-        images.push(lines(
-            ctx,
-            &format!("fig08_phase_{r}"),
-            &fig,
-            &[("D1", &s.d[0], &rate)],
+            &run.series,
+            ("fig08", r),
+            &format!("R_δ = {r}"),
+            ": time history (last two periods)",
         )?);
     }
     ctx.figure(
@@ -1062,12 +1072,7 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
         let solver = run.solver.as_ref().expect("electrical");
         let samples = solver.samples().expect("sampled");
         // Impacts per period between m1 and m2 over the kept two periods.
-        let impacts12 = s
-            .events
-            .iter()
-            .filter(|e| e.1 == EventKind::Impact && e.2 == 0)
-            .count() as f64
-            / 2.0;
+        let impacts12 = s.impacts.iter().filter(|(contact, _)| *contact == 0).count() as f64 / 2.0;
         let p = solver.power_curve().last().copied().unwrap_or(f64::NAN);
         per.push((r, impacts12, p));
         let fig = Figure::new(
@@ -1112,12 +1117,7 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
         ("run.initial_velocities", arr(&[-1.0, 0.5, 1.5])),
     ])?;
     let run = run_series(&equal, 400, 100, 10, false)?;
-    let late_impacts = run
-        .series
-        .events
-        .iter()
-        .filter(|e| e.1 == EventKind::Impact)
-        .count();
+    let late_impacts = run.series.impacts.len();
     ctx.figure(
         "13",
         "Gap D1, current and running power for three mass ratios",
@@ -1689,20 +1689,12 @@ fn figs_20_25(ctx: &mut Ctx) -> Result<()> {
         let s = &run.series;
         let solver = run.solver.as_ref().expect("electrical");
         let e = solver.samples().expect("sampled");
-        let fig = Figure::new(format!("D1 at Ω = {w} (one period)"), "time t [s]", "D1 [m]");
-        images22.push(lines(
+        images22.extend(d1_figures(
             ctx,
-            &format!("fig22_d1_{w}"),
-            &fig,
-            &[("D1", &s.t, &s.d[0])],
-        )?);
-        let rate: Vec<f64> = (0..s.t.len()).map(|j| s.v[0][j] - s.v[1][j]).collect();
-        let fig = Figure::new(format!("D1 at Ω = {w}: phase plot"), "D1 [m]", "dD1/dt [m/s]");
-        images22.push(lines(
-            ctx,
-            &format!("fig22_phase_{w}"),
-            &fig,
-            &[("D1", &s.d[0], &rate)],
+            s,
+            ("fig22", *w),
+            &format!("Ω = {w}"),
+            " (one period)",
         )?);
         let sum: Vec<f64> = (0..s.t.len()).map(|j| s.d[0][j] + s.d[1][j]).collect();
         let fig = Figure::new(format!("Gaps at Ω = {w} (one period)"), "time t [s]", "gap [m]");
