@@ -323,13 +323,21 @@ fn orbit_points(values: &[f64], results: &[PointResult], mass: usize, scale: f64
     (xs, ys)
 }
 
+/// Closing speeds, m/s, of the impacts of `r` at `contact` (0-based).
+fn closing_speeds(r: &PointResult, contact: usize) -> impl Iterator<Item = f64> + '_ {
+    r.impacts
+        .iter()
+        .filter(move |i| i.contact == contact)
+        .map(|i| i.closing_speed)
+}
+
 fn impact_points(values: &[f64], results: &[PointResult], contact: usize) -> (Vec<f64>, Vec<f64>) {
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     for (v, r) in values.iter().zip(results) {
-        for i in r.impacts.iter().filter(|i| i.contact == contact) {
+        for speed in closing_speeds(r, contact) {
             xs.push(*v);
-            ys.push(i.closing_speed);
+            ys.push(speed);
         }
     }
     (xs, ys)
@@ -420,6 +428,25 @@ fn d1_figures(
             &[("D1", &s.d[0], &s.rate[0])],
         )?,
     ])
+}
+
+/// Running average powers P_a(N), W, each (label, curve), against the number of periods N.
+fn running_power(
+    ctx: &Ctx,
+    name: &str,
+    title: String,
+    y_scale: Scale,
+    curves: &[(String, Vec<f64>)],
+) -> Result<String> {
+    let mut fig = Figure::new(title, "periods N_p", "P_a [W]");
+    fig.y_scale = y_scale;
+    let longest = curves.iter().map(|(_, c)| c.len()).max().unwrap_or(0);
+    let n: Vec<f64> = (1..=longest).map(|k| k as f64).collect();
+    let series: Vec<(&str, &[f64], &[f64])> = curves
+        .iter()
+        .map(|(l, c)| (l.as_str(), &n[..c.len()], c.as_slice()))
+        .collect();
+    lines(ctx, name, &fig, &series)
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -619,18 +646,13 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
         if means[0] > means[1] {
             better += 1;
         }
-        let n: Vec<f64> = (1..=curves[0].1.len()).map(|k| k as f64).collect();
-        let mut fig = Figure::new(
+        images.push(running_power(
+            ctx,
+            &format!("fig06_omega{w}"),
             format!("Running average power, configurations (1) and (2), Ω = {w}"),
-            "periods N_p",
-            "P_a [W]",
-        );
-        fig.y_scale = Scale::Log;
-        let series: Vec<(&str, &[f64], &[f64])> = curves
-            .iter()
-            .map(|(l, c)| (l.as_str(), &n[..c.len()], c.as_slice()))
-            .collect();
-        images.push(lines(ctx, &format!("fig06_omega{w}"), &fig, &series)?);
+            Scale::Log,
+            &curves,
+        )?);
     }
     ctx.figure(
         "6",
@@ -773,20 +795,9 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     // and the slowest m1–m2 impact next to each.
     let graze_grid = grid(1.40, 1.44, if ctx.quick { 81 } else { 401 });
     let gres = sweep(ctx, &base, "gap_ratio", &graze_grid, true)?;
-    let slowest = |r: &PointResult| {
-        r.impacts
-            .iter()
-            .filter(|i| i.contact == 0)
-            .map(|i| i.closing_speed)
-            .fold(f64::INFINITY, f64::min)
-    };
+    let slowest = |r: &PointResult| closing_speeds(r, 0).fold(f64::INFINITY, f64::min);
     let typical = {
-        let mut v: Vec<f64> = gres[0]
-            .impacts
-            .iter()
-            .filter(|i| i.contact == 0)
-            .map(|i| i.closing_speed)
-            .collect();
+        let mut v: Vec<f64> = closing_speeds(&gres[0], 0).collect();
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
@@ -986,13 +997,7 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
                 .join(", "),
             si(max_p, "W")
         ),
-        if decreasing && max_p < 1e-5 {
-            Verdict::Agrees
-        } else if decreasing || max_p < 1e-5 {
-            Verdict::Partly
-        } else {
-            Verdict::Differs
-        },
+        Verdict::of(usize::from(decreasing) + usize::from(max_p < 1e-5), 2),
     );
     Ok(())
 }
@@ -1073,7 +1078,8 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
         let samples = solver.samples().expect("sampled");
         // Impacts per period between m1 and m2 over the kept two periods.
         let impacts12 = s.impacts.iter().filter(|(contact, _)| *contact == 0).count() as f64 / 2.0;
-        let p = solver.power_curve().last().copied().unwrap_or(f64::NAN);
+        let curve = solver.power_curve();
+        let p = curve.last().copied().unwrap_or(f64::NAN);
         per.push((r, impacts12, p));
         let fig = Figure::new(
             format!("D1 at R_m = {r} (last two periods)"),
@@ -1097,18 +1103,12 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
             &fig,
             &[("I", &samples.times, &samples.current_a)],
         )?);
-        let curve = solver.power_curve();
-        let n: Vec<f64> = (1..=curve.len()).map(|k| k as f64).collect();
-        let fig = Figure::new(
-            format!("Running average power at R_m = {r}"),
-            "periods N_p",
-            "P_a [W]",
-        );
-        images.push(lines(
+        images.push(running_power(
             ctx,
             &format!("fig13_power_{r}"),
-            &fig,
-            &[("P_a", &n, &curve)],
+            format!("Running average power at R_m = {r}"),
+            Scale::Linear,
+            &[("P_a".into(), curve)],
         )?);
     }
     // R_m = 1, symmetric: impacts die out from a perturbed start.
@@ -1199,13 +1199,7 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     let (best_r, best_p) = refine_maximum(&values, &power).unwrap_or((f64::NAN, f64::NAN));
     let vmax: Vec<f64> = res
         .iter()
-        .map(|r| {
-            r.impacts
-                .iter()
-                .filter(|i| i.contact == 0)
-                .map(|i| i.closing_speed)
-                .fold(0.0, f64::max)
-        })
+        .map(|r| closing_speeds(r, 0).fold(0.0, f64::max))
         .collect();
     let (vi, _) = vmax
         .iter()
@@ -1228,13 +1222,10 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
             values[vi],
             describe_ranges(&np, values[1] - values[0])
         ),
-        if (best_r - 3.5).abs() < 0.3 && (at4 - 3.0).abs() < 0.01 {
-            Verdict::Agrees
-        } else if (best_r - 3.5).abs() < 0.3 || (at4 - 3.0).abs() < 0.01 {
-            Verdict::Partly
-        } else {
-            Verdict::Differs
-        },
+        Verdict::of(
+            usize::from((best_r - 3.5).abs() < 0.3) + usize::from((at4 - 3.0).abs() < 0.01),
+            2,
+        ),
     );
     // Fig. 15: running power at three mass ratios.
     let mut curves = Vec::new();
@@ -1245,13 +1236,13 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
             run.solver.expect("electrical").power_curve(),
         ));
     }
-    let n: Vec<f64> = (1..=curves[0].1.len()).map(|k| k as f64).collect();
-    let fig = Figure::new("Running average power at Ω = 0.72", "periods N_p", "P_a [W]");
-    let series: Vec<(&str, &[f64], &[f64])> = curves
-        .iter()
-        .map(|(l, c)| (l.as_str(), &n[..c.len()], c.as_slice()))
-        .collect();
-    let img = lines(ctx, "fig15_power", &fig, &series)?;
+    let img = running_power(
+        ctx,
+        "fig15_power",
+        "Running average power at Ω = 0.72".into(),
+        Scale::Linear,
+        &curves,
+    )?;
     let finals: Vec<f64> = curves
         .iter()
         .map(|c| c.1.last().copied().unwrap_or(f64::NAN))
@@ -1427,26 +1418,18 @@ fn fig_17(ctx: &mut Ctx) -> Result<()> {
         )?);
         let vmax: Vec<f64> = res
             .iter()
-            .map(|r| {
-                r.impacts
-                    .iter()
-                    .filter(|i| i.contact == 0)
-                    .map(|i| i.closing_speed)
-                    .fold(0.0, f64::max)
-            })
+            .map(|r| closing_speeds(r, 0).fold(0.0, f64::max))
             .collect();
         let third = vmax.len() / 3;
         let tail = &vmax[2 * third..];
-        let spread = (tail.iter().copied().fold(0.0, f64::max)
-            - tail.iter().copied().fold(f64::INFINITY, f64::min))
-            / tail.iter().copied().fold(0.0, f64::max);
+        let tail_max = tail.iter().copied().fold(0.0, f64::max);
+        let spread = (tail_max - tail.iter().copied().fold(f64::INFINITY, f64::min)) / tail_max;
         let (imax, _) = vmax
             .iter()
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(b.1))
             .unwrap_or((0, &0.0));
-        let interior_peak =
-            imax > 0 && imax < 2 * third && vmax[imax] > 1.1 * tail.iter().copied().fold(0.0, f64::max);
+        let interior_peak = imax > 0 && imax < 2 * third && vmax[imax] > 1.1 * tail_max;
         if spread < 0.15 && !interior_peak {
             saturate += 1;
         }
