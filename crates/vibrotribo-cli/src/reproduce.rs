@@ -603,22 +603,14 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
     for &w in &omegas {
         let mut curves: Vec<(String, Vec<f64>)> = Vec::new();
         let mut means = [0.0; 2];
-        for (c, ratios, key) in [
-            (0, [1.5, 2.0, 3.0], "mass_ratio_m2_fixed"),
-            (1, [0.3, 0.5, 0.7], "mass_ratio_m2_fixed"),
-        ] {
-            let masses = if c == 0 {
-                [0.08, 0.12, 0.08]
-            } else {
-                [0.12, 0.06, 0.12]
-            };
+        for (c, ratios) in [[1.5, 2.0, 3.0], [0.3, 0.5, 0.7]].into_iter().enumerate() {
             let mut powers = Vec::new();
             for &r in &ratios {
                 // Config. (1) keeps m2 = 120 g; config. (2) keeps m1 = m3 = 120 g.
                 let loaded = if c == 0 {
                     config(&[
-                        ("oscillator.masses", arr(&masses)),
-                        (key, f(r)),
+                        ("oscillator.masses", arr(&[0.08, 0.12, 0.08])),
+                        ("mass_ratio_m2_fixed", f(r)),
                         ("omega_ratio", f(w)),
                     ])?
                 } else {
@@ -636,11 +628,10 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
             means[c] = mean(&powers);
             let _ = writeln!(
                 table,
-                "Ω = {w}, configuration ({}): P_a after {} periods = {} (R_m = {:?})",
+                "Ω = {w}, configuration ({}): P_a after {} periods = {} (R_m = {ratios:?})",
                 c + 1,
                 ctx.budget.series,
                 powers.iter().map(|p| si(*p, "W")).collect::<Vec<_>>().join(", "),
-                if c == 0 { [1.5, 2.0, 3.0] } else { [0.3, 0.5, 0.7] }
             );
         }
         if means[0] > means[1] {
