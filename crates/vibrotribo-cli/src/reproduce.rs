@@ -165,7 +165,8 @@ fn f(x: f64) -> Value {
     Value::Float(x)
 }
 
-/// Runs `values` of `key` in parallel (from rest) or as a continuation, in grid order.
+/// Runs `values` of `key` in parallel, each from rest; the results in grid order. Points whose
+/// charge solver failed are noted in `ctx.failures`.
 fn sweep(
     ctx: &Ctx,
     base: &Loaded,
@@ -882,7 +883,8 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
             "R_δ = {r}: paper {claim}, vibrotribo {ours}, P_a = {}",
             si(p.average_power_w.unwrap_or(f64::NAN), "W")
         ));
-        // PSD of x2 over the recorded stroboscopic... use a dense run for the PSD.
+        // The PSD of x2 needs denser samples than one per period: a separate run, 64 samples
+        // per period over its last 64 periods.
         let run = run_series(
             &base.with("gap_ratio", *r)?,
             ctx.budget.series + 64,
