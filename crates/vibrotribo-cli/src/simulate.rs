@@ -315,8 +315,8 @@ struct Outcome {
     elapsed: f64,
     /// Impacts per period after the transient, per contact.
     impacts_per_period: Vec<f64>,
-    /// The harvester's power after the transient (`None` without a harvester or a complete
-    /// period after the transient).
+    /// The harvester's power after the transient (`None` without a harvester, or without a
+    /// complete period after the transient).
     power: Option<PowerSummary>,
     /// Why the run stopped early, if it failed.
     failure: Option<anyhow::Error>,
