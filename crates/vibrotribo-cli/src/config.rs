@@ -260,7 +260,6 @@ impl Loaded {
     }
 
     /// A copy with `key` set to a number (used by sweeps).
-    #[allow(dead_code)] // used by the sweep commands
     pub fn with(&self, key: &str, value: f64) -> Result<Self> {
         let mut table = self.table.clone();
         set_key(&mut table, key, Value::Float(value))?;
@@ -311,18 +310,31 @@ fn chain_len(table: &Table) -> usize {
         .map_or(3, Vec::len)
 }
 
+/// The paper's chain ([`ChainParams::default`]) with its stiffness and damping repeated for
+/// `n` masses and its spacing for the `n − 1` gaps; masses (the paper's three), restitution
+/// and excitation as they are: the defaults of the `[oscillator]` and `[excitation]` keys.
+fn default_chain(n: usize) -> ChainParams {
+    let paper = ChainParams::default();
+    ChainParams {
+        stiffness: vec![paper.stiffness[0]; n],
+        damping: vec![paper.damping[0]; n],
+        gaps: vec![paper.gaps[0]; n.saturating_sub(1)],
+        ..paper
+    }
+}
+
 /// The current value of an array key, with the default filled in if absent and a scalar
 /// broadcast (so that one element of it can be set).
 fn materialize_array(table: &Table, section: &str, name: &str) -> Result<Vec<f64>> {
     let n = chain_len(table);
     let current = table.get(section).and_then(|s| s.get(name));
-    let default = |x: f64, len: usize| vec![x; len];
+    let chain = default_chain(n);
     let defaults: Vec<f64> = match (section, name) {
-        ("oscillator", "masses") => ChainParams::default().masses,
-        ("oscillator", "stiffness") => default(120.0, n),
-        ("oscillator", "damping") => default(0.02, n),
-        ("oscillator", "gaps") => default(0.020, n.saturating_sub(1)),
-        ("run", "initial_positions") | ("run", "initial_velocities") => default(0.0, n),
+        ("oscillator", "masses") => chain.masses,
+        ("oscillator", "stiffness") => chain.stiffness,
+        ("oscillator", "damping") => chain.damping,
+        ("oscillator", "gaps") => chain.gaps,
+        ("run", "initial_positions") | ("run", "initial_velocities") => vec![0.0; n],
         _ => bail!("`{section}.{name}` is not an array parameter"),
     };
     match current {
@@ -453,6 +465,7 @@ impl Config {
         let o = &self.oscillator;
         let masses = o.masses.clone().unwrap_or_else(|| ChainParams::default().masses);
         let n = masses.len();
+        let default = default_chain(n);
         let e = &self.excitation;
         let frequency = match (e.omega_ratio, e.frequency_hz) {
             (Some(_), Some(_)) => {
@@ -460,17 +473,18 @@ impl Config {
             }
             (Some(w), None) => Frequency::OmegaRatio(w),
             (None, Some(f)) => Frequency::Hertz(f),
-            (None, None) => Frequency::default(),
+            (None, None) => default.excitation.frequency,
         };
         let params = ChainParams {
-            stiffness: o.stiffness.as_ref().map_or(vec![120.0; n], |s| s.expand(n)),
-            damping: o.damping.as_ref().map_or(vec![0.02; n], |s| s.expand(n)),
-            gaps: o.gaps.as_ref().map_or(vec![0.020; n.saturating_sub(1)], |s| {
-                s.expand(n.saturating_sub(1))
-            }),
-            restitution: o.restitution.unwrap_or(0.6),
+            stiffness: o.stiffness.as_ref().map_or(default.stiffness, |s| s.expand(n)),
+            damping: o.damping.as_ref().map_or(default.damping, |s| s.expand(n)),
+            gaps: o
+                .gaps
+                .as_ref()
+                .map_or(default.gaps, |s| s.expand(n.saturating_sub(1))),
+            restitution: o.restitution.unwrap_or(default.restitution),
             excitation: Excitation {
-                amplitude: e.amplitude.unwrap_or(0.08),
+                amplitude: e.amplitude.unwrap_or(default.excitation.amplitude),
                 frequency,
             },
             masses,

@@ -5,13 +5,17 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use serde_json::json;
-use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
-use vibrotribo::electrical::{ChargeSolver, LoadKind, load_sweep, log_spaced};
-use vibrotribo::{Simulator, Trajectory};
+use vibrotribo::electrical::breakdown::BreakdownMargin;
+use vibrotribo::electrical::{
+    ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, load_sweep, log_spaced,
+};
+use vibrotribo::{ChainParams, Simulator, Trajectory};
 
 use crate::config::ConfigArgs;
+use crate::harvester::add_breakdown_sample;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot;
+use crate::plots::both;
 use crate::progress::Progress;
 
 /// Options of `vibrotribo load-sweep`.
@@ -40,6 +44,32 @@ pub struct LoadSweepArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// Runs the charge solver of `h` over `trajectory` (of `chain`), recording the V–Q cycle of
+/// period `index` at `points + 1` times, and checks those samples for air breakdown. Returns
+/// the solver (its V–Q cycle and power) and the margin (no samples: the default, 0).
+pub fn breakdown_over_vq_cycle(
+    h: &HarvesterParams,
+    chain: &ChainParams,
+    options: &ChargeOptions,
+    trajectory: &Trajectory,
+    index: u64,
+    points: usize,
+) -> Result<(ChargeSolver, BreakdownMargin)> {
+    let mut s = ChargeSolver::for_chain(h, chain, options.clone())?.with_vq_cycle(index, points)?;
+    s.run_trajectory(trajectory)?;
+    let mut margin = BreakdownMargin::default();
+    if let Some(c) = s.vq_cycle() {
+        let (mut d, mut rates) = (vec![0.0; chain.len() - 1], vec![0.0; chain.len() - 1]);
+        for (&t, &q) in c.times.iter().zip(&c.charge_c) {
+            if let Some(flow) = trajectory.flow_at(t) {
+                flow.gaps_at(t, &mut d, &mut rates);
+                add_breakdown_sample(&mut margin, h, t, q, &d);
+            }
+        }
+    }
+    Ok((s, margin))
 }
 
 /// Runs `vibrotribo load-sweep`.
@@ -125,7 +155,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         create_dir(dir)?;
         let mut csv = CsvFile::create(
             &dir.join("load_sweep.csv"),
-            &["load_resistance_ohm", "average_power_w", "energy_per_period_j"].map(String::from),
+            &["load_resistance_ohm", "average_power_w", "energy_per_period_j"],
         )?;
         for p in &sweep.points {
             csv.row([p.resistance_ohm, p.average_power_w, p.energy_per_period_j])?;
@@ -135,33 +165,18 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         let last = spec.periods - 1;
         let mut vq = CsvFile::create(
             &dir.join("vq_cycle.csv"),
-            &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"].map(String::from),
+            &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"],
         )?;
         let mut cycles = Vec::new();
         let mut margins = Vec::new();
         for r in [configured, best.resistance_ohm] {
             let mut h = harvester.clone();
             h.load_resistance = r;
-            let mut s =
-                ChargeSolver::for_chain(&h, &chain, options.clone())?.with_vq_cycle(last, args.vq_points)?;
-            s.run_trajectory(&trajectory)?;
+            let (s, margin) =
+                breakdown_over_vq_cycle(&h, &chain, &options, &trajectory, last, args.vq_points)?;
             if let Some(c) = s.vq_cycle() {
-                let mut margin = BreakdownMargin::default();
-                let (mut d, mut rates) = (vec![0.0; chain.len() - 1], vec![0.0; chain.len() - 1]);
                 for j in 0..c.times.len() {
                     vq.row([r, c.times[j], c.charge_c[j], c.voltage_v[j], c.current_a[j]])?;
-                    if let Some(flow) = trajectory.flow_at(c.times[j]) {
-                        flow.gaps_at(c.times[j], &mut d, &mut rates);
-                        let d2 = d.get(h.contact + 1).copied().unwrap_or(0.0);
-                        margin.add(
-                            &h,
-                            &PaschenParams::default(),
-                            c.times[j],
-                            c.charge_c[j],
-                            d[h.contact],
-                            d2,
-                        );
-                    }
                 }
                 println!(
                     "  at {}: largest |V_gap|/V_breakdown over the last period {:.3}{}",
@@ -201,33 +216,26 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         if args.plot {
             let xs: Vec<f64> = sweep.points.iter().map(|p| p.resistance_ohm.log10()).collect();
             let ys: Vec<f64> = sweep.points.iter().map(|p| p.average_power_w).collect();
-            for ext in ["png", "svg"] {
-                let mut fig = plot::Figure::new(
-                    "Average power against load resistance",
-                    "log10(R / Ω)",
-                    "average power P_a [W]",
-                );
-                fig.y_scale = plot::Scale::Log;
-                plot::line_plot(
-                    &dir.join(format!("load_sweep.{ext}")),
-                    &fig,
-                    &[plot::Series::new("P_a(R)", &xs, &ys)],
-                )?;
-                let labels: Vec<String> = cycles
-                    .iter()
-                    .map(|(r, _, _)| format!("R = {}", si(*r, "Ω")))
-                    .collect();
-                let series: Vec<plot::Series> = cycles
-                    .iter()
-                    .zip(&labels)
-                    .map(|((_, q, v), l)| plot::Series::new(l, q, v))
-                    .collect();
-                plot::line_plot(
-                    &dir.join(format!("vq_cycle.{ext}")),
-                    &plot::Figure::new("V–Q cycle (last period)", "charge Q [C]", "voltage V [V]"),
-                    &series,
-                )?;
-            }
+            let mut fig = plot::Figure::new(
+                "Average power against load resistance",
+                "log10(R / Ω)",
+                "average power P_a [W]",
+            );
+            fig.y_scale = plot::Scale::Log;
+            both(dir, "load_sweep", |path| {
+                plot::line_plot(path, &fig, &[plot::Series::new("P_a(R)", &xs, &ys)])
+            })?;
+            let labels: Vec<String> = cycles
+                .iter()
+                .map(|(r, _, _)| format!("R = {}", si(*r, "Ω")))
+                .collect();
+            let series: Vec<plot::Series> = cycles
+                .iter()
+                .zip(&labels)
+                .map(|((_, q, v), l)| plot::Series::new(l, q, v))
+                .collect();
+            let fig = plot::Figure::new("V–Q cycle (last period)", "charge Q [C]", "voltage V [V]");
+            both(dir, "vq_cycle", |path| plot::line_plot(path, &fig, &series))?;
         }
         println!(
             "  wrote {0}/load_sweep.csv, {0}/vq_cycle.csv, {0}/load_sweep.json",

@@ -7,7 +7,6 @@ mod harvester;
 mod load_sweep;
 mod map;
 mod output;
-#[allow(dead_code)] // parts are used as commands gain --plot
 mod plot;
 mod plots;
 mod progress;

@@ -6,15 +6,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use rayon::prelude::*;
 use serde_json::json;
-use vibrotribo::analysis::{PointResult, QuadraticFit, fit_quadratic};
+use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 
 use crate::config::ConfigArgs;
-use crate::output::{CsvFile, create_dir, csv_text, point_cells, point_columns, write_json};
+use crate::output::{CsvFile, create_dir, point_cells, point_columns, write_json};
 use crate::plot::{self, Figure, Series};
-use crate::progress::{Progress, interrupted};
-use crate::sweep::{PointRunner, RunArgs, grid, set_threads};
+use crate::sweep::{PointRunner, RunArgs, grid, run_grid, set_threads};
 
 /// Options of `vibrotribo map`.
 #[derive(Debug, clap::Args)]
@@ -65,40 +63,6 @@ fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
     Ok(())
 }
 
-/// Runs `points` in parallel chunks, calling `write` in order; stops early on Ctrl-C.
-/// Returns how many were written.
-pub fn run_grid<'k, P, W>(
-    runner: &PointRunner,
-    points: &[P],
-    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
-    quiet: bool,
-    mut write: W,
-) -> Result<usize>
-where
-    P: Sync,
-    W: FnMut(&P, &Result<PointResult, String>) -> Result<()>,
-{
-    let progress = Progress::new(points.len() as u64, "points", quiet);
-    let chunk = rayon::current_num_threads() * 4;
-    let mut done = 0;
-    for block in points.chunks(chunk) {
-        let results: Vec<Result<PointResult, String>> = block
-            .par_iter()
-            .map(|p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")))
-            .collect();
-        for (p, r) in block.iter().zip(&results) {
-            write(p, r)?;
-            done += 1;
-            progress.inc(1);
-        }
-        if interrupted() {
-            break;
-        }
-    }
-    progress.finish();
-    Ok(done)
-}
-
 /// Runs `vibrotribo map`.
 pub fn run(args: &MapArgs) -> Result<()> {
     check_axis("x", args.x_from, args.x_to, args.x_steps)?;
@@ -117,7 +81,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     runner.check_all(&points, |&(x, y)| {
         vec![(args.x.as_str(), x), (args.y.as_str(), y)]
     })?;
-    let contacts = runner.base().config.chain_params()?.len() - 1;
+    let contacts = runner.masses() - 1;
     let mut csv = match &args.out {
         Some(dir) => {
             create_dir(dir)?;
@@ -133,6 +97,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         &runner,
         &points,
         |&(x, y)| vec![(xk, x), (yk, y)],
+        "points",
         args.run.quiet,
         |&(x, y), r| {
             let Some(csv) = csv.as_mut() else { return Ok(()) };
@@ -227,7 +192,7 @@ pub fn plot_optimal_mass_ratio(
     let paper: Vec<f64> = fine.iter().map(|&w| paper_fit(w)).collect();
     let ours: Vec<f64> = fine
         .iter()
-        .map(|w| fit.map_or(f64::NAN, |f| f.a * w * w + f.b * w + f.c))
+        .map(|&w| fit.map_or(f64::NAN, |f| f.eval(w)))
         .collect();
     let fig = Figure::new("Optimal mass ratio R_mo(Ω)", "Ω = ω/Ω1", "R_mo = m2/m1");
     plot::phase_portrait(
@@ -263,6 +228,22 @@ pub fn refine_maximum(grid: &[f64], values: &[f64]) -> Option<(f64, f64)> {
     Some((grid[best] + shift * h, b - 0.25 * (a - c) * shift))
 }
 
+/// The optimal mass ratio at each Ω of `omegas`: the maximum of its row of `power` (row-major,
+/// `ratios.len()` mass ratios per Ω) refined by [`refine_maximum`], as (Ω, R_mo, power there
+/// in W, whether R_mo is at an end of `ratios`). An Ω without a finite power is left out.
+pub(crate) fn optima(omegas: &[f64], ratios: &[f64], power: &[f64]) -> Vec<(f64, f64, f64, bool)> {
+    let (first, last) = (ratios[0], ratios[ratios.len() - 1]);
+    omegas
+        .iter()
+        .zip(power.chunks(ratios.len()))
+        .filter_map(|(&w, row)| {
+            let (r, p) = refine_maximum(ratios, row)?;
+            let at_edge = (r - first).abs() < 1e-12 || (r - last).abs() < 1e-12;
+            Some((w, r, p, at_edge))
+        })
+        .collect()
+}
+
 /// Runs `vibrotribo optimize-mass-ratio`.
 pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     check_axis("omega", args.omega_from, args.omega_to, args.omega_steps)?;
@@ -279,6 +260,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     let runner = PointRunner::new(base, &args.run)?;
+    let contacts = runner.masses() - 1;
     let (omegas, ratios) = (
         grid(args.omega_from, args.omega_to, args.omega_steps),
         grid(args.rm_from, args.rm_to, args.rm_steps),
@@ -302,8 +284,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                     "impacts_per_period",
                     "period",
                     "error",
-                ]
-                .map(String::from),
+                ],
             )?)
         }
         None => None,
@@ -313,6 +294,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         &runner,
         &points,
         |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)],
+        "points",
         args.run.quiet,
         |&(w, r), res| {
             if let Ok(p) = res {
@@ -320,25 +302,16 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             }
             index += 1;
             if let Some(csv) = grid_csv.as_mut() {
-                let row = match res {
-                    Ok(p) => vec![
-                        w.to_string(),
-                        r.to_string(),
-                        p.average_power_w.map_or(String::new(), |v| v.to_string()),
-                        p.total_impacts_per_period().to_string(),
-                        p.period().to_string(),
-                        p.electrical_error.as_deref().map_or(String::new(), csv_text),
-                    ],
-                    Err(e) => vec![
-                        w.to_string(),
-                        r.to_string(),
-                        String::new(),
-                        String::new(),
-                        String::new(),
-                        csv_text(e),
-                    ],
-                };
-                csv.row(row)?;
+                // Of the point's columns: average_power_w, impacts_per_period, period, error.
+                let mut cells = point_cells(res, contacts);
+                let error = cells.pop().unwrap_or_default();
+                cells.truncate(3);
+                csv.row(
+                    [w.to_string(), r.to_string()]
+                        .into_iter()
+                        .chain(cells)
+                        .chain([error]),
+                )?;
             }
             Ok(())
         },
@@ -347,14 +320,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         bail!("interrupted after {done} of {} points", points.len());
     }
     let n = ratios.len();
-    let mut optimum = Vec::new();
-    for (i, &w) in omegas.iter().enumerate() {
-        let row = &power[i * n..(i + 1) * n];
-        if let Some((r, p)) = refine_maximum(&ratios, row) {
-            let at_edge = (r - ratios[0]).abs() < 1e-12 || (r - ratios[n - 1]).abs() < 1e-12;
-            optimum.push((w, r, p, at_edge));
-        }
-    }
+    let optimum = optima(&omegas, &ratios, &power);
     let ws: Vec<f64> = optimum.iter().map(|o| o.0).collect();
     let rs: Vec<f64> = optimum.iter().map(|o| o.1).collect();
     let fit = fit_quadratic(&ws, &rs).ok();
@@ -404,8 +370,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                 "average_power_w",
                 "at_edge",
                 "paper_fit",
-            ]
-            .map(String::from),
+            ],
         )?;
         for (w, r, p, edge) in &optimum {
             let paper = paper_fit(*w);
@@ -431,15 +396,9 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             }),
         )?;
         if args.plot {
-            for ext in ["png", "svg"] {
-                plot_optimal_mass_ratio(
-                    &dir.join(format!("optimal_mass_ratio.{ext}")),
-                    &ws,
-                    &rs,
-                    fit.as_ref(),
-                    (args.omega_from, args.omega_to),
-                )?;
-            }
+            crate::plots::both(dir, "optimal_mass_ratio", |path| {
+                plot_optimal_mass_ratio(path, &ws, &rs, fit.as_ref(), (args.omega_from, args.omega_to))
+            })?;
         }
     }
     Ok(())

@@ -16,14 +16,15 @@ pub struct CsvFile {
 
 impl CsvFile {
     /// Creates `path` and writes the header `columns`.
-    pub fn create(path: &Path, columns: &[String]) -> Result<Self> {
+    pub fn create(path: &Path, columns: &[impl AsRef<str>]) -> Result<Self> {
         let file = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
         let mut f = CsvFile {
             path: path.to_path_buf(),
             out: BufWriter::new(file),
             line: String::new(),
         };
-        f.out.write_all(columns.join(",").as_bytes())?;
+        let header: Vec<&str> = columns.iter().map(AsRef::as_ref).collect();
+        f.out.write_all(header.join(",").as_bytes())?;
         f.out.write_all(b"\n")?;
         Ok(f)
     }
@@ -60,6 +61,12 @@ impl CsvFile {
 pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
     let text = serde_json::to_string_pretty(value)?;
     std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Reads the JSON file `path`.
+pub fn read_json(path: &Path) -> Result<serde_json::Value> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
 }
 
 /// Creates `dir` (and parents) for output.

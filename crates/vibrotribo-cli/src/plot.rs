@@ -85,10 +85,6 @@ pub enum Legend {
     UpperRight,
     /// Inside the plot, upper left.
     UpperLeft,
-    /// Inside the plot, lower left.
-    LowerLeft,
-    /// Inside the plot, lower right.
-    LowerRight,
     /// No legend, even if series have labels.
     Hidden,
 }
@@ -701,8 +697,6 @@ where
     let position = match figure.legend {
         Legend::UpperRight => SeriesLabelPosition::UpperRight,
         Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
-        Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
-        Legend::LowerRight => SeriesLabelPosition::LowerRight,
         Legend::Hidden => return Ok(()),
     };
     if layers.all().any(|s| s.label.is_some()) {

@@ -7,20 +7,15 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use vibrotribo::analysis::{WelchOptions, welch_psd};
 
-use crate::output::{CsvFile, column, numbers, read_csv, si};
+use crate::output::{CsvFile, column, numbers, read_csv, read_json, si};
 use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series};
 
 /// Writes `name.png` and `name.svg` in `dir` with `draw`.
-fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<()> {
+pub(crate) fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<()> {
     for ext in ["png", "svg"] {
         draw(&dir.join(format!("{name}.{ext}")))?;
     }
     Ok(())
-}
-
-fn read_json(path: &Path) -> Result<serde_json::Value> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
 }
 
 /// Draws whatever `dir` holds: a `simulate`, `sweep` or `map` output directory.
@@ -304,7 +299,7 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
     );
     let mut csv = CsvFile::create(
         &dir.join("poincare_impacts.csv"),
-        &["time_s", "phase", "contact", "rel_velocity_m_s"].map(String::from),
+        &["time_s", "phase", "contact", "rel_velocity_m_s"],
     )?;
     let mut per_contact: Vec<(Vec<f64>, Vec<f64>)> = vec![(vec![], vec![]); masses - 1];
     for r in erows.iter().filter(|r| r[kc] == "impact") {
@@ -362,7 +357,7 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         };
         let mut csv = CsvFile::create(
             &dir.join(format!("psd_x{}.csv", i + 1)),
-            &["frequency_hz", "psd_m2_per_hz"].map(String::from),
+            &["frequency_hz", "psd_m2_per_hz"],
         )?;
         for (f, p) in psd.frequencies.iter().zip(&psd.density) {
             csv.row([*f, *p])?;

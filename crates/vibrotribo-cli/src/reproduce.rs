@@ -11,7 +11,6 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use toml::{Table, Value};
 use vibrotribo::analysis::{PointResult, WelchOptions, fit_quadratic, welch_psd};
-use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
 use vibrotribo::electrical::{
     ChargeOptions, ChargeSolver, HarvesterParams, VocModel, load_sweep, log_spaced,
 };
@@ -20,7 +19,8 @@ use vibrotribo::{
 };
 
 use crate::config::{Loaded, set_key};
-use crate::map::{paper_fit, plot_optimal_mass_ratio, refine_maximum};
+use crate::load_sweep::breakdown_over_vq_cycle;
+use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::{create_dir, si};
 use crate::plot::{self, Figure, Legend, Scale, Series};
 use crate::progress::interrupted;
@@ -165,7 +165,8 @@ fn f(x: f64) -> Value {
     Value::Float(x)
 }
 
-/// Runs `values` of `key` in parallel (from rest) or as a continuation, in grid order.
+/// Runs `values` of `key` in parallel, each from rest; the results in grid order. Points whose
+/// charge solver failed are noted in `ctx.failures`.
 fn sweep(
     ctx: &Ctx,
     base: &Loaded,
@@ -195,25 +196,29 @@ fn sweep(
     Ok(results)
 }
 
-/// Samples and events of one run, for time histories.
+/// Samples and impacts of one run, for time histories.
 #[derive(Default)]
 struct Series1 {
     t: Vec<f64>,
     x: Vec<Vec<f64>>,
     v: Vec<Vec<f64>>,
+    /// The gaps d_k, m.
     d: Vec<Vec<f64>>,
-    events: Vec<(f64, EventKind, usize, f64, Vec<f64>)>,
+    /// Their rates d_k', m/s.
+    rate: Vec<Vec<f64>>,
+    /// Each impact's contact (0-based) and the positions of the masses then.
+    impacts: Vec<(usize, Vec<f64>)>,
 }
 
 struct SeriesObserver {
     keep_from: f64,
     dt: f64,
     next: u64,
-    n: usize,
-    gaps: Vec<f64>,
     data: Series1,
     xbuf: Vec<f64>,
     vbuf: Vec<f64>,
+    dbuf: Vec<f64>,
+    rbuf: Vec<f64>,
 }
 
 impl Observer for SeriesObserver {
@@ -228,27 +233,26 @@ impl Observer for SeriesObserver {
                 continue;
             }
             flow.state_at(t, &mut self.xbuf, &mut self.vbuf);
+            flow.gaps_at(t, &mut self.dbuf, &mut self.rbuf);
             self.data.t.push(t);
-            for i in 0..self.n {
-                self.data.x[i].push(self.xbuf[i]);
-                self.data.v[i].push(self.vbuf[i]);
-            }
-            for k in 0..self.n - 1 {
-                self.data.d[k].push(self.gaps[k] - (self.xbuf[k + 1] - self.xbuf[k]));
-            }
+            push_each(&mut self.data.x, &self.xbuf);
+            push_each(&mut self.data.v, &self.vbuf);
+            push_each(&mut self.data.d, &self.dbuf);
+            push_each(&mut self.data.rate, &self.rbuf);
         }
     }
 
     fn event(&mut self, e: &Event, state: &StateView<'_>) {
-        if e.time >= self.keep_from {
-            self.data.events.push((
-                e.time,
-                e.kind,
-                e.contact,
-                e.velocity_before,
-                state.positions.to_vec(),
-            ));
+        if e.kind == EventKind::Impact && e.time >= self.keep_from {
+            self.data.impacts.push((e.contact, state.positions.to_vec()));
         }
+    }
+}
+
+/// Appends `values[i]` to `series[i]`.
+fn push_each(series: &mut [Vec<f64>], values: &[f64]) {
+    for (s, &v) in series.iter_mut().zip(values) {
+        s.push(v);
     }
 }
 
@@ -272,16 +276,17 @@ fn run_series(loaded: &Loaded, periods: u64, keep: u64, spp: u64, electrical: bo
         keep_from,
         dt,
         next: 0,
-        n,
-        gaps: params.gaps.clone(),
         data: Series1 {
             x: vec![Vec::new(); n],
             v: vec![Vec::new(); n],
             d: vec![Vec::new(); n - 1],
+            rate: vec![Vec::new(); n - 1],
             ..Series1::default()
         },
         xbuf: vec![0.0; n],
         vbuf: vec![0.0; n],
+        dbuf: vec![0.0; n - 1],
+        rbuf: vec![0.0; n - 1],
     };
     let mut solver = if electrical {
         let h = loaded.harvester(&params)?;
@@ -301,14 +306,9 @@ fn run_series(loaded: &Loaded, periods: u64, keep: u64, spp: u64, electrical: bo
     })
 }
 
-fn png(ctx: &Ctx, name: &str) -> PathBuf {
-    ctx.path(&format!("{name}.png"))
-}
-
-/// Draws `draw` as PNG and SVG; returns the PNG's file name.
+/// Draws `draw` as PNG and SVG in the output directory; returns the PNG's file name.
 fn both(ctx: &Ctx, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<String> {
-    draw(&png(ctx, name))?;
-    draw(&ctx.path(&format!("{name}.svg")))?;
+    crate::plots::both(&ctx.out, name, draw)?;
     Ok(format!("{name}.png"))
 }
 
@@ -316,22 +316,29 @@ fn orbit_points(values: &[f64], results: &[PointResult], mass: usize, scale: f64
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     for (v, r) in values.iter().zip(results) {
-        let n = r.strobe.len() / r.strobe_periods.len().max(1);
-        for j in 0..r.strobe_periods.len() {
+        for x in r.position_series(mass) {
             xs.push(*v);
-            ys.push(r.strobe[j * n + mass] * scale);
+            ys.push(x * scale);
         }
     }
     (xs, ys)
+}
+
+/// Closing speeds, m/s, of the impacts of `r` at `contact` (0-based).
+fn closing_speeds(r: &PointResult, contact: usize) -> impl Iterator<Item = f64> + '_ {
+    r.impacts
+        .iter()
+        .filter(move |i| i.contact == contact)
+        .map(|i| i.closing_speed)
 }
 
 fn impact_points(values: &[f64], results: &[PointResult], contact: usize) -> (Vec<f64>, Vec<f64>) {
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     for (v, r) in values.iter().zip(results) {
-        for i in r.impacts.iter().filter(|i| i.contact == contact) {
+        for speed in closing_speeds(r, contact) {
             xs.push(*v);
-            ys.push(i.closing_speed);
+            ys.push(speed);
         }
     }
     (xs, ys)
@@ -350,7 +357,7 @@ fn orbit_figure(
     scale: f64,
 ) -> Result<String> {
     let (x, y) = orbit_points(values, results, 1, scale);
-    scatter(ctx, name, title, xl, yl, &[("X2", &x, &y)])
+    scatter(ctx, name, Figure::new(title, xl, yl), &x, &y, 2)
 }
 
 /// An impact-velocity diagram (closing speeds at `contact` against the parameter).
@@ -366,25 +373,33 @@ fn impact_figure(
     contact: usize,
 ) -> Result<String> {
     let (x, y) = impact_points(values, results, contact);
-    scatter(ctx, name, title, xl, yl, &[("V", &x, &y)])
+    scatter(ctx, name, Figure::new(title, xl, yl), &x, &y, 2)
 }
 
-fn scatter(
+/// The points (`x`, `y`) as marks of `marker_px` pixels, without a legend.
+fn scatter(ctx: &Ctx, name: &str, mut fig: Figure, x: &[f64], y: &[f64], marker_px: u32) -> Result<String> {
+    fig.legend = Legend::Hidden;
+    both(ctx, name, |p| {
+        plot::scatter_plot(p, &fig, &[Series::unlabelled(x, y)], marker_px)
+    })
+}
+
+/// The return map (Poincaré section) X(n+1) against X(n) of mass `mass` (0-based) of `p`,
+/// X = x/`delta1` at t = nT.
+fn return_map(
     ctx: &Ctx,
     name: &str,
-    title: &str,
-    xl: &str,
-    yl: &str,
-    series: &[(&str, &[f64], &[f64])],
+    title: String,
+    p: &PointResult,
+    mass: usize,
+    delta1: f64,
+    marker_px: u32,
 ) -> Result<String> {
-    let mut fig = Figure::new(title, xl, yl);
-    if series.len() == 1 {
-        fig.legend = Legend::Hidden;
-    }
-    both(ctx, name, |p| {
-        let s: Vec<Series> = series.iter().map(|(l, x, y)| Series::new(l, x, y)).collect();
-        plot::scatter_plot(p, &fig, &s, 2)
-    })
+    let x: Vec<f64> = p.position_series(mass).map(|x| x / delta1).collect();
+    let next = &x[x.len().min(1)..];
+    let label = format!("X{}", mass + 1);
+    let fig = Figure::new(title, format!("{label}(n)"), format!("{label}(n+1)"));
+    scatter(ctx, name, fig, &x[..next.len()], next, marker_px)
 }
 
 fn lines(ctx: &Ctx, name: &str, fig: &Figure, series: &[(&str, &[f64], &[f64])]) -> Result<String> {
@@ -392,6 +407,47 @@ fn lines(ctx: &Ctx, name: &str, fig: &Figure, series: &[(&str, &[f64], &[f64])])
         let s: Vec<Series> = series.iter().map(|(l, x, y)| Series::new(l, x, y)).collect();
         plot::line_plot(p, fig, &s)
     })
+}
+
+/// The gap D1 of `s` at `at` (e.g. `R_δ = 1.085`): its time history (title ending in
+/// `history`) and its phase plot, as `{fig}_d1_{tag}` and `{fig}_phase_{tag}`.
+fn d1_figures(
+    ctx: &Ctx,
+    s: &Series1,
+    (fig, tag): (&str, f64),
+    at: &str,
+    history: &str,
+) -> Result<[String; 2]> {
+    let time = Figure::new(format!("D1 at {at}{history}"), "time t [s]", "D1 [m]");
+    let phase = Figure::new(format!("D1 at {at}: phase plot"), "D1 [m]", "dD1/dt [m/s]");
+    Ok([
+        lines(ctx, &format!("{fig}_d1_{tag}"), &time, &[("D1", &s.t, &s.d[0])])?,
+        lines(
+            ctx,
+            &format!("{fig}_phase_{tag}"),
+            &phase,
+            &[("D1", &s.d[0], &s.rate[0])],
+        )?,
+    ])
+}
+
+/// Running average powers P_a(N), W, each (label, curve), against the number of periods N.
+fn running_power(
+    ctx: &Ctx,
+    name: &str,
+    title: String,
+    y_scale: Scale,
+    curves: &[(String, Vec<f64>)],
+) -> Result<String> {
+    let mut fig = Figure::new(title, "periods N_p", "P_a [W]");
+    fig.y_scale = y_scale;
+    let longest = curves.iter().map(|(_, c)| c.len()).max().unwrap_or(0);
+    let n: Vec<f64> = (1..=longest).map(|k| k as f64).collect();
+    let series: Vec<(&str, &[f64], &[f64])> = curves
+        .iter()
+        .map(|(l, c)| (l.as_str(), &n[..c.len()], c.as_slice()))
+        .collect();
+    lines(ctx, name, &fig, &series)
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -483,10 +539,7 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
         let run = run_series(&loaded, periods, 20, 200, false)?;
         let s = &run.series;
         let mut side = [[false; 2]; 3]; // [mass][below, above]
-        for (_, kind, contact, _, x) in &s.events {
-            if *kind != EventKind::Impact {
-                continue;
-            }
+        for (contact, x) in &s.impacts {
             for i in [*contact, contact + 1] {
                 side[i][usize::from(x[i] > 0.0)] = true;
             }
@@ -551,22 +604,14 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
     for &w in &omegas {
         let mut curves: Vec<(String, Vec<f64>)> = Vec::new();
         let mut means = [0.0; 2];
-        for (c, ratios, key) in [
-            (0, [1.5, 2.0, 3.0], "mass_ratio_m2_fixed"),
-            (1, [0.3, 0.5, 0.7], "mass_ratio_m2_fixed"),
-        ] {
-            let masses = if c == 0 {
-                [0.08, 0.12, 0.08]
-            } else {
-                [0.12, 0.06, 0.12]
-            };
+        for (c, ratios) in [[1.5, 2.0, 3.0], [0.3, 0.5, 0.7]].into_iter().enumerate() {
             let mut powers = Vec::new();
             for &r in &ratios {
                 // Config. (1) keeps m2 = 120 g; config. (2) keeps m1 = m3 = 120 g.
                 let loaded = if c == 0 {
                     config(&[
-                        ("oscillator.masses", arr(&masses)),
-                        (key, f(r)),
+                        ("oscillator.masses", arr(&[0.08, 0.12, 0.08])),
+                        ("mass_ratio_m2_fixed", f(r)),
                         ("omega_ratio", f(w)),
                     ])?
                 } else {
@@ -584,28 +629,22 @@ fn figs_5_6(ctx: &mut Ctx) -> Result<()> {
             means[c] = mean(&powers);
             let _ = writeln!(
                 table,
-                "Ω = {w}, configuration ({}): P_a after {} periods = {} (R_m = {:?})",
+                "Ω = {w}, configuration ({}): P_a after {} periods = {} (R_m = {ratios:?})",
                 c + 1,
                 ctx.budget.series,
                 powers.iter().map(|p| si(*p, "W")).collect::<Vec<_>>().join(", "),
-                if c == 0 { [1.5, 2.0, 3.0] } else { [0.3, 0.5, 0.7] }
             );
         }
         if means[0] > means[1] {
             better += 1;
         }
-        let n: Vec<f64> = (1..=curves[0].1.len()).map(|k| k as f64).collect();
-        let mut fig = Figure::new(
+        images.push(running_power(
+            ctx,
+            &format!("fig06_omega{w}"),
             format!("Running average power, configurations (1) and (2), Ω = {w}"),
-            "periods N_p",
-            "P_a [W]",
-        );
-        fig.y_scale = Scale::Log;
-        let series: Vec<(&str, &[f64], &[f64])> = curves
-            .iter()
-            .map(|(l, c)| (l.as_str(), &n[..c.len()], c.as_slice()))
-            .collect();
-        images.push(lines(ctx, &format!("fig06_omega{w}"), &fig, &series)?);
+            Scale::Log,
+            &curves,
+        )?);
     }
     ctx.figure(
         "6",
@@ -630,8 +669,9 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         ("oscillator.masses", arr(&[0.09, 0.12, 0.09])),
         ("omega_ratio", f(0.70)),
     ])?;
+    // Orbit and impact-velocity diagrams only: the mechanics (the coupling is one-way).
     let values = grid(1.0, 1.6, ctx.budget.coarse);
-    let results = sweep(ctx, &base, "gap_ratio", &values, false)?;
+    let results = sweep(ctx, &base, "gap_ratio", &values, true)?;
     let a = orbit_figure(
         ctx,
         "fig07a_orbit_x2",
@@ -643,7 +683,7 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         1.0 / 0.020,
     )?;
     let fine = grid(1.40, 1.52, ctx.budget.fine);
-    let fres = sweep(ctx, &base, "gap_ratio", &fine, false)?;
+    let fres = sweep(ctx, &base, "gap_ratio", &fine, true)?;
     let b = orbit_figure(
         ctx,
         "fig07b_orbit_x2_zoom",
@@ -712,25 +752,12 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     let mut images = Vec::new();
     for r in [1.085, 1.090] {
         let run = run_series(&base.with("gap_ratio", r)?, ctx.budget.series, 2, 400, false)?;
-        let s = &run.series;
-        let fig = Figure::new(
-            format!("D1 at R_δ = {r}: time history (last two periods)"),
-            "time t [s]",
-            "D1 [m]",
-        );
-        images.push(lines(
+        images.extend(d1_figures(
             ctx,
-            &format!("fig08_d1_{r}"),
-            &fig,
-            &[("D1", &s.t, &s.d[0])],
-        )?);
-        let rate: Vec<f64> = (0..s.t.len()).map(|j| s.v[0][j] - s.v[1][j]).collect();
-        let fig = Figure::new(format!("D1 at R_δ = {r}: phase plot"), "D1 [m]", "dD1/dt [m/s]");
-        images.push(lines(
-            ctx,
-            &format!("fig08_phase_{r}"),
-            &fig,
-            &[("D1", &s.d[0], &rate)],
+            &run.series,
+            ("fig08", r),
+            &format!("R_δ = {r}"),
+            ": time history (last two periods)",
         )?);
     }
     ctx.figure(
@@ -760,20 +787,9 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     // and the slowest m1–m2 impact next to each.
     let graze_grid = grid(1.40, 1.44, if ctx.quick { 81 } else { 401 });
     let gres = sweep(ctx, &base, "gap_ratio", &graze_grid, true)?;
-    let slowest = |r: &PointResult| {
-        r.impacts
-            .iter()
-            .filter(|i| i.contact == 0)
-            .map(|i| i.closing_speed)
-            .fold(f64::INFINITY, f64::min)
-    };
+    let slowest = |r: &PointResult| closing_speeds(r, 0).fold(f64::INFINITY, f64::min);
     let typical = {
-        let mut v: Vec<f64> = gres[0]
-            .impacts
-            .iter()
-            .filter(|i| i.contact == 0)
-            .map(|i| i.closing_speed)
-            .collect();
+        let mut v: Vec<f64> = closing_speeds(&gres[0], 0).collect();
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
@@ -867,7 +883,8 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
             "R_δ = {r}: paper {claim}, vibrotribo {ours}, P_a = {}",
             si(p.average_power_w.unwrap_or(f64::NAN), "W")
         ));
-        // PSD of x2 over the recorded stroboscopic... use a dense run for the PSD.
+        // The PSD of x2 needs denser samples than one per period: a separate run, 64 samples
+        // per period over its last 64 periods.
         let run = run_series(
             &base.with("gap_ratio", *r)?,
             ctx.budget.series + 64,
@@ -898,20 +915,15 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
             let de: Vec<f64> = psd.density[1..].to_vec();
             images.push(lines(ctx, &format!("fig10_psd_{r}"), &fig, &[("PSD", &fr, &de)])?);
         }
-        let n = p.strobe.len() / p.strobe_periods.len().max(1);
-        let x2: Vec<f64> = (0..p.strobe_periods.len())
-            .map(|j| p.strobe[j * n + 1] / 0.020)
-            .collect();
-        let next: Vec<f64> = x2.iter().skip(1).copied().collect();
-        let mut fig = Figure::new(
+        images.push(return_map(
+            ctx,
+            &format!("fig10_poincare_{r}"),
             format!("Poincaré section of X2 at R_δ = {r}: X2(n+1) against X2(n)"),
-            "X2(n)",
-            "X2(n+1)",
-        );
-        fig.legend = Legend::Hidden;
-        images.push(both(ctx, &format!("fig10_poincare_{r}"), |path| {
-            plot::scatter_plot(path, &fig, &[Series::unlabelled(&x2[..next.len()], &next)], 5)
-        })?);
+            p,
+            1,
+            0.020,
+            5,
+        )?);
     }
     ctx.figure(
         "10",
@@ -945,15 +957,12 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         .iter()
         .map(|p| p.average_power_w.unwrap_or(f64::NAN))
         .collect();
-    let mut fig = Figure::new(
+    let fig = Figure::new(
         format!("Average power of the four motions (R_δ = {})", labels.join(", ")),
         "motion (0: 1.415, 1: 1.423, 2: 1.430, 3: 1.512)",
         "P_a [W]",
     );
-    fig.legend = Legend::Hidden;
-    let img = both(ctx, "fig11_power", |p| {
-        plot::scatter_plot(p, &fig, &[Series::unlabelled(&xs, &ys)], 9)
-    })?;
+    let img = scatter(ctx, "fig11_power", fig, &xs, &ys, 9)?;
     ctx.figure(
         "11",
         "Average power of the four motions",
@@ -981,13 +990,7 @@ fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
                 .join(", "),
             si(max_p, "W")
         ),
-        if decreasing && max_p < 1e-5 {
-            Verdict::Agrees
-        } else if decreasing || max_p < 1e-5 {
-            Verdict::Partly
-        } else {
-            Verdict::Differs
-        },
+        Verdict::of(usize::from(decreasing) + usize::from(max_p < 1e-5), 2),
     );
     Ok(())
 }
@@ -1023,12 +1026,7 @@ fn fig_12(ctx: &mut Ctx) -> Result<()> {
     // Amplitude: largest |x2| over the recorded samples, and its trend (Spearman's ρ).
     let amp: Vec<f64> = res
         .iter()
-        .map(|r| {
-            let n = r.strobe.len() / r.strobe_periods.len().max(1);
-            (0..r.strobe_periods.len())
-                .map(|j| r.strobe[j * n + 1].abs())
-                .fold(0.0, f64::max)
-        })
+        .map(|r| r.position_series(1).map(f64::abs).fold(0.0, f64::max))
         .collect();
     let rho = spearman(&values, &amp);
     ctx.finding(
@@ -1072,13 +1070,9 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
         let solver = run.solver.as_ref().expect("electrical");
         let samples = solver.samples().expect("sampled");
         // Impacts per period between m1 and m2 over the kept two periods.
-        let impacts12 = s
-            .events
-            .iter()
-            .filter(|e| e.1 == EventKind::Impact && e.2 == 0)
-            .count() as f64
-            / 2.0;
-        let p = solver.power_curve().last().copied().unwrap_or(f64::NAN);
+        let impacts12 = s.impacts.iter().filter(|(contact, _)| *contact == 0).count() as f64 / 2.0;
+        let curve = solver.power_curve();
+        let p = curve.last().copied().unwrap_or(f64::NAN);
         per.push((r, impacts12, p));
         let fig = Figure::new(
             format!("D1 at R_m = {r} (last two periods)"),
@@ -1102,18 +1096,12 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
             &fig,
             &[("I", &samples.times, &samples.current_a)],
         )?);
-        let curve = solver.power_curve();
-        let n: Vec<f64> = (1..=curve.len()).map(|k| k as f64).collect();
-        let fig = Figure::new(
-            format!("Running average power at R_m = {r}"),
-            "periods N_p",
-            "P_a [W]",
-        );
-        images.push(lines(
+        images.push(running_power(
             ctx,
             &format!("fig13_power_{r}"),
-            &fig,
-            &[("P_a", &n, &curve)],
+            format!("Running average power at R_m = {r}"),
+            Scale::Linear,
+            &[("P_a".into(), curve)],
         )?);
     }
     // R_m = 1, symmetric: impacts die out from a perturbed start.
@@ -1122,12 +1110,7 @@ fn fig_13(ctx: &mut Ctx) -> Result<()> {
         ("run.initial_velocities", arr(&[-1.0, 0.5, 1.5])),
     ])?;
     let run = run_series(&equal, 400, 100, 10, false)?;
-    let late_impacts = run
-        .series
-        .events
-        .iter()
-        .filter(|e| e.1 == EventKind::Impact)
-        .count();
+    let late_impacts = run.series.impacts.len();
     ctx.figure(
         "13",
         "Gap D1, current and running power for three mass ratios",
@@ -1209,13 +1192,7 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     let (best_r, best_p) = refine_maximum(&values, &power).unwrap_or((f64::NAN, f64::NAN));
     let vmax: Vec<f64> = res
         .iter()
-        .map(|r| {
-            r.impacts
-                .iter()
-                .filter(|i| i.contact == 0)
-                .map(|i| i.closing_speed)
-                .fold(0.0, f64::max)
-        })
+        .map(|r| closing_speeds(r, 0).fold(0.0, f64::max))
         .collect();
     let (vi, _) = vmax
         .iter()
@@ -1238,13 +1215,10 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
             values[vi],
             describe_ranges(&np, values[1] - values[0])
         ),
-        if (best_r - 3.5).abs() < 0.3 && (at4 - 3.0).abs() < 0.01 {
-            Verdict::Agrees
-        } else if (best_r - 3.5).abs() < 0.3 || (at4 - 3.0).abs() < 0.01 {
-            Verdict::Partly
-        } else {
-            Verdict::Differs
-        },
+        Verdict::of(
+            usize::from((best_r - 3.5).abs() < 0.3) + usize::from((at4 - 3.0).abs() < 0.01),
+            2,
+        ),
     );
     // Fig. 15: running power at three mass ratios.
     let mut curves = Vec::new();
@@ -1255,13 +1229,13 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
             run.solver.expect("electrical").power_curve(),
         ));
     }
-    let n: Vec<f64> = (1..=curves[0].1.len()).map(|k| k as f64).collect();
-    let fig = Figure::new("Running average power at Ω = 0.72", "periods N_p", "P_a [W]");
-    let series: Vec<(&str, &[f64], &[f64])> = curves
-        .iter()
-        .map(|(l, c)| (l.as_str(), &n[..c.len()], c.as_slice()))
-        .collect();
-    let img = lines(ctx, "fig15_power", &fig, &series)?;
+    let img = running_power(
+        ctx,
+        "fig15_power",
+        "Running average power at Ω = 0.72".into(),
+        Scale::Linear,
+        &curves,
+    )?;
     let finals: Vec<f64> = curves
         .iter()
         .map(|c| c.1.last().copied().unwrap_or(f64::NAN))
@@ -1302,12 +1276,7 @@ fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
                 .map(|p| p.average_power_w.unwrap_or(f64::NAN))
         })
         .collect::<Result<_>>()?;
-    let mut opt = Vec::new();
-    for (i, &w) in omegas.iter().enumerate() {
-        if let Some((r, _)) = refine_maximum(&ratios, &pw[i * ratios.len()..(i + 1) * ratios.len()]) {
-            opt.push((w, r));
-        }
-    }
+    let opt = optima(&omegas, &ratios, &pw);
     let ws: Vec<f64> = opt.iter().map(|o| o.0).collect();
     let rs: Vec<f64> = opt.iter().map(|o| o.1).collect();
     let fit = fit_quadratic(&ws, &rs).ok();
@@ -1442,26 +1411,18 @@ fn fig_17(ctx: &mut Ctx) -> Result<()> {
         )?);
         let vmax: Vec<f64> = res
             .iter()
-            .map(|r| {
-                r.impacts
-                    .iter()
-                    .filter(|i| i.contact == 0)
-                    .map(|i| i.closing_speed)
-                    .fold(0.0, f64::max)
-            })
+            .map(|r| closing_speeds(r, 0).fold(0.0, f64::max))
             .collect();
         let third = vmax.len() / 3;
         let tail = &vmax[2 * third..];
-        let spread = (tail.iter().copied().fold(0.0, f64::max)
-            - tail.iter().copied().fold(f64::INFINITY, f64::min))
-            / tail.iter().copied().fold(0.0, f64::max);
+        let tail_max = tail.iter().copied().fold(0.0, f64::max);
+        let spread = (tail_max - tail.iter().copied().fold(f64::INFINITY, f64::min)) / tail_max;
         let (imax, _) = vmax
             .iter()
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(b.1))
             .unwrap_or((0, &0.0));
-        let interior_peak =
-            imax > 0 && imax < 2 * third && vmax[imax] > 1.1 * tail.iter().copied().fold(0.0, f64::max);
+        let interior_peak = imax > 0 && imax < 2 * third && vmax[imax] > 1.1 * tail_max;
         if spread < 0.15 && !interior_peak {
             saturate += 1;
         }
@@ -1549,22 +1510,17 @@ fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         },
     )?;
     let p = long.run(&[("mass_ratio", 4.21)], None)?;
-    let n = 3;
     let mut images = Vec::new();
     for i in 0..3 {
-        let xi: Vec<f64> = (0..p.strobe_periods.len())
-            .map(|j| p.strobe[j * n + i] / 0.020)
-            .collect();
-        let next: Vec<f64> = xi.iter().skip(1).copied().collect();
-        let mut fig = Figure::new(
+        images.push(return_map(
+            ctx,
+            &format!("fig19_poincare_x{}", i + 1),
             format!("Poincaré section of X{} at Ω = 0.30, R_m = 4.21", i + 1),
-            format!("X{}(n)", i + 1),
-            format!("X{}(n+1)", i + 1),
-        );
-        fig.legend = Legend::Hidden;
-        images.push(both(ctx, &format!("fig19_poincare_x{}", i + 1), |path| {
-            plot::scatter_plot(path, &fig, &[Series::unlabelled(&xi[..next.len()], &next)], 3)
-        })?);
+            &p,
+            i,
+            0.020,
+            3,
+        )?);
     }
     let period_421 = p.period();
     ctx.figure(
@@ -1709,20 +1665,12 @@ fn figs_20_25(ctx: &mut Ctx) -> Result<()> {
         let s = &run.series;
         let solver = run.solver.as_ref().expect("electrical");
         let e = solver.samples().expect("sampled");
-        let fig = Figure::new(format!("D1 at Ω = {w} (one period)"), "time t [s]", "D1 [m]");
-        images22.push(lines(
+        images22.extend(d1_figures(
             ctx,
-            &format!("fig22_d1_{w}"),
-            &fig,
-            &[("D1", &s.t, &s.d[0])],
-        )?);
-        let rate: Vec<f64> = (0..s.t.len()).map(|j| s.v[0][j] - s.v[1][j]).collect();
-        let fig = Figure::new(format!("D1 at Ω = {w}: phase plot"), "D1 [m]", "dD1/dt [m/s]");
-        images22.push(lines(
-            ctx,
-            &format!("fig22_phase_{w}"),
-            &fig,
-            &[("D1", &s.d[0], &rate)],
+            s,
+            ("fig22", *w),
+            &format!("Ω = {w}"),
+            " (one period)",
         )?);
         let sum: Vec<f64> = (0..s.t.len()).map(|j| s.d[0][j] + s.d[1][j]).collect();
         let fig = Figure::new(format!("Gaps at Ω = {w} (one period)"), "time t [s]", "gap [m]");
@@ -1847,16 +1795,28 @@ fn extras(ctx: &mut Ctx) -> Result<()> {
     let mut traj = Trajectory::new(&sim);
     sim.run_until(periods as f64 * chain.period(), &mut traj)?;
     let transient = periods as usize / 2;
-    let mut powers = Vec::new();
-    for model in [VocModel::Paper, VocModel::Exact] {
+    let average_power = |s: &ChargeSolver| s.summary(transient).map_or(f64::NAN, |s| s.average_power_w);
+    // Air breakdown over the last period at a load resistance, on the paper's harvester.
+    let breakdown_at = |r: f64| {
         let h = HarvesterParams {
-            voc_model: model,
+            load_resistance: r,
             ..HarvesterParams::default()
         };
-        let mut s = ChargeSolver::for_chain(&h, &chain, ChargeOptions::default())?;
-        s.run_trajectory(&traj)?;
-        powers.push(s.summary(transient).map_or(f64::NAN, |s| s.average_power_w));
-    }
+        breakdown_over_vq_cycle(&h, &chain, &ChargeOptions::default(), &traj, periods - 1, 2000)
+    };
+    // The paper's case (100 kΩ, the paper's V_oc): its power comes from the same run (the
+    // V–Q recording does not change the solver's steps).
+    let (paper, paper_margin) = breakdown_at(1e5)?;
+    let mut exact = ChargeSolver::for_chain(
+        &HarvesterParams {
+            voc_model: VocModel::Exact,
+            ..HarvesterParams::default()
+        },
+        &chain,
+        ChargeOptions::default(),
+    )?;
+    exact.run_trajectory(&traj)?;
+    let powers = [average_power(&paper), average_power(&exact)];
     let sweep = load_sweep(
         &traj,
         &HarvesterParams::default(),
@@ -1876,29 +1836,10 @@ fn extras(ctx: &mut Ctx) -> Result<()> {
     fig.legend = Legend::Hidden;
     let img = lines(ctx, "extra_load_sweep", &fig, &[("P_a", &xs, &ys)])?;
     let best = sweep.optimum;
-    // Air breakdown over the last period at the paper's load and at the optimum.
-    let mut margins = Vec::new();
-    for r in [1e5, best.resistance_ohm] {
-        let h = HarvesterParams {
-            load_resistance: r,
-            ..HarvesterParams::default()
-        };
-        let last = periods - 1;
-        let mut s =
-            ChargeSolver::for_chain(&h, &chain, ChargeOptions::default())?.with_vq_cycle(last, 2000)?;
-        s.run_trajectory(&traj)?;
-        let mut margin = BreakdownMargin::default();
-        let (mut d, mut rates) = ([0.0; 2], [0.0; 2]);
-        if let Some(c) = s.vq_cycle() {
-            for (j, &t) in c.times.iter().enumerate() {
-                if let Some(flow) = traj.flow_at(t) {
-                    flow.gaps_at(t, &mut d, &mut rates);
-                    margin.add(&h, &PaschenParams::default(), t, c.charge_c[j], d[0], d[1]);
-                }
-            }
-        }
-        margins.push(margin.worst_ratio);
-    }
+    let margins = [
+        paper_margin.worst_ratio,
+        breakdown_at(best.resistance_ohm)?.1.worst_ratio,
+    ];
     ctx.figure(
         "extra",
         "Average power against the load resistance",

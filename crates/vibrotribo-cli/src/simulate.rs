@@ -7,11 +7,14 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
-use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
-use vibrotribo::electrical::{ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, TransducerMode};
+use vibrotribo::electrical::breakdown::BreakdownMargin;
+use vibrotribo::electrical::{
+    ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, PowerSummary, TransducerMode,
+};
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
 use crate::config::{ConfigArgs, Loaded, RunSpec};
+use crate::harvester::add_breakdown_sample;
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Progress, interrupted};
 
@@ -45,10 +48,12 @@ struct Files {
     gaps: Vec<f64>,
     x: Vec<f64>,
     v: Vec<f64>,
+    /// The gaps d_k at the current sample, m.
+    d: Vec<f64>,
     row: Vec<f64>,
-    electrical: bool,
     rectifier: bool,
-    /// Air breakdown check over the samples after the transient (with a harvester).
+    /// With a harvester (electrical columns): the air breakdown check over the samples after
+    /// the transient (harvester, margin so far, end of the transient in s).
     breakdown: Option<(HarvesterParams, BreakdownMargin, f64)>,
     error: Option<anyhow::Error>,
 }
@@ -95,8 +100,8 @@ impl Files {
             gaps: params.gaps.clone(),
             x: vec![0.0; n],
             v: vec![0.0; n],
+            d: vec![0.0; n - 1],
             row: Vec::with_capacity(tr_cols.len()),
-            electrical: harvester.is_some(),
             rectifier,
             breakdown: harvester.map(|h| {
                 (
@@ -134,12 +139,14 @@ impl Files {
             }
             flow.state_at(t, &mut self.x, &mut self.v);
             let (y, _) = flow.base_at(t);
-            let n = self.x.len();
+            for (k, d) in self.d.iter_mut().enumerate() {
+                *d = self.gaps[k] - (self.x[k + 1] - self.x[k]);
+            }
             self.row.clear();
             self.row.push(t);
             self.row.extend_from_slice(&self.x);
             self.row.extend_from_slice(&self.v);
-            if self.electrical {
+            if let Some((h, margin, from)) = self.breakdown.as_mut() {
                 let idx = j as usize;
                 let at = |v: &[f64]| v.get(idx).copied().unwrap_or(f64::NAN);
                 let e = samples.filter(|s| s.times.get(idx).is_some_and(|&ts| ts == t));
@@ -152,22 +159,12 @@ impl Files {
                 if self.rectifier {
                     self.row.push(get(|s| &s.storage_voltage_v));
                 }
-                if let Some((h, margin, from)) = self.breakdown.as_mut()
-                    && t >= *from
-                {
-                    let (d1, d2) = (
-                        self.gaps[h.contact] - (self.x[h.contact + 1] - self.x[h.contact]),
-                        self.gaps.get(h.contact + 1).map_or(0.0, |g| {
-                            g - (self.x[(h.contact + 2).min(n - 1)] - self.x[h.contact + 1])
-                        }),
-                    );
-                    margin.add(h, &PaschenParams::default(), t, get(|s| &s.charge_c), d1, d2);
+                if t >= *from {
+                    add_breakdown_sample(margin, h, t, get(|s| &s.charge_c), &self.d);
                 }
             }
             self.row.push(y);
-            for k in 0..n - 1 {
-                self.row.push(self.gaps[k] - (self.x[k + 1] - self.x[k]));
-            }
+            self.row.extend_from_slice(&self.d);
             let r = self.trajectory.row(self.row.iter());
             self.keep(r);
             self.next_sample += 1;
@@ -272,19 +269,19 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     progress.finish();
-    let elapsed = started.elapsed().as_secs_f64();
-    let summary = summary_json(
-        &loaded,
-        &params,
-        &spec,
-        &rec,
-        harvester.as_ref(),
+    let outcome = Outcome {
         done,
-        elapsed,
-        failure.as_ref(),
-    );
+        elapsed: started.elapsed().as_secs_f64(),
+        impacts_per_period: rec.stats.impacts_per_period(done),
+        power: rec
+            .solver
+            .as_ref()
+            .and_then(|s| s.summary(spec.transient_periods as usize)),
+        failure,
+    };
     if let (Some(files), Some(dir)) = (rec.files.as_mut(), &args.out) {
         files.flush()?;
+        let summary = summary_json(&loaded, &params, &spec, &rec, harvester.as_ref(), &outcome);
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
             crate::plots::analyze_run(dir, None)?;
@@ -295,11 +292,10 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         &spec,
         &rec,
         harvester.as_ref(),
-        done,
-        elapsed,
+        &outcome,
         args.out.as_deref(),
     );
-    if let Some(e) = failure {
+    if let Some(e) = outcome.failure {
         return Err(e).context(format!("simulation stopped after {done} complete periods"));
     }
     if done < spec.periods {
@@ -311,19 +307,32 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
+/// How a run ended and what it found, for the printed summary and `summary.json`.
+struct Outcome {
+    /// Complete periods simulated.
+    done: u64,
+    /// Wall time, s.
+    elapsed: f64,
+    /// Impacts per period after the transient, per contact.
+    impacts_per_period: Vec<f64>,
+    /// The harvester's power after the transient (`None` without a harvester, or without a
+    /// complete period after the transient).
+    power: Option<PowerSummary>,
+    /// Why the run stopped early, if it failed.
+    failure: Option<anyhow::Error>,
+}
+
 fn summary_json(
     loaded: &Loaded,
     params: &ChainParams,
     spec: &RunSpec,
     rec: &Recorder,
     harvester: Option<&HarvesterParams>,
-    done: u64,
-    elapsed: f64,
-    failure: Option<&anyhow::Error>,
+    outcome: &Outcome,
 ) -> serde_json::Value {
     let stats = &rec.stats;
-    let per_contact = stats.impacts_per_period(done);
+    let done = outcome.done;
+    let per_contact = &outcome.impacts_per_period;
     let after = stats.impacts_after_transient();
     let mut out = json!({
         "periods": done,
@@ -345,7 +354,7 @@ fn summary_json(
     });
     let obj = out.as_object_mut().expect("object");
     if let (Some(solver), Some(h)) = (&rec.solver, harvester) {
-        let s = solver.summary(spec.transient_periods as usize);
+        let s = &outcome.power;
         obj.insert(
             "average_power_w".into(),
             json!(s.as_ref().map(|s| s.average_power_w)),
@@ -389,12 +398,15 @@ fn summary_json(
     obj.insert("nondimensional".into(), json!(params.nondimensional()));
     obj.insert("parameters".into(), json!(params));
     obj.insert("settings".into(), json!(loaded.table));
-    obj.insert("wall_time_s".into(), json!(elapsed));
+    obj.insert("wall_time_s".into(), json!(outcome.elapsed));
     obj.insert(
         "interrupted".into(),
-        json!(done < spec.periods && failure.is_none()),
+        json!(done < spec.periods && outcome.failure.is_none()),
     );
-    obj.insert("error".into(), json!(failure.map(|e| format!("{e:#}"))));
+    obj.insert(
+        "error".into(),
+        json!(outcome.failure.as_ref().map(|e| format!("{e:#}"))),
+    );
     out
 }
 
@@ -403,13 +415,12 @@ fn print_summary(
     spec: &RunSpec,
     rec: &Recorder,
     harvester: Option<&HarvesterParams>,
-    done: u64,
-    elapsed: f64,
+    outcome: &Outcome,
     out: Option<&Path>,
 ) {
     let stats = &rec.stats;
     let n = params.len();
-    let per_contact = stats.impacts_per_period(done);
+    let per_contact = &outcome.impacts_per_period;
     println!(
         "vibrotribo simulate: {n} masses {:?} kg, Ω = {:.4} (ω = {:.3} rad/s, f = {:.4} Hz, T = {:.6} s)",
         params.masses,
@@ -419,8 +430,8 @@ fn print_summary(
         params.period()
     );
     println!(
-        "  simulated {done} periods ({} transient) in {:.3} s: {} events",
-        spec.transient_periods, elapsed, stats.events
+        "  simulated {} periods ({} transient) in {:.3} s: {} events",
+        outcome.done, spec.transient_periods, outcome.elapsed, stats.events
     );
     let contacts: Vec<String> = per_contact
         .iter()
@@ -447,7 +458,7 @@ fn print_summary(
             LoadKind::Rectifier => format!("rectifier into {}", si(h.storage_capacitance, "F")),
             other => other.as_str().to_string(),
         };
-        match solver.summary(spec.transient_periods as usize) {
+        match &outcome.power {
             Some(s) => println!(
                 "  harvester ({}, V_oc {}, {load}): average power {} after the transient, {} per period, peak current {}, peak voltage {}",
                 h.mode.as_str(),

@@ -8,11 +8,11 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow, bail};
 use rayon::prelude::*;
 use serde_json::json;
-use vibrotribo::ChainState;
 use vibrotribo::analysis::{PointOptions, PointResult, run_point};
+use vibrotribo::{ChainParams, ChainState};
 
-use crate::config::{ConfigArgs, Loaded};
-use crate::output::{CsvFile, create_dir, numbered, point_cells, point_columns, write_json};
+use crate::config::{ConfigArgs, Loaded, RunSpec};
+use crate::output::{CsvFile, create_dir, numbered, point_cells, point_columns, read_json, write_json};
 use crate::progress::{Progress, interrupted};
 
 /// Direction of parameter continuation.
@@ -140,6 +140,7 @@ pub fn grid(from: f64, to: f64, steps: usize) -> Vec<f64> {
 /// Everything needed to run one value of a sweep or a map.
 pub struct PointRunner {
     base: Loaded,
+    masses: usize,
     options: PointOptions,
     mechanics_only: bool,
 }
@@ -162,6 +163,7 @@ impl PointRunner {
         }
         Ok(PointRunner {
             base,
+            masses: params.len(),
             options: PointOptions {
                 transient_periods: transient,
                 recorded_periods: recorded,
@@ -182,14 +184,25 @@ impl PointRunner {
         &self.base
     }
 
-    /// Checks that the configuration with `keys` set to `values` is valid, without running it.
-    pub fn check(&self, keys: &[(&str, f64)]) -> Result<()> {
+    /// Number of masses of the chain (the same at every point: keys set numbers, not arrays).
+    pub fn masses(&self) -> usize {
+        self.masses
+    }
+
+    /// The base configuration with `keys` set to `values`: its chain and run settings.
+    fn configure(&self, keys: &[(&str, f64)]) -> Result<(Loaded, ChainParams, RunSpec)> {
         let mut loaded = self.base.clone();
         for (k, v) in keys {
             loaded = loaded.with(k, *v)?;
         }
         let params = loaded.config.chain_params()?;
-        loaded.config.run_spec(&params)?;
+        let spec = loaded.config.run_spec(&params)?;
+        Ok((loaded, params, spec))
+    }
+
+    /// Checks that the configuration with `keys` set to `values` is valid, without running it.
+    pub fn check(&self, keys: &[(&str, f64)]) -> Result<()> {
+        let (loaded, params, _) = self.configure(keys)?;
         if !self.mechanics_only {
             loaded.harvester(&params)?;
         }
@@ -214,12 +227,7 @@ impl PointRunner {
     /// Runs the configuration with `keys` set to `values`, from `initial` (or the configured
     /// initial state).
     pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult> {
-        let mut loaded = self.base.clone();
-        for (k, v) in keys {
-            loaded = loaded.with(k, *v)?;
-        }
-        let params = loaded.config.chain_params()?;
-        let spec = loaded.config.run_spec(&params)?;
+        let (loaded, params, spec) = self.configure(keys)?;
         let sim_options = loaded.config.sim_options()?;
         let harvester = if self.mechanics_only {
             None
@@ -238,6 +246,42 @@ impl PointRunner {
             &self.options,
         )?)
     }
+}
+
+/// Runs `points` in parallel chunks, calling `write` in grid order (so the output does not
+/// depend on the thread count) and ticking a progress bar labelled `what`; stops after the
+/// current chunk on Ctrl-C, keeping what was written. Returns how many were written.
+pub fn run_grid<'k, P, W>(
+    runner: &PointRunner,
+    points: &[P],
+    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
+    what: &str,
+    quiet: bool,
+    mut write: W,
+) -> Result<usize>
+where
+    P: Sync,
+    W: FnMut(&P, &Result<PointResult, String>) -> Result<()>,
+{
+    let progress = Progress::new(points.len() as u64, what, quiet);
+    let chunk = rayon::current_num_threads() * 4;
+    let mut done = 0;
+    for block in points.chunks(chunk) {
+        let results: Vec<Result<PointResult, String>> = block
+            .par_iter()
+            .map(|p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")))
+            .collect();
+        for (p, r) in block.iter().zip(&results) {
+            write(p, r)?;
+            done += 1;
+            progress.inc(1);
+        }
+        if interrupted() {
+            break;
+        }
+    }
+    progress.finish();
+    Ok(done)
 }
 
 /// Installs the worker-thread count (once per process).
@@ -273,7 +317,7 @@ impl SweepFiles {
             orbit: CsvFile::create(&dir.join("orbit.csv"), &orbit_cols)?,
             impacts: CsvFile::create(
                 &dir.join("impacts.csv"),
-                &["param", "time_s", "contact", "rel_velocity_m_s"].map(String::from),
+                &["param", "time_s", "contact", "rel_velocity_m_s"],
             )?,
             summary: CsvFile::create(&dir.join("summary.csv"), &summary_cols)?,
             contacts: masses - 1,
@@ -358,7 +402,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     let runner = PointRunner::new(base, &args.run)?;
-    let masses = runner.base().config.chain_params()?.len();
+    let masses = runner.masses();
     let values = grid(args.from, args.to, args.steps);
     // Fail early on a bad key or on any value of the grid that makes a bad configuration.
     runner.check_all(&values, |&v| vec![(args.param.as_str(), v)])?;
@@ -374,44 +418,29 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         None => None,
     };
     let started = Instant::now();
-    let progress = Progress::new(order.len() as u64, "values", args.run.quiet);
-    let mut done = 0usize;
     let mut failed = 0usize;
     let mut record = |value: f64, result: &Result<PointResult, String>| -> Result<()> {
         if result.is_err() {
             failed += 1;
         }
-        if let Some(f) = files.as_mut() {
-            f.write(value, result)?;
+        match files.as_mut() {
+            Some(f) => f.write(value, result),
+            None => Ok(()),
         }
-        done += 1;
-        progress.inc(1);
-        Ok(())
     };
     let key = args.param.as_str();
-    match args.continuation {
-        Continuation::None => {
-            // Parallel in chunks, written in grid order: the output does not depend on the
-            // thread count, and an interruption keeps every finished chunk.
-            let chunk = rayon::current_num_threads() * 4;
-            for block in order.chunks(chunk) {
-                let results: Vec<Result<PointResult, String>> = block
-                    .par_iter()
-                    .map(|&j| {
-                        runner
-                            .run(&[(key, values[j])], None)
-                            .map_err(|e| format!("{e:#}"))
-                    })
-                    .collect();
-                for (&j, r) in block.iter().zip(&results) {
-                    record(values[j], r)?;
-                }
-                if interrupted() {
-                    break;
-                }
-            }
-        }
+    let done = match args.continuation {
+        Continuation::None => run_grid(
+            &runner,
+            &order,
+            |&j| vec![(key, values[j])],
+            "values",
+            args.run.quiet,
+            |&j, r| record(values[j], r),
+        )?,
         Continuation::Up | Continuation::Down => {
+            let progress = Progress::new(order.len() as u64, "values", args.run.quiet);
+            let mut done = 0usize;
             let mut state: Option<ChainState> = None;
             for &j in &order {
                 let r = runner
@@ -421,13 +450,16 @@ pub fn run(args: &SweepArgs) -> Result<()> {
                     state = Some(p.final_state.clone());
                 }
                 record(values[j], &r)?;
+                done += 1;
+                progress.inc(1);
                 if interrupted() {
                     break;
                 }
             }
+            progress.finish();
+            done
         }
-    }
-    progress.finish();
+    };
     let complete = done == order.len();
     if let (Some(f), Some(dir)) = (files.as_mut(), &args.out) {
         f.flush()?;
@@ -497,11 +529,7 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let mut seen = vec![];
     let mut complete = true;
     for dir in &args.shards {
-        let path = dir.join("sweep.json");
-        let text =
-            std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let mut s: serde_json::Value =
-            serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))?;
+        let mut s = read_json(&dir.join("sweep.json"))?;
         let shard = s["shard"].clone();
         if shard.is_null() {
             bail!("{} is not a shard (it was run without --shard)", dir.display());

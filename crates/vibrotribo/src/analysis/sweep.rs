@@ -114,6 +114,15 @@ impl PointResult {
     pub fn total_impacts_per_period(&self) -> f64 {
         self.impacts_per_period.iter().sum()
     }
+
+    /// The stroboscopic positions x_i, m, of mass `i` (0-based), one per entry of
+    /// [`strobe_periods`](Self::strobe_periods); empty if `i` is not a mass of the chain.
+    pub fn position_series(&self, i: usize) -> impl Iterator<Item = f64> + '_ {
+        let n = self.strobe.len() / self.strobe_periods.len().max(1);
+        self.strobe
+            .chunks_exact(n.max(1))
+            .filter_map(move |x| x.get(i).copied())
+    }
 }
 
 /// A sweep point failed.
