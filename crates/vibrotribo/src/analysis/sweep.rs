@@ -257,3 +257,41 @@ pub fn run_point(
         final_state: sim.state(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Trajectory;
+
+    /// Each mass's stroboscopic series is its position at t = nT, n = strobe_periods, read
+    /// from a separately recorded trajectory of the same run.
+    #[test]
+    fn position_series_are_the_positions_at_the_strobe_times() {
+        let params = ChainParams::default();
+        let options = PointOptions {
+            transient_periods: 5,
+            recorded_periods: 6,
+            ..PointOptions::default()
+        };
+        let initial = ChainState::at_rest(3);
+        let point = run_point(&params, &initial, &SimOptions::default(), None, &options).unwrap();
+        let mut sim = Simulator::new(&params, &initial, SimOptions::default()).unwrap();
+        let mut traj = Trajectory::new(&sim);
+        sim.run_until(11.0 * params.period(), &mut traj).unwrap();
+        assert_eq!(point.strobe_periods.len(), 6);
+        let (mut x, mut v) = (vec![0.0; 3], vec![0.0; 3]);
+        for i in 0..3 {
+            let series: Vec<f64> = point.position_series(i).collect();
+            assert_eq!(series.len(), point.strobe_periods.len());
+            for (&n, got) in point.strobe_periods.iter().zip(series) {
+                assert!(traj.state_at(n as f64 * params.period(), &mut x, &mut v));
+                assert!(
+                    (got - x[i]).abs() < 1e-12,
+                    "mass {i}, period {n}: {got} vs {}",
+                    x[i]
+                );
+            }
+        }
+        assert_eq!(point.position_series(3).count(), 0);
+    }
+}
