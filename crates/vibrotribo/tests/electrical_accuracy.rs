@@ -2,7 +2,9 @@
 //! default tolerance against a reference computed with a 1e5 times tighter one, for loads
 //! from 1 kΩ (stiff) to 10 GΩ (not stiff), and convergence under halving the tolerance.
 
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, PeriodStats};
+mod common;
+use common::period_stats;
+use vibrotribo::electrical::{ChargeOptions, HarvesterParams, LoadKind, PeriodStats};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 fn trajectory(chain: &ChainParams, periods: f64) -> Trajectory {
@@ -10,16 +12,6 @@ fn trajectory(chain: &ChainParams, periods: f64) -> Trajectory {
     let mut t = Trajectory::new(&sim);
     sim.run_until(periods * chain.period(), &mut t).unwrap();
     t
-}
-
-fn periods(chain: &ChainParams, traj: &Trajectory, params: &HarvesterParams, rtol: f64) -> Vec<PeriodStats> {
-    let options = ChargeOptions {
-        rtol,
-        ..ChargeOptions::default()
-    };
-    let mut s = ChargeSolver::for_chain(params, chain, options).unwrap();
-    s.run_trajectory(traj).unwrap();
-    s.periods().to_vec()
 }
 
 /// Largest relative difference of the energy per period, over all periods.
@@ -39,9 +31,9 @@ fn check_case(name: &str, chain: &ChainParams, n_periods: f64, loads: &[f64]) {
             load_resistance: r,
             ..HarvesterParams::default()
         };
-        let reference = periods(chain, &traj, &params, default * 1e-5);
-        let got = periods(chain, &traj, &params, default);
-        let halved = periods(chain, &traj, &params, default / 2.0);
+        let reference = period_stats(chain, &traj, &params, default * 1e-5);
+        let got = period_stats(chain, &traj, &params, default);
+        let halved = period_stats(chain, &traj, &params, default / 2.0);
         let (err, change) = (worst(&got, &reference), worst(&got, &halved));
         println!(
             "{name}, R = {r:e} Ω: energy per period {:.6e} J; worst relative error vs reference {err:.2e}, \
@@ -89,8 +81,8 @@ fn rectifier_energy_per_period_within_1e_6() {
         ..HarvesterParams::default()
     };
     let default = ChargeOptions::default().rtol;
-    let reference = periods(&chain, &traj, &params, default * 1e-4);
-    let got = periods(&chain, &traj, &params, default);
+    let reference = period_stats(&chain, &traj, &params, default * 1e-4);
+    let got = period_stats(&chain, &traj, &params, default);
     let err = worst(&got, &reference);
     let vs = |p: &[PeriodStats]| p.last().unwrap().storage_voltage_v.unwrap();
     println!(

@@ -3,18 +3,10 @@
 //! spanned the bridge's switching, where the current changes by orders of magnitude between
 //! the stage points and the error estimate does not see it.
 
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, PeriodStats};
+mod common;
+use common::period_stats;
+use vibrotribo::electrical::{ChargeOptions, HarvesterParams, LoadKind};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
-
-fn periods(chain: &ChainParams, traj: &Trajectory, params: &HarvesterParams, rtol: f64) -> Vec<PeriodStats> {
-    let options = ChargeOptions {
-        rtol,
-        ..ChargeOptions::default()
-    };
-    let mut s = ChargeSolver::for_chain(params, chain, options).unwrap();
-    s.run_trajectory(traj).unwrap();
-    s.periods().to_vec()
-}
 
 #[test]
 fn rectifier_energy_per_period_within_1e_6_on_the_default_case() {
@@ -29,8 +21,8 @@ fn rectifier_energy_per_period_within_1e_6_on_the_default_case() {
             storage_capacitance: storage,
             ..HarvesterParams::default()
         };
-        let reference = periods(&chain, &traj, &params, default * 1e-5);
-        let got = periods(&chain, &traj, &params, default);
+        let reference = period_stats(&chain, &traj, &params, default * 1e-5);
+        let got = period_stats(&chain, &traj, &params, default);
         assert_eq!(got.len(), reference.len());
         for (g, r) in got.iter().zip(&reference) {
             let err = (g.energy_j - r.energy_j) / r.energy_j;

@@ -150,3 +150,21 @@ pub fn read_csv(path: &std::path::Path) -> Vec<Vec<f64>> {
         })
         .collect()
 }
+
+/// Energy statistics per period of the charge solver replaying `traj` (a run of `chain`) for
+/// the harvester `params` at relative tolerance `rtol`.
+pub fn period_stats(
+    chain: &ChainParams,
+    traj: &vibrotribo::Trajectory,
+    params: &vibrotribo::electrical::HarvesterParams,
+    rtol: f64,
+) -> Vec<vibrotribo::electrical::PeriodStats> {
+    use vibrotribo::electrical::{ChargeOptions, ChargeSolver};
+    let options = ChargeOptions {
+        rtol,
+        ..ChargeOptions::default()
+    };
+    let mut s = ChargeSolver::for_chain(params, chain, options).unwrap();
+    s.run_trajectory(traj).unwrap();
+    s.periods().to_vec()
+}
