@@ -7,7 +7,7 @@ would write it today: integrate the smooth equations of motion with an adaptive
 Runge-Kutta method, stop at terminal events (a gap closes, a stuck contact's
 force falls to zero), apply the impact / stick / release rule, restart.
 
-Model (see /work/shared/MODEL-NOTES.md section 1): N masses in a column (m1 on
+Model (see docs/MODEL.md section 1): N masses in a column (m1 on
 top), each tied to the base y = A sin(w t) by k_i, c_i:
 
     m_i x_i'' + c_i (x_i' - y') + k_i (x_i - y) = 0
@@ -57,7 +57,7 @@ import scipy
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-REF_DIR = "/work/shared/reference"
+REF_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "crates", "vibrotribo", "tests", "data", "reference")
 
 
 # --------------------------------------------------------------------------

@@ -27,7 +27,7 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 }
 
 fn reference_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../vibrotribo/tests/data/reference")
 }
 
 #[test]
@@ -56,7 +56,7 @@ fn output_files_follow_the_contract() {
     assert!(o.status.success(), "{}", stderr(&o));
     let (header, rows) = read_csv(&dir.path().join("events.csv"));
     assert_eq!(header[..4], ["time_s", "kind", "contact", "rel_velocity_m_s"]);
-    // The impacts are those of the independent reference (shared/reference).
+    // The impacts are those of the independent reference (crates/vibrotribo/tests/data/reference).
     let text = std::fs::read_to_string(reference_dir().join("default-case-impacts.csv")).unwrap();
     let reference: Vec<Vec<f64>> = text
         .lines()

@@ -1,6 +1,6 @@
 //! Runs the paper's default case (Sect. 4.1, configuration (1), m2 = 120 g, R_m = 2.5,
 //! Ω = 0.70) from rest for 40 periods and prints every impact, in the format of
-//! `shared/reference/default-case-impacts.csv`.
+//! `crates/vibrotribo/tests/data/reference/default-case-impacts.csv`.
 //!
 //! `cargo run --release --example default_case`
 use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator};

@@ -260,7 +260,7 @@ fn contact_separation_on_two_masses_relaxes_exponentially() {
 
 #[test]
 fn exact_voc_model_sets_gauss_law_equilibrium() {
-    // V_oc = σ(D₂ − D₁)/ε₀ (MODEL-NOTES §2).
+    // V_oc = σ(D₂ − D₁)/ε₀ (docs/MODEL.md §2).
     let (d1, d2) = (6e-3, 2e-3);
     let p = HarvesterParams {
         voc_model: VocModel::Exact,

@@ -1,4 +1,4 @@
-//! The paper's default case against `shared/reference/` (an independent adaptive integrator
+//! The paper's default case against `tests/data/reference/` (an independent adaptive integrator
 //! with event functions at rtol 1e-11, whose impact times are good to about 1e-9 s).
 
 mod common;

@@ -350,7 +350,7 @@ fn plastic_impacts_stick() {
 
 /// All three masses pressed together with no base motion: a stiff top, medium middle and soft
 /// bottom spring push the stack together. The cluster moves harmonically; the contact forces
-/// N_1 = m1 (a_G − a1), N_2 = (m1 + m2) a_G − m1 a1 − m2 a2 (MODEL-NOTES §1) are linear in the
+/// N_1 = m1 (a_G − a1), N_2 = (m1 + m2) a_G − m1 a1 − m2 a2 (docs/MODEL.md §1) are linear in the
 /// cluster position, so the first release time is analytic.
 #[test]
 fn all_three_stuck_release_at_the_analytic_time() {

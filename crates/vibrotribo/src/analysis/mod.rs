@@ -1,5 +1,5 @@
 //! Analyses of simulated motion: Poincaré sections, periodicity, spectra, fits
-//! (seed Sect. 4; MODEL-NOTES §3).
+//! (seed Sect. 4; docs/MODEL.md §3).
 
 //!
 //! Two kinds of tool live here:

@@ -445,14 +445,14 @@ mod tests {
 
     /// The paper's default case from rest, sampled at t = nT, n = 0..=40, against an
     /// independent adaptive integration (Dormand–Prince 8(5,3), rtol 1e-11, event location;
-    /// `shared/reference/default-case-strobe.csv`, beside the repository).
+    /// `tests/data/reference/default-case-strobe.csv`).
     #[test]
     fn stroboscopic_section_of_the_default_case_matches_the_reference_integration() {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../../shared/reference/default-case-strobe.csv"
+            "/tests/data/reference/default-case-strobe.csv"
         );
-        let reference = std::fs::read_to_string(path).expect("shared/reference beside the repository");
+        let reference = std::fs::read_to_string(path).expect("tests/data/reference/default-case-strobe.csv");
         let p = ChainParams::default();
         let mut sim = Simulator::new(&p, &ChainState::at_rest(3), SimOptions::default()).unwrap();
         let mut section = StroboscopicSection::for_simulator(&sim, StroboscopicOptions::default()).unwrap();

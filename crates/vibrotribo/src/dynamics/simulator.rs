@@ -22,7 +22,7 @@
 //!   by the linear complementarity problem `w = q + Wλ ≥ 0, λ ≥ 0, wᵀλ = 0` (q: gap
 //!   accelerations of the free masses; W: the tridiagonal Delassus matrix of the chain, an
 //!   M-matrix), solved exactly by Chandrasekaran's monotone active-set method. Inside a
-//!   cluster this gives the corrected contact force of MODEL-NOTES §1,
+//!   cluster this gives the corrected contact force of docs/MODEL.md §1,
 //!   `N_j = Σ_{i≤j} m_i (a_G − a_i)`, not the paper's eqs. 9–10 (whose factor ½ is exact only
 //!   for equal masses).
 //! - **Release**: a closed contact opens when its force falls to zero.

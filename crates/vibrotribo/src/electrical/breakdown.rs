@@ -1,6 +1,6 @@
 //! Air breakdown across the gaps (Paschen's law): is a computed operating point physical?
 //!
-//! The electric field in each air gap follows from Gauss's law across the stack (MODEL-NOTES
+//! The electric field in each air gap follows from Gauss's law across the stack (docs/MODEL.md
 //! §2). With `Q` the charge of the transducer in the exact form `V = −Q/C + σ(D₂ − D₁)/ε₀`
 //! (freestanding mode: top electrode −Q, film −σS, metal +2σS, film −σS, bottom electrode
 //! +Q), the gap voltages are

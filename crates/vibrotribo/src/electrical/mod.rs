@@ -1,5 +1,5 @@
 //! Triboelectric transducers, electrical loads and the charge solver (seed Sect. 3,
-//! eqs. 11–14; MODEL-NOTES §2).
+//! eqs. 11–14; docs/MODEL.md §2).
 //!
 //! ## Model
 //!

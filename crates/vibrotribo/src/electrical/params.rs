@@ -44,7 +44,7 @@ pub enum VocModel {
     /// The paper's eq. 13, `V_oc = 2σD₂/ε₀` (exact only when the outer plates are fixed).
     #[default]
     Paper,
-    /// Gauss's law with moving outer plates (MODEL-NOTES §2), `V_oc = σ(D₂ − D₁)/ε₀`.
+    /// Gauss's law with moving outer plates (docs/MODEL.md §2), `V_oc = σ(D₂ − D₁)/ε₀`.
     Exact,
 }
 

@@ -1,7 +1,7 @@
 //! ngspice netlists of the harvester circuit, for cross-checking the charge solver against a
 //! real circuit simulator, and a runner for `ngspice -b`.
 //!
-//! The netlist follows MODEL-NOTES §2:
+//! The netlist follows docs/MODEL.md §2:
 //!
 //! - the gaps enter as `PWL` voltage sources, 1 V standing for 1 m;
 //! - the transducer is a behavioural voltage source `V = V_oc − Q/C` whose charge `Q` is a

@@ -1,5 +1,5 @@
 //! Triboelectric transducers: capacitance C and open-circuit voltage V_oc as functions of the
-//! gaps (seed eqs. 12–13; MODEL-NOTES §2).
+//! gaps (seed eqs. 12–13; docs/MODEL.md §2).
 //!
 //! Both transducers have an elastance 1/C and an open-circuit voltage that are *linear* in the
 //! gaps, so the equilibrium charge `Q_eq = C·V_oc` and its rate `dQ_eq/dt` are explicit

@@ -130,9 +130,9 @@ pub fn integrate_to(ode: ClusterOde, t0: f64, t1: f64, y0: &[f64]) -> Vec<f64> {
     integrate_segment(ode, t0, t1, y0)
 }
 
-/// Directory of the shared reference data (`../shared/reference` beside the repository).
+/// Directory of the reference data of the paper's default case (`tests/data/reference/`; see its README).
 pub fn reference_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference")
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/reference")
 }
 
 /// Reads a CSV file of numbers with one header line.
