@@ -4,7 +4,6 @@
 use anyhow::{Result, anyhow, bail};
 use toml::{Table, Value};
 use vibrotribo::ChainParams;
-use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
 use vibrotribo::electrical::{ChargeOptions, HarvesterParams, TransducerMode};
 
 use crate::config::Loaded;
@@ -76,12 +75,4 @@ impl Loaded {
         o.validate()?;
         Ok(o)
     }
-}
-
-/// Folds one sample into the air-breakdown check `margin` of the harvester `h` (Paschen's
-/// law, air at 1 atm): time `t`, s, charge `q`, C, and every gap of the chain, m. The
-/// harvester's gaps are `gaps[h.contact]` and the next one (0 past the last contact).
-pub fn add_breakdown_sample(margin: &mut BreakdownMargin, h: &HarvesterParams, t: f64, q: f64, gaps: &[f64]) {
-    let d2 = gaps.get(h.contact + 1).copied().unwrap_or(0.0);
-    margin.add(h, &PaschenParams::default(), t, q, gaps[h.contact], d2);
 }

@@ -12,7 +12,6 @@ use vibrotribo::electrical::{
 use vibrotribo::{ChainParams, Simulator, Trajectory};
 
 use crate::config::ConfigArgs;
-use crate::harvester::add_breakdown_sample;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot;
 use crate::plots::both;
@@ -24,10 +23,10 @@ pub struct LoadSweepArgs {
     #[command(flatten)]
     pub input: ConfigArgs,
     /// Smallest load resistance, Ω.
-    #[arg(long, default_value_t = 1e3)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1e3)]
     pub from: f64,
     /// Largest load resistance, Ω.
-    #[arg(long, default_value_t = 1e13)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1e13)]
     pub to: f64,
     /// Log-spaced resistances between --from and --to.
     #[arg(long, default_value_t = 41)]
@@ -47,8 +46,8 @@ pub struct LoadSweepArgs {
 }
 
 /// Runs the charge solver of `h` over `trajectory` (of `chain`), recording the V–Q cycle of
-/// period `index` at `points + 1` times, and checks those samples for air breakdown. Returns
-/// the solver (its V–Q cycle and power) and the margin (no samples: the default, 0).
+/// period `index` at `points + 1` times, and checks the air gaps for breakdown from that
+/// period on. Returns the solver (its V–Q cycle and power) and the margin.
 pub fn breakdown_over_vq_cycle(
     h: &HarvesterParams,
     chain: &ChainParams,
@@ -57,18 +56,11 @@ pub fn breakdown_over_vq_cycle(
     index: u64,
     points: usize,
 ) -> Result<(ChargeSolver, BreakdownMargin)> {
-    let mut s = ChargeSolver::for_chain(h, chain, options.clone())?.with_vq_cycle(index, points)?;
+    let mut s = ChargeSolver::for_chain(h, chain, options.clone())?
+        .with_vq_cycle(index, points)?
+        .with_breakdown_check(index as f64 * chain.period());
     s.run_trajectory(trajectory)?;
-    let mut margin = BreakdownMargin::default();
-    if let Some(c) = s.vq_cycle() {
-        let (mut d, mut rates) = (vec![0.0; chain.len() - 1], vec![0.0; chain.len() - 1]);
-        for (&t, &q) in c.times.iter().zip(&c.charge_c) {
-            if let Some(flow) = trajectory.flow_at(t) {
-                flow.gaps_at(t, &mut d, &mut rates);
-                add_breakdown_sample(&mut margin, h, t, q, &d);
-            }
-        }
-    }
+    let margin = s.breakdown_margin().copied().unwrap_or_default();
     Ok((s, margin))
 }
 

@@ -4,6 +4,8 @@
 mod config;
 mod export_spice;
 mod harvester;
+mod job;
+mod limits;
 mod load_sweep;
 mod map;
 mod output;
@@ -60,7 +62,8 @@ struct PlotArgs {
 
 fn run() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    progress::install_interrupt_handler();
+    progress::install_interrupt_handler()
+        .map_err(|e| anyhow::anyhow!("cannot install the signal handlers: {e}"))?;
     match cli.command {
         Command::Simulate(args) => simulate::run(&args),
         Command::LoadSweep(args) => load_sweep::run(&args),
@@ -77,9 +80,15 @@ fn run() -> anyhow::Result<()> {
 fn main() -> ExitCode {
     match run() {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
+        Err(e) => match e.downcast_ref::<progress::Interrupted>() {
+            Some(stop) => {
+                eprintln!("{stop}");
+                ExitCode::from(progress::interrupt_status())
+            }
+            None => {
+                eprintln!("error: {e:#}");
+                ExitCode::FAILURE
+            }
+        },
     }
 }

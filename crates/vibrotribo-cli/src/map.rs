@@ -5,14 +5,20 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::{Result, anyhow, bail};
 use serde_json::json;
 use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 
 use crate::config::ConfigArgs;
+use crate::job::{CsvSpec, GridOutput, Layout};
+use crate::limits;
 use crate::output::{CsvFile, create_dir, point_cells, point_columns, write_json};
 use crate::plot::{self, Figure, Series};
-use crate::sweep::{PointRunner, RunArgs, grid, run_grid, set_threads};
+use crate::progress::Interrupted;
+use crate::sweep::{
+    MergeArgs, PointRunner, RunArgs, Shard, check_distinct, estimate_point_memory, estimate_point_output,
+    grid, header_len, run_grid, set_threads,
+};
 
 /// Options of `vibrotribo map`.
 #[derive(Debug, clap::Args)]
@@ -23,10 +29,10 @@ pub struct MapArgs {
     #[arg(long)]
     pub x: String,
     /// First x value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub x_from: f64,
     /// Last x value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub x_to: f64,
     /// Number of x values.
     #[arg(long)]
@@ -35,10 +41,10 @@ pub struct MapArgs {
     #[arg(long)]
     pub y: String,
     /// First y value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub y_from: f64,
     /// Last y value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub y_to: f64,
     /// Number of y values.
     #[arg(long)]
@@ -46,6 +52,13 @@ pub struct MapArgs {
     /// Write map.csv and map.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Compute only the I-th of N interleaved slices of the grid (points in map.csv order),
+    /// e.g. `--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`; combine with `merge`.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<Shard>,
+    /// Continue the interrupted map (or shard) in --out DIR from its finished points.
+    #[arg(long)]
+    pub resume: bool,
     /// Also draw heat maps (PNG and SVG) into the output directory.
     #[arg(long)]
     pub plot: bool,
@@ -63,12 +76,40 @@ fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
     Ok(())
 }
 
+/// Files of a map directory: `map.csv` (one row per point) and the manifest `map.json`.
+fn map_layout(contacts: usize) -> Layout {
+    let mut cols = vec!["x".to_string(), "y".to_string()];
+    cols.extend(point_columns(contacts));
+    Layout {
+        manifest: "map.json",
+        files: vec![CsvSpec {
+            name: "map.csv",
+            columns: cols,
+        }],
+        index_file: 0,
+        key_fields: 2,
+    }
+}
+
+/// The points of a map in grid order (y outer, x inner) and their keys (`x,y` as written).
+fn map_points(xs: &[f64], ys: &[f64]) -> Vec<(f64, f64)> {
+    ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect()
+}
+
+fn point_key(&(x, y): &(f64, f64)) -> String {
+    format!("{x},{y}")
+}
+
 /// Runs `vibrotribo map`.
 pub fn run(args: &MapArgs) -> Result<()> {
     check_axis("x", args.x_from, args.x_to, args.x_steps)?;
     check_axis("y", args.y_from, args.y_to, args.y_steps)?;
+    limits::check_grid("--x-steps × --y-steps", args.x_steps as f64 * args.y_steps as f64)?;
     if args.plot && args.out.is_none() {
         bail!("--plot needs --out DIR");
+    }
+    if args.resume && args.out.is_none() {
+        bail!("--resume needs --out DIR (the directory of the job to continue)");
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
@@ -77,66 +118,132 @@ pub fn run(args: &MapArgs) -> Result<()> {
         grid(args.x_from, args.x_to, args.x_steps),
         grid(args.y_from, args.y_to, args.y_steps),
     );
-    let points: Vec<(f64, f64)> = ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect();
+    check_distinct("--x-from/--x-to/--x-steps", &xs)?;
+    check_distinct("--y-from/--y-to/--y-steps", &ys)?;
+    let mut points = map_points(&xs, &ys);
+    if let Some(s) = args.shard {
+        points = points
+            .into_iter()
+            .enumerate()
+            .filter(|(j, _)| j % s.count == s.index)
+            .map(|(_, p)| p)
+            .collect();
+    }
     runner.check_all(&points, |&(x, y)| {
         vec![(args.x.as_str(), x), (args.y.as_str(), y)]
     })?;
+    let threads = rayon::current_num_threads() as f64;
+    limits::check_memory(
+        "one point of the map (--transient + --recorded periods)",
+        estimate_point_memory(&runner) * threads * 4.0,
+        args.run.allow_large,
+    )?;
+    if args.out.is_some() {
+        limits::check_output(
+            "map.csv",
+            estimate_point_output(&runner, false) * points.len() as f64,
+            args.run.allow_large,
+        )?;
+    }
     let contacts = runner.masses() - 1;
-    let mut csv = match &args.out {
-        Some(dir) => {
-            create_dir(dir)?;
-            let mut cols = vec!["x".to_string(), "y".to_string()];
-            cols.extend(point_columns(contacts));
-            Some(CsvFile::create(&dir.join("map.csv"), &cols)?)
+    let o = runner.options();
+    let settings = json!({
+        "command": "map",
+        "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": args.x_steps, "values": xs},
+        "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": args.y_steps, "values": ys},
+        "transient_periods": o.transient_periods,
+        "recorded_periods": o.recorded_periods,
+        "period_tolerance": o.period_tolerance,
+        "mechanics_only": args.run.mechanics_only,
+        "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
+        "settings": runner.base().table,
+    });
+    let keys: Vec<String> = points.iter().map(point_key).collect();
+    let (mut out, skip) = match &args.out {
+        None => (None, 0),
+        Some(dir) if args.resume => {
+            let (o, done) = GridOutput::resume(dir, map_layout(contacts), settings, &keys, keys.len())?;
+            (Some(o), done)
         }
-        None => None,
+        Some(dir) => (Some(GridOutput::create(dir, map_layout(contacts), settings)?), 0),
     };
     let started = Instant::now();
     let (xk, yk) = (args.x.as_str(), args.y.as_str());
-    let done = run_grid(
+    let computed = run_grid(
         &runner,
-        &points,
+        &points[skip..],
         |&(x, y)| vec![(xk, x), (yk, y)],
-        "points",
+        ("points", skip as u64, points.len() as u64),
         args.run.quiet,
-        |&(x, y), r| {
-            let Some(csv) = csv.as_mut() else { return Ok(()) };
+        |point| {
+            let Some(out) = out.as_mut() else { return Ok(()) };
+            let Some((&(x, y), r)) = point else {
+                return out.commit();
+            };
             let mut row = vec![x.to_string(), y.to_string()];
             row.extend(point_cells(r, contacts));
-            csv.row(row)
+            out.row(0, row)
         },
     )?;
-    if let (Some(csv), Some(dir)) = (csv.as_mut(), &args.out) {
-        csv.flush()?;
-        let o = runner.options();
-        write_json(
-            &dir.join("map.json"),
-            &json!({
-                "command": "map",
-                "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": args.x_steps, "values": xs},
-                "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": args.y_steps, "values": ys},
-                "transient_periods": o.transient_periods,
-                "recorded_periods": o.recorded_periods,
-                "period_tolerance": o.period_tolerance,
-                "mechanics_only": args.run.mechanics_only,
-                "complete": done == points.len(),
-                "settings": runner.base().table,
-            }),
-        )?;
-        if args.plot {
+    let done = skip + computed;
+    let complete = done == points.len();
+    if let (Some(out), Some(dir)) = (out, &args.out) {
+        out.finish(complete, done)?;
+        if complete && args.plot && args.shard.is_none() {
             crate::plots::plot_map(dir)?;
         }
     }
     println!(
-        "map of {} × {} ({} × {} points): {done} computed in {:.2} s on {} threads",
+        "map of {} × {} ({} × {} points{}): {computed} computed{} in {:.2} s on {} threads",
         args.x,
-        args.y,
+        ys.len(),
         xs.len(),
         ys.len(),
+        args.shard
+            .map_or(String::new(), |s| format!(", shard {}/{}", s.index, s.count)),
+        if skip > 0 {
+            format!(", {skip} kept from before")
+        } else {
+            String::new()
+        },
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
+    if !complete {
+        return Err(Interrupted {
+            what: format!(
+                "map.csv holds the {done} of {} points finished, marked incomplete in map.json; \
+                 the same command with --resume continues",
+                points.len()
+            ),
+        }
+        .into());
+    }
     Ok(())
+}
+
+/// Merges the shards of a map (`vibrotribo merge`).
+pub fn merge(args: &MergeArgs) -> Result<()> {
+    // map.csv: x, y, then the point columns: 7 and one per contact.
+    let contacts = header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2 + 7);
+    let keys = |m: &serde_json::Value| -> Result<Vec<String>> {
+        let axis = |a: &str| -> Result<Vec<f64>> {
+            m[a]["values"]
+                .as_array()
+                .ok_or_else(|| anyhow!("map.json lacks the {a} values"))?
+                .iter()
+                .map(|v| {
+                    v.as_f64()
+                        .ok_or_else(|| anyhow!("map.json: a {a} value is not a number"))
+                })
+                .collect()
+        };
+        Ok(map_points(&axis("x")?, &axis("y")?)
+            .iter()
+            .map(point_key)
+            .collect())
+    };
+    crate::job::merge(&args.shards, &args.out, &map_layout(contacts), keys)
 }
 
 /// Options of `vibrotribo optimize-mass-ratio`.
@@ -145,19 +252,19 @@ pub struct OptimizeArgs {
     #[command(flatten)]
     pub input: ConfigArgs,
     /// First Ω.
-    #[arg(long, default_value_t = 0.55)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.55)]
     pub omega_from: f64,
     /// Last Ω.
-    #[arg(long, default_value_t = 0.95)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.95)]
     pub omega_to: f64,
     /// Number of Ω values.
     #[arg(long, default_value_t = 9)]
     pub omega_steps: usize,
     /// Smallest mass ratio R_m = m2/m1 tried (m1 and m3 fixed).
-    #[arg(long, default_value_t = 1.2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.2)]
     pub rm_from: f64,
     /// Largest mass ratio tried.
-    #[arg(long, default_value_t = 7.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 7.0)]
     pub rm_to: f64,
     /// Number of mass ratios per Ω.
     #[arg(long, default_value_t = 59)]
@@ -294,9 +401,12 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         &runner,
         &points,
         |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)],
-        "points",
+        ("points", 0, points.len() as u64),
         args.run.quiet,
-        |&(w, r), res| {
+        |point| {
+            let Some((&(w, r), res)) = point else {
+                return Ok(());
+            };
             if let Ok(p) = res {
                 power[index] = p.average_power_w.unwrap_or(f64::NAN);
             }
@@ -317,7 +427,10 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         },
     )?;
     if done < points.len() {
-        bail!("interrupted after {done} of {} points", points.len());
+        return Err(Interrupted {
+            what: format!("after {done} of {} points; nothing was written", points.len()),
+        }
+        .into());
     }
     let n = ratios.len();
     let optimum = optima(&omegas, &ratios, &power);

@@ -12,6 +12,7 @@ pub struct CsvFile {
     path: PathBuf,
     out: BufWriter<File>,
     line: String,
+    rows: u64,
 }
 
 impl CsvFile {
@@ -22,11 +23,31 @@ impl CsvFile {
             path: path.to_path_buf(),
             out: BufWriter::new(file),
             line: String::new(),
+            rows: 0,
         };
         let header: Vec<&str> = columns.iter().map(AsRef::as_ref).collect();
         f.out.write_all(header.join(",").as_bytes())?;
         f.out.write_all(b"\n")?;
         Ok(f)
+    }
+
+    /// Opens the existing `path`, which holds a header and `rows` rows, to add rows at its end.
+    pub fn append(path: &Path, rows: u64) -> Result<Self> {
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .with_context(|| format!("cannot open {} to continue it", path.display()))?;
+        Ok(CsvFile {
+            path: path.to_path_buf(),
+            out: BufWriter::new(file),
+            line: String::new(),
+            rows,
+        })
+    }
+
+    /// Rows written (header excluded), those of an appended-to file included.
+    pub fn rows(&self) -> u64 {
+        self.rows
     }
 
     /// Writes one row of already-formatted fields.
@@ -44,6 +65,7 @@ impl CsvFile {
             let _ = write!(self.line, "{f}");
         }
         self.line.push('\n');
+        self.rows += 1;
         self.out
             .write_all(self.line.as_bytes())
             .with_context(|| format!("cannot write {}", self.path.display()))
@@ -57,10 +79,28 @@ impl CsvFile {
     }
 }
 
-/// Writes `value` as pretty JSON to `path`.
+/// Writes `value` as pretty JSON to `path`, atomically: a reader (or a later run after a
+/// kill) sees either the old file or the new one, never a part of one.
 pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    write_atomic(path, text.as_bytes())
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory renamed over it.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let name = path
+        .file_name()
+        .map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let write = || -> std::io::Result<()> {
+        let mut f = File::create(&tmp)?;
+        f.write_all(bytes)?;
+        std::fs::rename(&tmp, path)
+    };
+    write().map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        anyhow::Error::from(e).context(format!("cannot write {}", path.display()))
+    })
 }
 
 /// Reads the JSON file `path`.

@@ -20,6 +20,15 @@ pub(crate) fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -
 
 /// Draws whatever `dir` holds: a `simulate`, `sweep` or `map` output directory.
 pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
+    if !dir.exists() {
+        bail!("{} does not exist", dir.display());
+    }
+    if !dir.is_dir() {
+        bail!(
+            "{} is not a directory (plot takes an output directory)",
+            dir.display()
+        );
+    }
     if dir.join("sweep.json").exists() {
         plot_sweep(dir)
     } else if dir.join("map.json").exists() {

@@ -1,32 +1,82 @@
-//! Progress bars on a terminal, and Ctrl-C handling that lets a run stop cleanly.
+//! Progress bars on a terminal, and SIGINT/SIGTERM handling that lets a run stop cleanly.
+//!
+//! The first SIGINT (Ctrl-C) or SIGTERM (`kill`, a Slurm time limit) sets a flag that long
+//! loops read at their checkpoints ([`interrupted`]): they stop there, write a consistent
+//! result marked incomplete, and return [`Interrupted`], which `main` turns into the exit
+//! status of the signal (130 for SIGINT, 143 for SIGTERM). A second signal exits at once.
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use indicatif::{ProgressBar, ProgressStyle};
+use signal_hook::consts::{SIGINT, SIGTERM};
 
-static INTERRUPTED: OnceLock<Arc<AtomicBool>> = OnceLock::new();
-
-/// Installs the Ctrl-C handler (once). After the first Ctrl-C, [`interrupted`] is true and
-/// long loops stop at their next checkpoint, keeping what they wrote; a second Ctrl-C exits.
-pub fn install_interrupt_handler() {
-    let flag = INTERRUPTED
-        .get_or_init(|| Arc::new(AtomicBool::new(false)))
-        .clone();
-    let _ = ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-        eprintln!(
-            "\ninterrupted: finishing the current step and writing what was computed (Ctrl-C again to abort)"
-        );
-    });
+/// The flags the signal handlers set.
+struct Flags {
+    any: Arc<AtomicBool>,
+    term: Arc<AtomicBool>,
 }
 
-/// Whether the user asked to stop.
+static FLAGS: OnceLock<Flags> = OnceLock::new();
+
+/// Exit status after SIGINT.
+pub const EXIT_SIGINT: u8 = 130;
+/// Exit status after SIGTERM.
+pub const EXIT_SIGTERM: u8 = 143;
+
+/// Installs the SIGINT and SIGTERM handlers (once).
+pub fn install_interrupt_handler() -> std::io::Result<()> {
+    let flags = FLAGS.get_or_init(|| Flags {
+        any: Arc::new(AtomicBool::new(false)),
+        term: Arc::new(AtomicBool::new(false)),
+    });
+    for (signal, status) in [(SIGINT, EXIT_SIGINT), (SIGTERM, EXIT_SIGTERM)] {
+        // Registered first, so that it sees the flag as it was before this signal: a second
+        // signal of either kind exits at once.
+        signal_hook::flag::register_conditional_shutdown(signal, i32::from(status), Arc::clone(&flags.any))?;
+        signal_hook::flag::register(signal, Arc::clone(&flags.any))?;
+    }
+    signal_hook::flag::register(SIGTERM, Arc::clone(&flags.term))?;
+    Ok(())
+}
+
+/// Whether a SIGINT or SIGTERM asked the program to stop.
 pub fn interrupted() -> bool {
-    INTERRUPTED.get().is_some_and(|f| f.load(Ordering::SeqCst))
+    FLAGS.get().is_some_and(|f| f.any.load(Ordering::SeqCst))
+}
+
+/// The exit status for the signal that stopped the program: 143 after SIGTERM, else 130.
+pub fn interrupt_status() -> u8 {
+    match FLAGS.get() {
+        Some(f) if f.term.load(Ordering::SeqCst) => EXIT_SIGTERM,
+        _ => EXIT_SIGINT,
+    }
+}
+
+/// A command stopped at a checkpoint because of SIGINT or SIGTERM, after writing a
+/// consistent result marked incomplete. `what` says what was kept and how to continue.
+#[derive(Debug)]
+pub struct Interrupted {
+    /// What was kept, e.g. "the files hold the 12 values finished; --resume continues".
+    pub what: String,
+}
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "interrupted: {}", self.what)
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// `Err(Interrupted)` with `what` if a signal asked to stop, else `Ok`.
+pub fn check_interrupt(what: impl FnOnce() -> String) -> anyhow::Result<()> {
+    if interrupted() {
+        Err(Interrupted { what: what() }.into())
+    } else {
+        Ok(())
+    }
 }
 
 /// A progress bar drawn only when stderr is a terminal.
@@ -48,6 +98,15 @@ impl Progress {
             bar
         });
         Progress { bar }
+    }
+
+    /// Starts at `pos` steps already done (a resumed job).
+    pub fn starting_at(self, pos: u64) -> Self {
+        if let Some(b) = &self.bar {
+            b.set_position(pos);
+            b.reset_eta();
+        }
+        self
     }
 
     /// Advances by `n` steps.

@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use rayon::prelude::*;
 use toml::{Table, Value};
 use vibrotribo::analysis::{PointResult, WelchOptions, fit_quadratic, welch_psd};
@@ -23,7 +23,7 @@ use crate::load_sweep::breakdown_over_vq_cycle;
 use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::{create_dir, si};
 use crate::plot::{self, Figure, Legend, Scale, Series};
-use crate::progress::interrupted;
+use crate::progress::check_interrupt;
 use crate::sweep::{PointRunner, RunArgs, grid, set_threads};
 
 /// Options of `vibrotribo reproduce`.
@@ -144,6 +144,7 @@ impl Ctx {
             period_tolerance: 1e-4,
             threads: None,
             quiet: true,
+            allow_large: false,
         }
     }
 }
@@ -179,9 +180,7 @@ fn sweep(
         .par_iter()
         .map(|&v| runner.run(&[(key, v)], None))
         .collect();
-    if interrupted() {
-        bail!("interrupted");
-    }
+    check_interrupt(|| format!("during a sweep of {key}; REPORT.md is written only by a complete run"))?;
     let results: Vec<PointResult> = results
         .into_iter()
         .zip(values)
@@ -505,9 +504,12 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         ctx.say(&format!("{what} …"));
         step(&mut ctx).with_context(|| what.to_string())?;
         ctx.say(&format!("{what}: {:.1} s", t0.elapsed().as_secs_f64()));
-        if interrupted() {
-            bail!("interrupted");
-        }
+        check_interrupt(|| {
+            format!(
+                "after {what}: the figures of the finished steps are in {}; REPORT.md is written only by a complete run",
+                ctx.out.display()
+            )
+        })?;
     }
     let elapsed = started.elapsed().as_secs_f64();
     write_report(&ctx, elapsed)?;

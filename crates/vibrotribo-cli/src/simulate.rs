@@ -7,16 +7,15 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::analysis::RunStats;
-use vibrotribo::electrical::breakdown::BreakdownMargin;
 use vibrotribo::electrical::{
     ChargeSolver, ElectricalSamples, HarvesterParams, LoadKind, PowerSummary, TransducerMode,
 };
 use vibrotribo::{ChainParams, Event, Flow, Observer, Simulator, StateView};
 
 use crate::config::{ConfigArgs, Loaded, RunSpec};
-use crate::harvester::add_breakdown_sample;
+use crate::limits;
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
-use crate::progress::{Progress, interrupted};
+use crate::progress::{Interrupted, Progress, interrupted};
 
 /// Options of `vibrotribo simulate`.
 #[derive(Debug, clap::Args)]
@@ -36,13 +35,17 @@ pub struct SimulateArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
+    #[arg(long)]
+    pub allow_large: bool,
 }
 
 /// Streams `events.csv` and `trajectory.csv` as the simulation goes.
 struct Files {
     events: CsvFile,
     trajectory: CsvFile,
-    dt: f64,
+    period: f64,
+    per_period: u64,
     next_sample: u64,
     last_sample: u64,
     gaps: Vec<f64>,
@@ -52,9 +55,8 @@ struct Files {
     d: Vec<f64>,
     row: Vec<f64>,
     rectifier: bool,
-    /// With a harvester (electrical columns): the air breakdown check over the samples after
-    /// the transient (harvester, margin so far, end of the transient in s).
-    breakdown: Option<(HarvesterParams, BreakdownMargin, f64)>,
+    /// Whether there are electrical columns.
+    electrical: bool,
     error: Option<anyhow::Error>,
 }
 
@@ -94,7 +96,8 @@ impl Files {
         Ok(Files {
             events: CsvFile::create(&dir.join("events.csv"), &ev_cols)?,
             trajectory: CsvFile::create(&dir.join("trajectory.csv"), &tr_cols)?,
-            dt: params.period() / spec.samples_per_period as f64,
+            period: params.period(),
+            per_period: spec.samples_per_period,
             next_sample: 0,
             last_sample: spec.periods * spec.samples_per_period,
             gaps: params.gaps.clone(),
@@ -103,13 +106,7 @@ impl Files {
             d: vec![0.0; n - 1],
             row: Vec::with_capacity(tr_cols.len()),
             rectifier,
-            breakdown: harvester.map(|h| {
-                (
-                    h.clone(),
-                    BreakdownMargin::default(),
-                    spec.transient_periods as f64 * params.period(),
-                )
-            }),
+            electrical: harvester.is_some(),
             error: None,
         })
     }
@@ -129,11 +126,12 @@ impl Files {
     }
 
     /// Writes the grid rows inside `flow`; electrical columns come from `samples`, which the
-    /// charge solver has already filled up to the end of this flow (same grid).
+    /// charge solver has just recorded for this flow (same grid, t_j = T·(j/per_period)).
     fn rows(&mut self, flow: &Flow<'_>, samples: Option<&ElectricalSamples>) {
+        let mut cursor = 0;
         while self.next_sample <= self.last_sample {
             let j = self.next_sample;
-            let t = j as f64 * self.dt;
+            let t = self.period * (j as f64 / self.per_period as f64);
             if t > flow.t_end {
                 break;
             }
@@ -146,10 +144,13 @@ impl Files {
             self.row.push(t);
             self.row.extend_from_slice(&self.x);
             self.row.extend_from_slice(&self.v);
-            if let Some((h, margin, from)) = self.breakdown.as_mut() {
-                let idx = j as usize;
+            if self.electrical {
+                let idx = cursor;
                 let at = |v: &[f64]| v.get(idx).copied().unwrap_or(f64::NAN);
                 let e = samples.filter(|s| s.times.get(idx).is_some_and(|&ts| ts == t));
+                if e.is_some() {
+                    cursor += 1;
+                }
                 let get = |f: fn(&ElectricalSamples) -> &Vec<f64>| e.map_or(f64::NAN, |s| at(f(s)));
                 self.row.push(get(|s| &s.charge_c));
                 self.row.push(get(|s| &s.current_a));
@@ -158,9 +159,6 @@ impl Files {
                 self.row.push(get(|s| &s.voc_v));
                 if self.rectifier {
                     self.row.push(get(|s| &s.storage_voltage_v));
-                }
-                if t >= *from {
-                    add_breakdown_sample(margin, h, t, get(|s| &s.charge_c), &self.d);
                 }
             }
             self.row.push(y);
@@ -202,7 +200,8 @@ impl Observer for Recorder {
             s.flow(flow);
         }
         if let Some(f) = &mut self.files {
-            f.rows(flow, self.solver.as_ref().and_then(ChargeSolver::samples));
+            let fresh = self.solver.as_mut().map(ChargeSolver::take_samples);
+            f.rows(flow, fresh.as_ref());
         }
     }
 
@@ -229,12 +228,14 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         Some(loaded.harvester(&params)?)
     };
     let period = params.period();
+    check_size(&params, &spec, harvester.as_ref(), args)?;
     let mut sim = Simulator::new(&params, &spec.initial, options)?;
     let solver = match &harvester {
         Some(h) => {
-            let mut s = ChargeSolver::for_chain(h, &params, loaded.charge_options()?)?;
+            let mut s = ChargeSolver::for_chain(h, &params, loaded.charge_options()?)?
+                .with_breakdown_check(spec.transient_periods as f64 * period);
             if args.out.is_some() {
-                s = s.with_sampling(0.0, period / spec.samples_per_period as f64)?;
+                s = s.with_periodic_sampling(spec.samples_per_period)?;
             }
             Some(s)
         }
@@ -299,10 +300,54 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         return Err(e).context(format!("simulation stopped after {done} complete periods"));
     }
     if done < spec.periods {
-        eprintln!(
-            "stopped early by Ctrl-C after {done} of {} periods; files hold what was computed",
-            spec.periods
-        );
+        return Err(Interrupted {
+            what: format!(
+                "after {done} of {} periods{}",
+                spec.periods,
+                if args.out.is_some() {
+                    "; the files hold what was computed, summary.json says \"interrupted\": true"
+                } else {
+                    ""
+                }
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Refuses a run whose per-period statistics or files would be unreasonably large (see
+/// [`limits`]).
+fn check_size(
+    params: &ChainParams,
+    spec: &RunSpec,
+    harvester: Option<&HarvesterParams>,
+    args: &SimulateArgs,
+) -> Result<()> {
+    let periods = spec.periods as f64;
+    let n = params.len() as f64;
+    // Per period: impact counts per contact, the solver's period record, and the per-period
+    // arrays of summary.json.
+    let per_period = 48.0
+        + 4.0 * n
+        + if harvester.is_some() {
+            80.0 + 2.0 * limits::CSV_NUMBER_BYTES
+        } else {
+            0.0
+        };
+    limits::check_memory(
+        &format!("{} periods of per-period statistics", spec.periods),
+        periods * per_period,
+        args.allow_large,
+    )?;
+    if args.out.is_some() {
+        let columns = 1.0 + 2.0 * n + 1.0 + (n - 1.0) + if harvester.is_some() { 6.0 } else { 0.0 };
+        let rows = periods * spec.samples_per_period as f64 + 1.0;
+        limits::check_output(
+            "trajectory.csv",
+            rows * columns * limits::CSV_NUMBER_BYTES,
+            args.allow_large,
+        )?;
     }
     Ok(())
 }
@@ -389,7 +434,7 @@ fn summary_json(
             );
             obj.insert("time_to_target_s".into(), json!(solver.time_to_target()));
         }
-        if let Some((_, margin, _)) = rec.files.as_ref().and_then(|f| f.breakdown.as_ref()) {
+        if let Some(margin) = solver.breakdown_margin() {
             obj.insert("air_breakdown".into(), json!(margin));
         }
         obj.insert("harvester".into(), json!(h));
@@ -473,7 +518,7 @@ fn print_summary(
             ),
             None => println!("  harvester: no complete period after the transient"),
         }
-        if let Some((_, m, _)) = rec.files.as_ref().and_then(|f| f.breakdown.as_ref()) {
+        if let Some(m) = solver.breakdown_margin().filter(|m| m.worst_ratio > 0.0) {
             println!(
                 "  air gaps: largest |V_gap|/V_breakdown = {:.3} (gap {}, {} across {}; Paschen's law, air at 1 atm){}",
                 m.worst_ratio,

@@ -1,7 +1,6 @@
 //! `vibrotribo sweep` and `vibrotribo merge`: one-parameter sweeps (orbit diagrams,
 //! impact-velocity diagrams, power curves), parallel, continued, or sharded across machines.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -12,8 +11,10 @@ use vibrotribo::analysis::{PointOptions, PointResult, run_point};
 use vibrotribo::{ChainParams, ChainState};
 
 use crate::config::{ConfigArgs, Loaded, RunSpec};
-use crate::output::{CsvFile, create_dir, numbered, point_cells, point_columns, read_json, write_json};
-use crate::progress::{Progress, interrupted};
+use crate::job::{CsvSpec, GridOutput, Layout};
+use crate::limits;
+use crate::output::{numbered, point_cells, point_columns};
+use crate::progress::{Interrupted, Progress, interrupted};
 
 /// Direction of parameter continuation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -81,6 +82,9 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
+    #[arg(long)]
+    pub allow_large: bool,
 }
 
 /// Options of `vibrotribo sweep`.
@@ -94,10 +98,10 @@ pub struct SweepArgs {
     #[arg(long)]
     pub param: String,
     /// First value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub from: f64,
     /// Last value.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub to: f64,
     /// Number of values, equally spaced from --from to --to.
     #[arg(long)]
@@ -113,6 +117,10 @@ pub struct SweepArgs {
     /// Write orbit.csv, impacts.csv, summary.csv and sweep.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Continue the interrupted sweep (or shard) in --out DIR from its finished values; the
+    /// result is what one uninterrupted run writes.
+    #[arg(long)]
+    pub resume: bool,
     /// Also draw the diagrams (PNG and SVG) into the output directory.
     #[arg(long)]
     pub plot: bool,
@@ -248,22 +256,23 @@ impl PointRunner {
     }
 }
 
-/// Runs `points` in parallel chunks, calling `write` in grid order (so the output does not
-/// depend on the thread count) and ticking a progress bar labelled `what`; stops after the
-/// current chunk on Ctrl-C, keeping what was written. Returns how many were written.
+/// Runs `points` in parallel chunks, calling `write` with each point's result in grid order
+/// (so the output does not depend on the thread count) and with `None` after each chunk, and
+/// ticking a progress bar (label, points done before, points in all); stops after the
+/// current chunk on SIGINT/SIGTERM, keeping what was written. Returns how many were written.
 pub fn run_grid<'k, P, W>(
     runner: &PointRunner,
     points: &[P],
     keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
-    what: &str,
+    (what, before, total): (&str, u64, u64),
     quiet: bool,
     mut write: W,
 ) -> Result<usize>
 where
     P: Sync,
-    W: FnMut(&P, &Result<PointResult, String>) -> Result<()>,
+    W: FnMut(Option<(&P, &Result<PointResult, String>)>) -> Result<()>,
 {
-    let progress = Progress::new(points.len() as u64, what, quiet);
+    let progress = Progress::new(total, what, quiet).starting_at(before);
     let chunk = rayon::current_num_threads() * 4;
     let mut done = 0;
     for block in points.chunks(chunk) {
@@ -272,10 +281,11 @@ where
             .map(|p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")))
             .collect();
         for (p, r) in block.iter().zip(&results) {
-            write(p, r)?;
+            write(Some((p, r)))?;
             done += 1;
             progress.inc(1);
         }
+        write(None)?;
         if interrupted() {
             break;
         }
@@ -298,60 +308,66 @@ pub fn set_threads(threads: Option<usize>) -> Result<()> {
     Ok(())
 }
 
-/// The output files of a sweep, written value by value in order.
-struct SweepFiles {
-    orbit: CsvFile,
-    impacts: CsvFile,
-    summary: CsvFile,
-    contacts: usize,
+/// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
+/// one row per value) and the manifest `sweep.json`.
+fn sweep_layout(masses: usize) -> Layout {
+    let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
+    orbit_cols.extend(numbered("x", masses, "_m"));
+    let mut summary_cols = vec!["param".to_string()];
+    summary_cols.extend(point_columns(masses - 1));
+    Layout {
+        manifest: "sweep.json",
+        files: vec![
+            CsvSpec {
+                name: "orbit.csv",
+                columns: orbit_cols,
+            },
+            CsvSpec {
+                name: "impacts.csv",
+                columns: ["param", "time_s", "contact", "rel_velocity_m_s"]
+                    .map(String::from)
+                    .to_vec(),
+            },
+            CsvSpec {
+                name: "summary.csv",
+                columns: summary_cols,
+            },
+        ],
+        index_file: 2,
+        key_fields: 1,
+    }
 }
 
-impl SweepFiles {
-    fn create(dir: &Path, masses: usize) -> Result<Self> {
-        create_dir(dir)?;
-        let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
-        orbit_cols.extend(numbered("x", masses, "_m"));
-        let mut summary_cols = vec!["param".to_string()];
-        summary_cols.extend(point_columns(masses - 1));
-        Ok(SweepFiles {
-            orbit: CsvFile::create(&dir.join("orbit.csv"), &orbit_cols)?,
-            impacts: CsvFile::create(
-                &dir.join("impacts.csv"),
-                &["param", "time_s", "contact", "rel_velocity_m_s"],
-            )?,
-            summary: CsvFile::create(&dir.join("summary.csv"), &summary_cols)?,
-            contacts: masses - 1,
-        })
-    }
-
-    fn write(&mut self, value: f64, result: &Result<PointResult, String>) -> Result<()> {
-        let p = value.to_string();
-        if let Ok(r) = result {
-            let n = self.contacts + 1;
-            for (j, &period) in r.strobe_periods.iter().enumerate() {
-                let mut row = vec![p.clone(), period.to_string()];
-                row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
-                self.orbit.row(row)?;
-            }
-            for i in &r.impacts {
-                self.impacts.row([
+/// Writes one value's rows: orbit, impacts, then its summary row (last, see [`crate::job`]).
+fn write_value(
+    out: &mut GridOutput,
+    value: f64,
+    result: &Result<PointResult, String>,
+    contacts: usize,
+) -> Result<()> {
+    let p = value.to_string();
+    if let Ok(r) = result {
+        let n = contacts + 1;
+        for (j, &period) in r.strobe_periods.iter().enumerate() {
+            let mut row = vec![p.clone(), period.to_string()];
+            row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
+            out.row(0, row)?;
+        }
+        for i in &r.impacts {
+            out.row(
+                1,
+                vec![
                     p.clone(),
                     i.time.to_string(),
                     (i.contact + 1).to_string(),
                     i.closing_speed.to_string(),
-                ])?;
-            }
+                ],
+            )?;
         }
-        let mut row = vec![p];
-        row.extend(point_cells(result, self.contacts));
-        self.summary.row(row)
     }
-
-    fn flush(&mut self) -> Result<()> {
-        self.orbit.flush()?;
-        self.impacts.flush()?;
-        self.summary.flush()
-    }
+    let mut row = vec![p];
+    row.extend(point_cells(result, contacts));
+    out.row(2, row)
 }
 
 /// The settings a sweep records in `sweep.json` (everything that determines its output).
@@ -383,16 +399,50 @@ fn settings_json(
     })
 }
 
+/// Checks that a grid's values are distinct: rows are keyed by their value.
+pub fn check_distinct(what: &str, values: &[f64]) -> Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for v in values {
+        if !seen.insert(v.to_bits()) {
+            bail!("{what}: the grid repeats the value {v} (use --steps 1 for a single value)");
+        }
+    }
+    Ok(())
+}
+
+/// Estimated bytes written per point of a sweep or map (the orbit rows dominate).
+pub fn estimate_point_output(runner: &PointRunner, orbit: bool) -> f64 {
+    let o = runner.options();
+    let n = runner.masses() as f64;
+    let orbit_bytes = if orbit {
+        o.recorded_periods as f64 * (n + 2.0) * limits::CSV_NUMBER_BYTES
+    } else {
+        0.0
+    };
+    orbit_bytes + (n + 8.0) * limits::CSV_NUMBER_BYTES
+}
+
+/// Estimated memory of one point's run (stroboscopic samples and per-period counts).
+pub fn estimate_point_memory(runner: &PointRunner) -> f64 {
+    let o = runner.options();
+    let n = runner.masses() as f64;
+    (o.transient_periods + o.recorded_periods) as f64 * (8.0 * n + 96.0)
+}
+
 /// Runs `vibrotribo sweep`.
 pub fn run(args: &SweepArgs) -> Result<()> {
     if args.steps == 0 {
         bail!("--steps must be at least 1");
     }
+    limits::check_grid("--steps", args.steps as f64)?;
     if !args.from.is_finite() || !args.to.is_finite() {
         bail!("--from and --to must be finite numbers");
     }
     if args.plot && args.out.is_none() {
         bail!("--plot needs --out DIR");
+    }
+    if args.resume && args.out.is_none() {
+        bail!("--resume needs --out DIR (the directory of the job to continue)");
     }
     if args.shard.is_some() && args.continuation != Continuation::None {
         bail!(
@@ -404,6 +454,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let runner = PointRunner::new(base, &args.run)?;
     let masses = runner.masses();
     let values = grid(args.from, args.to, args.steps);
+    check_distinct("--from/--to/--steps", &values)?;
     // Fail early on a bad key or on any value of the grid that makes a bad configuration.
     runner.check_all(&values, |&v| vec![(args.param.as_str(), v)])?;
     let mut order: Vec<usize> = (0..values.len()).collect();
@@ -413,44 +464,89 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     if let Some(s) = args.shard {
         order.retain(|j| j % s.count == s.index);
     }
-    let mut files = match &args.out {
-        Some(dir) => Some(SweepFiles::create(dir, masses)?),
-        None => None,
+    let threads = rayon::current_num_threads() as f64;
+    limits::check_memory(
+        "one value of the sweep (--transient + --recorded periods)",
+        estimate_point_memory(&runner) * threads * 4.0,
+        args.run.allow_large,
+    )?;
+    if args.out.is_some() {
+        limits::check_output(
+            "the sweep's files",
+            estimate_point_output(&runner, true) * order.len() as f64,
+            args.run.allow_large,
+        )?;
+    }
+    let keys: Vec<String> = order.iter().map(|&j| values[j].to_string()).collect();
+    let settings = settings_json(args, &runner, &values, args.shard);
+    let continued = args.continuation != Continuation::None;
+    let mut state: Option<ChainState> = None;
+    let (mut out, skip) = match &args.out {
+        None => (None, 0),
+        Some(dir) if args.resume => {
+            let checkpoint = if continued {
+                crate::job::read_checkpoint(dir)?
+            } else {
+                None
+            };
+            let keep = if continued {
+                checkpoint.as_ref().map_or(0, |c| c.0)
+            } else {
+                order.len()
+            };
+            let (o, done) = GridOutput::resume(dir, sweep_layout(masses), settings, &keys, keep)?;
+            if let Some((n, s)) = checkpoint.filter(|c| c.0 == done && done > 0) {
+                state = Some(serde_json::from_value(s).map_err(|e| {
+                    anyhow!(
+                        "--resume: {}/{} is damaged: {e}",
+                        dir.display(),
+                        crate::job::CHECKPOINT
+                    )
+                })?);
+                debug_assert_eq!(n, done);
+            }
+            (Some(o), done)
+        }
+        Some(dir) => (Some(GridOutput::create(dir, sweep_layout(masses), settings)?), 0),
     };
     let started = Instant::now();
     let mut failed = 0usize;
-    let mut record = |value: f64, result: &Result<PointResult, String>| -> Result<()> {
-        if result.is_err() {
-            failed += 1;
-        }
-        match files.as_mut() {
-            Some(f) => f.write(value, result),
-            None => Ok(()),
-        }
-    };
+    let contacts = masses - 1;
     let key = args.param.as_str();
-    let done = match args.continuation {
+    let todo = &order[skip..];
+    let computed = match args.continuation {
         Continuation::None => run_grid(
             &runner,
-            &order,
+            todo,
             |&j| vec![(key, values[j])],
-            "values",
+            ("values", skip as u64, order.len() as u64),
             args.run.quiet,
-            |&j, r| record(values[j], r),
+            |point| match (point, out.as_mut()) {
+                (Some((&j, r)), o) => {
+                    failed += usize::from(r.is_err());
+                    o.map_or(Ok(()), |o| write_value(o, values[j], r, contacts))
+                }
+                (None, Some(o)) => o.commit(),
+                (None, None) => Ok(()),
+            },
         )?,
         Continuation::Up | Continuation::Down => {
-            let progress = Progress::new(order.len() as u64, "values", args.run.quiet);
+            let progress =
+                Progress::new(order.len() as u64, "values", args.run.quiet).starting_at(skip as u64);
             let mut done = 0usize;
-            let mut state: Option<ChainState> = None;
-            for &j in &order {
+            for &j in todo {
                 let r = runner
                     .run(&[(key, values[j])], state.as_ref())
                     .map_err(|e| format!("{e:#}"));
                 if let Ok(p) = &r {
                     state = Some(p.final_state.clone());
                 }
-                record(values[j], &r)?;
+                failed += usize::from(r.is_err());
                 done += 1;
+                if let Some(o) = out.as_mut() {
+                    write_value(o, values[j], &r, contacts)?;
+                    o.checkpoint(skip + done, json!(state))?;
+                }
                 progress.inc(1);
                 if interrupted() {
                     break;
@@ -460,24 +556,27 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             done
         }
     };
+    let done = skip + computed;
     let complete = done == order.len();
-    if let (Some(f), Some(dir)) = (files.as_mut(), &args.out) {
-        f.flush()?;
-        let mut settings = settings_json(args, &runner, &values, args.shard);
-        settings["complete"] = json!(complete);
-        write_json(&dir.join("sweep.json"), &settings)?;
-        if args.plot {
+    if let (Some(o), Some(dir)) = (out, &args.out) {
+        o.finish(complete, done)?;
+        if complete && args.plot {
             crate::plots::plot_sweep(dir)?;
         }
     }
     println!(
-        "sweep of {} over {} values from {} to {}{}: {done} computed ({failed} failed) in {:.2} s on {} threads",
+        "sweep of {} over {} values from {} to {}{}: {computed} computed{} ({failed} failed) in {:.2} s on {} threads",
         args.param,
         values.len(),
         args.from,
         args.to,
         args.shard
             .map_or(String::new(), |s| format!(" (shard {}/{})", s.index, s.count)),
+        if skip > 0 {
+            format!(", {skip} kept from before")
+        } else {
+            String::new()
+        },
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
@@ -488,7 +587,14 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         );
     }
     if !complete {
-        eprintln!("interrupted: the files hold the {done} values finished; rerun to complete");
+        return Err(Interrupted {
+            what: format!(
+                "the files hold the {done} of {} values finished, marked incomplete in sweep.json; \
+                 the same command with --resume continues",
+                order.len()
+            ),
+        }
+        .into());
     }
     Ok(())
 }
@@ -496,109 +602,44 @@ pub fn run(args: &SweepArgs) -> Result<()> {
 /// Options of `vibrotribo merge`.
 #[derive(Debug, clap::Args)]
 pub struct MergeArgs {
-    /// Output directories of the shards of one sweep (`--shard I/N`).
+    /// Output directories of the shards of one sweep or map (`--shard I/N`).
     #[arg(required = true)]
     pub shards: Vec<PathBuf>,
-    /// Where to write the merged files.
+    /// Where to write the merged files (a new or empty directory).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }
 
-/// Rows of a CSV file grouped by their first field (the parameter value), keeping order.
-fn rows_by_param(path: &Path) -> Result<(String, BTreeMap<u64, Vec<String>>)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .ok_or_else(|| anyhow!("{} is empty", path.display()))?
-        .to_string();
-    let mut groups: BTreeMap<u64, Vec<String>> = BTreeMap::new();
-    for line in lines {
-        let p = line.split(',').next().unwrap_or("");
-        let v: f64 = p
-            .parse()
-            .with_context(|| format!("{}: bad parameter value {p:?}", path.display()))?;
-        groups.entry(v.to_bits()).or_default().push(line.to_string());
-    }
-    Ok((header, groups))
+/// The keys (`param` values as written) of a sweep's grid from its `sweep.json`.
+fn sweep_keys(settings: &serde_json::Value) -> Result<Vec<String>> {
+    settings["values"]
+        .as_array()
+        .ok_or_else(|| anyhow!("sweep.json lacks the values"))?
+        .iter()
+        .map(|v| {
+            v.as_f64()
+                .map(|x| x.to_string())
+                .ok_or_else(|| anyhow!("sweep.json: a value is not a number"))
+        })
+        .collect()
 }
 
 /// Runs `vibrotribo merge`.
 pub fn merge(args: &MergeArgs) -> Result<()> {
-    let mut settings: Option<serde_json::Value> = None;
-    let mut seen = vec![];
-    let mut complete = true;
-    for dir in &args.shards {
-        let mut s = read_json(&dir.join("sweep.json"))?;
-        let shard = s["shard"].clone();
-        if shard.is_null() {
-            bail!("{} is not a shard (it was run without --shard)", dir.display());
-        }
-        complete &= s["complete"].as_bool().unwrap_or(false);
-        seen.push((
-            shard["index"].as_u64().unwrap_or(0),
-            shard["count"].as_u64().unwrap_or(0),
-        ));
-        s["shard"] = serde_json::Value::Null;
-        s["complete"] = serde_json::Value::Null;
-        match &settings {
-            None => settings = Some(s),
-            Some(first) if *first != s => bail!("{} is a shard of a different sweep", dir.display()),
-            Some(_) => {}
-        }
+    let first = &args.shards[0];
+    if first.join("map.json").exists() {
+        crate::map::merge(args)?;
+    } else {
+        // orbit.csv: param, period, x1_m, …, xN_m.
+        let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
+        crate::job::merge(&args.shards, &args.out, &sweep_layout(masses), sweep_keys)?;
     }
-    let mut settings = settings.expect("at least one shard");
-    let count = seen[0].1;
-    let mut indices: Vec<u64> = seen.iter().map(|s| s.0).collect();
-    indices.sort_unstable();
-    indices.dedup();
-    if seen.iter().any(|s| s.1 != count) || indices.len() != seen.len() || indices.len() as u64 != count {
-        bail!("need each of the {count} shards exactly once, got indices {indices:?}");
-    }
-    if !complete {
-        bail!("some shards are incomplete (interrupted): rerun them before merging");
-    }
-    settings["complete"] = json!(true);
-    // Grid order is the order of the values.
-    let values: Vec<f64> = settings["values"]
-        .as_array()
-        .ok_or_else(|| anyhow!("sweep.json lacks the values"))?
-        .iter()
-        .map(|v| v.as_f64().unwrap_or(f64::NAN))
-        .collect();
-    create_dir(&args.out)?;
-    for name in ["orbit.csv", "impacts.csv", "summary.csv"] {
-        let mut header = None;
-        let mut all: BTreeMap<u64, Vec<String>> = BTreeMap::new();
-        for dir in &args.shards {
-            let (h, groups) = rows_by_param(&dir.join(name))?;
-            if header.as_ref().is_some_and(|x| *x != h) {
-                bail!("{}: header differs between shards", name);
-            }
-            header = Some(h);
-            for (k, rows) in groups {
-                if all.insert(k, rows).is_some() {
-                    bail!("{name}: a value appears in two shards");
-                }
-            }
-        }
-        let mut text = header.unwrap_or_default();
-        text.push('\n');
-        for v in &values {
-            if let Some(rows) = all.remove(&v.to_bits()) {
-                for r in rows {
-                    text.push_str(&r);
-                    text.push('\n');
-                }
-            }
-        }
-        if !all.is_empty() {
-            bail!("{name}: rows for values outside the sweep's grid");
-        }
-        let path = args.out.join(name);
-        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    write_json(&args.out.join("sweep.json"), &settings)?;
     println!("merged {} shards into {}", args.shards.len(), args.out.display());
     Ok(())
+}
+
+/// The number of columns of the CSV file `path` (from its header).
+pub fn header_len(path: &Path) -> Result<usize> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    Ok(text.lines().next().unwrap_or("").split(',').count())
 }

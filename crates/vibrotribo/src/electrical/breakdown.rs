@@ -121,6 +121,117 @@ impl BreakdownMargin {
     }
 }
 
+/// The air-breakdown check along a whole solution, kept by the charge solver
+/// ([`ChargeSolver::with_breakdown_check`](super::ChargeSolver::with_breakdown_check)): the
+/// ratio is evaluated at every stage point of every step and, wherever a point beats the
+/// worst so far, maximised over the neighbouring points by golden-section search on the
+/// solver's dense output. The result does not depend on any output sampling.
+#[derive(Debug, Clone)]
+pub(crate) struct BreakdownWatch {
+    params: HarvesterParams,
+    paschen: PaschenParams,
+    /// Gap indices of the chain that the transducer spans (the second may be absent).
+    contacts: [Option<usize>; 2],
+    /// Start of the checked window, s.
+    from: f64,
+    /// The worst point so far.
+    pub margin: BreakdownMargin,
+}
+
+/// Golden-section iterations of a refinement: the interval shrinks to 0.618³⁰ ≈ 5e-7 of
+/// itself, the ratio at a smooth maximum to ~1e-13 relative.
+const REFINE_ITERATIONS: usize = 30;
+
+impl BreakdownWatch {
+    /// A watch for the harvester `params` from time `from`, s, on.
+    pub fn new(params: &HarvesterParams, from: f64) -> Self {
+        let c = params.contact;
+        let second = match params.mode {
+            TransducerMode::Freestanding => Some(c + 1),
+            TransducerMode::ContactSeparation => None,
+        };
+        BreakdownWatch {
+            params: params.clone(),
+            paschen: PaschenParams::default(),
+            contacts: [Some(c), second],
+            from,
+            margin: BreakdownMargin::default(),
+        }
+    }
+
+    /// Start of the checked window, s.
+    pub fn from(&self) -> f64 {
+        self.from
+    }
+
+    /// Folds in the instant `t`, s, with charge `q`, C, and the chain's gaps `gaps`, m;
+    /// true if it is the worst so far.
+    pub fn observe(&mut self, t: f64, q: f64, gaps: &[f64]) -> bool {
+        if t < self.from {
+            return false;
+        }
+        let d = self.contacts.map(|c| c.map_or(0.0, |k| gaps[k]));
+        let before = self.margin.worst_ratio;
+        self.margin.add(&self.params, &self.paschen, t, q, d[0], d[1]);
+        self.margin.worst_ratio > before
+    }
+
+    /// Maximises the ratio over `[a, b]`, s, by golden-section search, with `eval(t)` giving
+    /// the charge, C, at `t` and filling the gaps, m (None: stop refining).
+    pub fn refine<F>(&mut self, a: f64, b: f64, mut eval: F)
+    where
+        F: FnMut(f64, &mut [f64]) -> Option<f64>,
+    {
+        let a = a.max(self.from);
+        if b.partial_cmp(&a) != Some(std::cmp::Ordering::Greater) {
+            return;
+        }
+        let n = self.contacts.iter().flatten().max().map_or(0, |&k| k + 1);
+        let mut gaps = [0.0f64; 64];
+        if n > gaps.len() {
+            return;
+        }
+        let paschen = self.paschen;
+        let params = self.params.clone();
+        let contacts = self.contacts;
+        let mut ratio = |t: f64, this: &mut Self| -> Option<f64> {
+            let q = eval(t, &mut gaps[..n])?;
+            this.observe(t, q, &gaps[..n]);
+            let d = contacts.map(|c| c.map_or(0.0, |k| gaps[k]));
+            let v = gap_voltages(&params, q, d[0], d[1]);
+            Some(
+                (v[0].abs() / paschen.breakdown_voltage(d[0])).max(if contacts[1].is_some() {
+                    v[1].abs() / paschen.breakdown_voltage(d[1])
+                } else {
+                    0.0
+                }),
+            )
+        };
+        const G: f64 = 0.618_033_988_749_895;
+        let (mut lo, mut hi) = (a, b);
+        let mut x1 = hi - G * (hi - lo);
+        let mut x2 = lo + G * (hi - lo);
+        let (Some(mut f1), Some(mut f2)) = (ratio(x1, self), ratio(x2, self)) else {
+            return;
+        };
+        for _ in 0..REFINE_ITERATIONS {
+            if f1 < f2 {
+                lo = x1;
+                (x1, f1) = (x2, f2);
+                x2 = lo + G * (hi - lo);
+                let Some(f) = ratio(x2, self) else { return };
+                f2 = f;
+            } else {
+                hi = x2;
+                (x2, f2) = (x1, f1);
+                x1 = hi - G * (hi - lo);
+                let Some(f) = ratio(x1, self) else { return };
+                f1 = f;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -74,6 +74,7 @@
 //! polynomial with the transducer evaluated exactly at the sample time.
 
 use super::ElectricalError;
+use super::breakdown::{BreakdownMargin, BreakdownWatch};
 use super::diode::DiodeLaw;
 use super::params::{HarvesterParams, LoadKind};
 use super::radau::{Tableau, solve_fixed, solve_unpivoted};
@@ -226,11 +227,13 @@ enum LoadModel {
     Short,
 }
 
-/// A uniform grid `t0 + j·dt`, j = 0, 1, …, up to `last` if given.
+/// A uniform grid `t0 + span·(j/per)`, j = 0, 1, …, up to `last` if given (`per` = 1: a
+/// step of `span`; `per` samples per `span`: the grid hits `t0 + k·span` exactly).
 #[derive(Debug, Clone)]
 struct Grid {
     t0: f64,
-    dt: f64,
+    span: f64,
+    per: u64,
     next: u64,
     last: Option<u64>,
     data: ElectricalSamples,
@@ -243,7 +246,7 @@ impl Grid {
             if self.last.is_some_and(|l| self.next > l) {
                 return None;
             }
-            let t = self.t0 + self.next as f64 * self.dt;
+            let t = self.t0 + self.span * (self.next as f64 / self.per as f64);
             if t > tb {
                 return None;
             }
@@ -413,7 +416,15 @@ pub struct ChargeSolver {
     error: Option<ElectricalError>,
     /// The current piece of flow, expanded (buffers reused).
     poly: GapPolynomial,
+    /// The harvester solved (for checks that need its geometry).
+    harvester: HarvesterParams,
+    /// The air-breakdown check, if requested.
+    breakdown: Option<BreakdownWatch>,
 }
+
+/// Points per piece at which an open or short circuit (no steps) is checked for air
+/// breakdown before the refinement.
+const BREAKDOWN_POINTS: usize = 32;
 
 /// Stages of the Radau IIA method for the resistor: order 13, stage order 7.
 const RESISTOR_STAGES: usize = 7;
@@ -563,7 +574,24 @@ impl ChargeSolver {
             stats: SolverStats::default(),
             error: None,
             poly: GapPolynomial::default(),
+            harvester: params.clone(),
+            breakdown: None,
         })
+    }
+
+    /// Also checks the air gaps for breakdown (Paschen's law, air at 1 atm; see
+    /// [`breakdown`](super::breakdown)) from time `from`, s, on: the worst ratio over the whole
+    /// solution, located by maximising it between the solver's stage points, so that it
+    /// does not depend on any sampling. See [`breakdown_margin`](Self::breakdown_margin).
+    pub fn with_breakdown_check(mut self, from: f64) -> Self {
+        self.breakdown = Some(BreakdownWatch::new(&self.harvester, from));
+        self
+    }
+
+    /// The worst air-breakdown ratio so far, if [`with_breakdown_check`](Self::with_breakdown_check)
+    /// was requested (all zero before the checked window).
+    pub fn breakdown_margin(&self) -> Option<&BreakdownMargin> {
+        self.breakdown.as_ref().map(|w| &w.margin)
     }
 
     /// A solver for the harvester `params` mounted on `chain` (its period and gap count).
@@ -594,7 +622,30 @@ impl ChargeSolver {
         }
         self.sampler = Some(Grid {
             t0,
-            dt,
+            span: dt,
+            per: 1,
+            next: 0,
+            last: None,
+            data: ElectricalSamples::default(),
+        });
+        Ok(self)
+    }
+
+    /// Also records [`samples`](Self::samples) at `t_j = T·(j/per_period)`, j = 0, 1, …
+    /// (T the excitation period): `per_period` samples per period, landing exactly on the
+    /// period boundaries `kT` where a run split into periods stops.
+    pub fn with_periodic_sampling(mut self, per_period: u64) -> Result<Self, ParamError> {
+        if per_period == 0 {
+            return Err(ParamError::Invalid {
+                name: "run.samples_per_period".into(),
+                value: 0.0,
+                reason: "must be positive",
+            });
+        }
+        self.sampler = Some(Grid {
+            t0: 0.0,
+            span: self.period,
+            per: per_period,
             next: 0,
             last: None,
             data: ElectricalSamples::default(),
@@ -614,7 +665,8 @@ impl ChargeSolver {
         }
         self.vq = Some(Grid {
             t0: index as f64 * self.period,
-            dt: self.period / points as f64,
+            span: self.period / points as f64,
+            per: 1,
             next: 0,
             last: Some(points as u64),
             data: ElectricalSamples::default(),
@@ -756,9 +808,20 @@ impl ChargeSolver {
         &self.periods
     }
 
-    /// Samples on the grid of [`with_sampling`](Self::with_sampling), if requested.
+    /// Samples on the grid of [`with_sampling`](Self::with_sampling) or
+    /// [`with_periodic_sampling`](Self::with_periodic_sampling), if requested (those not yet
+    /// taken by [`take_samples`](Self::take_samples)).
     pub fn samples(&self) -> Option<&ElectricalSamples> {
         self.sampler.as_ref().map(|g| &g.data)
+    }
+
+    /// Takes the samples recorded so far (empty if sampling was not requested), so that a
+    /// long run that streams them out holds only the newest in memory.
+    pub fn take_samples(&mut self) -> ElectricalSamples {
+        self.sampler
+            .as_mut()
+            .map(|g| std::mem::take(&mut g.data))
+            .unwrap_or_default()
     }
 
     /// The V–Q cycle of [`with_vq_cycle`](Self::with_vq_cycle), if requested (plot
@@ -921,6 +984,7 @@ impl ChargeSolver {
                 let r1 = self.row(n1, self.y, self.energy);
                 self.note_peaks(r1.current, r1.voltage);
                 self.sample_between(ta, tb, wave, None)?;
+                self.watch_piece(ta, tb, wave)?;
             }
         }
         let vs = self.storage_voltage();
@@ -1508,14 +1572,21 @@ impl ChargeSolver {
         }
     }
 
-    /// Outputs of the last accepted step: samples, V–Q points, target crossing.
+    /// Outputs of the last accepted step: samples, V–Q points, target crossing, breakdown.
     fn record<W: GapWaveform + ?Sized>(&mut self, wave: &W) -> Result<(), ElectricalError> {
-        if self.sampler.is_none() && self.vq.is_none() && self.target_voltage.is_none() {
+        if self.sampler.is_none()
+            && self.vq.is_none()
+            && self.target_voltage.is_none()
+            && self.breakdown.is_none()
+        {
             return Ok(());
         }
         let Some(step) = self.last_step else {
             return Ok(());
         };
+        if self.breakdown.is_some() {
+            self.watch_step(&step, wave)?;
+        }
         let t1 = step.t0 + step.h;
         self.sample_between(step.t0, t1, wave, Some(&step))?;
         if let (Some(target), None, LoadModel::Rectifier(_)) =
@@ -1540,6 +1611,94 @@ impl ChargeSolver {
             }
         }
         Ok(())
+    }
+
+    /// The air-breakdown check over an accepted step: its stage points (whose gaps are still
+    /// in `node_gaps`), refined between the neighbours of one that beats the worst so far.
+    fn watch_step<W: GapWaveform + ?Sized>(&mut self, step: &Step, wave: &W) -> Result<(), ElectricalError> {
+        let Some(mut watch) = self.breakdown.take() else {
+            return Ok(());
+        };
+        let n = self.gaps.len();
+        let c: &[f64] = if step.stages == RESISTOR_STAGES {
+            &self.tab_resistor.c
+        } else {
+            &self.tab_rectifier.c
+        };
+        let node = |i: usize| step.t0 + c[i] * step.h;
+        let mut best = None;
+        if node(step.stages - 1) >= watch.from() {
+            for i in 0..step.stages {
+                let q = step.y0[0] + step.z[0][i] + step.qeq0 + step.dq[i];
+                if watch.observe(node(i), q, &self.node_gaps[i * n..(i + 1) * n]) {
+                    best = Some(i);
+                }
+            }
+        }
+        let mut result = Ok(());
+        if let Some(i) = best {
+            let a = if i == 0 { step.t0 } else { node(i - 1) };
+            let b = if i + 1 < step.stages { node(i + 1) } else { node(i) };
+            watch.refine(a, b, |t, gaps| match self.eval(t, wave) {
+                Ok(ts) => {
+                    gaps.copy_from_slice(&self.gaps[..gaps.len()]);
+                    let (y, _) = self.dense(step, t, ts.equilibrium_charge);
+                    Some(y[0] + ts.equilibrium_charge)
+                }
+                Err(e) => {
+                    result = Err(e);
+                    None
+                }
+            });
+        }
+        self.breakdown = Some(watch);
+        result
+    }
+
+    /// The air-breakdown check over a piece `[ta, tb]` of an open or short circuit, whose
+    /// charge is known in closed form: equally spaced points, refined around the worst.
+    fn watch_piece<W: GapWaveform + ?Sized>(
+        &mut self,
+        ta: f64,
+        tb: f64,
+        wave: &W,
+    ) -> Result<(), ElectricalError> {
+        let Some(mut watch) = self.breakdown.take() else {
+            return Ok(());
+        };
+        let mut result = Ok(());
+        if tb >= watch.from() {
+            let at = |j: usize| ta + (tb - ta) * (j as f64 / BREAKDOWN_POINTS as f64);
+            let mut best = None;
+            for j in 0..=BREAKDOWN_POINTS {
+                let ts = match self.eval(at(j), wave) {
+                    Ok(ts) => ts,
+                    Err(e) => {
+                        self.breakdown = Some(watch);
+                        return Err(e);
+                    }
+                };
+                let q = self.row(ts, self.y, self.energy).charge;
+                if watch.observe(at(j), q, &self.gaps) {
+                    best = Some(j);
+                }
+            }
+            if let Some(j) = best {
+                let (a, b) = (at(j.saturating_sub(1)), at((j + 1).min(BREAKDOWN_POINTS)));
+                watch.refine(a, b, |t, gaps| match self.eval(t, wave) {
+                    Ok(ts) => {
+                        gaps.copy_from_slice(&self.gaps[..gaps.len()]);
+                        Some(self.row(ts, self.y, self.energy).charge)
+                    }
+                    Err(e) => {
+                        result = Err(e);
+                        None
+                    }
+                });
+            }
+        }
+        self.breakdown = Some(watch);
+        result
     }
 
     /// Samples grid times inside `[ta, tb]`: from a step's polynomial, or (open, short, or

@@ -1,34 +1,13 @@
 //! Integration tests of the `vibrotribo` binary: file contracts, and clear errors on bad input.
+//! One test target; each fixed bug has its own module (`issue_*.rs`) opening with what broke.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod issue_grid_jobs_stop_resume_and_merge;
+mod issue_simulate_output_edges;
+mod util;
 
-fn vibrotribo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vibrotribo"))
-        .args(args)
-        .output()
-        .expect("cannot run vibrotribo")
-}
+use std::path::Path;
 
-fn tempdir() -> tempfile::TempDir {
-    tempfile::tempdir().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines.map(|l| l.split(',').map(String::from).collect()).collect();
-    (header, rows)
-}
-
-fn reference_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../vibrotribo/tests/data/reference")
-}
+use util::*;
 
 #[test]
 fn default_run_prints_a_summary() {
@@ -94,12 +73,6 @@ fn output_files_follow_the_contract() {
     assert_eq!(summary["periods"], 40);
     assert_eq!(summary["impacts"], 60);
     assert_eq!(summary["impacts_per_period"], 6.0);
-}
-
-fn config_file(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../configs")
-        .join(name)
 }
 
 #[test]
@@ -405,33 +378,6 @@ fn bad_harvester_input_is_named() {
             "{args:?}: expected {expected:?} in {err:?}"
         );
     }
-}
-
-fn sweep_args<'a>(dir: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
-    let mut args = vec![
-        "sweep",
-        "--param",
-        "excitation.omega_ratio",
-        "--from",
-        "0.55",
-        "--to",
-        "0.8",
-        "--steps",
-        "7",
-        "--transient",
-        "30",
-        "--recorded",
-        "24",
-        "--out",
-        dir,
-        "--quiet",
-    ];
-    args.extend_from_slice(extra);
-    args
-}
-
-fn read(dir: &Path, name: &str) -> String {
-    std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(name).display()))
 }
 
 #[test]
