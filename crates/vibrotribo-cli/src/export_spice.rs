@@ -5,11 +5,11 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
+use vibrotribo::config::Config;
 use vibrotribo::electrical::spice::{self, SpiceOptions};
 use vibrotribo::electrical::{ChargeSolver, PwlGaps};
-use vibrotribo::{Simulator, Trajectory};
+use vibrotribo::study::{RunSpec, record_trajectory};
 
-use crate::config::Loaded;
 use crate::output::si;
 
 /// Options of `vibrotribo export-spice`.
@@ -52,14 +52,13 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
         .with_context(|| format!("{} has no `settings`", summary_path.display()))?;
     let table: toml::Table =
         serde_json::from_value(settings).context("the recorded settings are not a table")?;
-    let loaded = Loaded::from_table(table)?;
-    let chain = loaded.config.chain_params()?;
-    let spec = loaded.config.run_spec(&chain)?;
-    let harvester = loaded.harvester(&chain)?;
+    let config = Config::from_table(table)?;
+    let chain = config.chain();
+    let harvester = config.harvester();
     if !(args.dt_fraction > 0.0 && args.dt_fraction < 1.0) {
         bail!("--dt-fraction must lie in (0, 1), got {}", args.dt_fraction);
     }
-    let from = args.from_period.unwrap_or(spec.transient_periods);
+    let from = args.from_period.unwrap_or(config.run().transient());
     if args.periods == 0 {
         bail!("--periods must be at least 1");
     }
@@ -67,14 +66,15 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
     let (t0, t1) = (from as f64 * period, (from + args.periods) as f64 * period);
 
     // Re-create the run's exact trajectory (the simulation is deterministic).
-    let mut sim = Simulator::new(&chain, &spec.initial, loaded.config.sim_options()?)?;
-    sim.run_until(t0, &mut ())?;
-    let mut trajectory = Trajectory::new(&sim);
-    sim.run_until(t1, &mut trajectory)?;
+    let spec = RunSpec {
+        periods: from + args.periods,
+        ..config.run_spec(true)
+    };
+    let (trajectory, _) = record_trajectory(&spec, from, &mut ())?;
     let pwl = PwlGaps::from_trajectory(&trajectory, args.dt_fraction * period, t1)?;
     let options = SpiceOptions::default();
     let data_file = "vibrotribo-out.txt";
-    let deck = spice::netlist(&harvester, &pwl, t1, &options, data_file)?;
+    let deck = spice::netlist(harvester, &pwl, t1, &options, data_file)?;
     let path = args.run_dir.join(&args.name);
     std::fs::write(&path, &deck).with_context(|| format!("cannot write {}", path.display()))?;
     println!(
@@ -90,11 +90,11 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
     );
     if args.check {
         let ours = {
-            let mut s = ChargeSolver::for_chain(&harvester, &chain, loaded.charge_options()?)?;
+            let mut s = ChargeSolver::for_chain(harvester, chain, config.charge_options().clone())?;
             s.run_pwl(&pwl)?;
             s.total_energy()
         };
-        let run = spice::run_ngspice(&harvester, &pwl, t1, &options)?;
+        let run = spice::run_ngspice(harvester, &pwl, t1, &options)?;
         let theirs = run.energy_j.last().copied().unwrap_or(f64::NAN);
         println!(
             "  delivered energy: vibrotribo {}, ngspice {} (relative difference {:.2e}; ngspice took {:.2} s)",

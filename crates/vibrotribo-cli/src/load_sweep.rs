@@ -6,16 +6,40 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use serde_json::json;
 use vibrotribo::electrical::breakdown::BreakdownMargin;
-use vibrotribo::electrical::{
-    ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, load_sweep, log_spaced,
-};
-use vibrotribo::{ChainParams, Simulator, Trajectory};
+use vibrotribo::electrical::{ElectricalSamples, HarvesterParams, Load, load_sweep, log_spaced};
+use vibrotribo::study::{Ending, Harvester, ReplayOptions, record_trajectory, replay};
+use vibrotribo::{ChainParams, Trajectory};
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot;
 use crate::plots::both;
-use crate::progress::Progress;
+use crate::progress::{Interrupted, Progress, Watch};
+
+/// The V–Q cycle of period `index` at `points + 1` times of `harvester` along `trajectory`
+/// (of `chain`), and the air-breakdown check from that period on.
+pub fn vq_cycle(
+    trajectory: &Trajectory,
+    chain: &ChainParams,
+    harvester: &Harvester,
+    index: u64,
+    points: usize,
+) -> Result<(ElectricalSamples, BreakdownMargin)> {
+    let r = replay(
+        trajectory,
+        chain,
+        harvester,
+        &ReplayOptions {
+            breakdown_from_period: Some(index),
+            vq_cycle: Some((index, points)),
+            ..ReplayOptions::default()
+        },
+    )?;
+    Ok((
+        r.vq_cycle.unwrap_or_default(),
+        r.electrical.breakdown.unwrap_or_default(),
+    ))
+}
 
 /// Options of `vibrotribo load-sweep`.
 #[derive(Debug, clap::Args)]
@@ -45,25 +69,6 @@ pub struct LoadSweepArgs {
     pub quiet: bool,
 }
 
-/// Runs the charge solver of `h` over `trajectory` (of `chain`), recording the V–Q cycle of
-/// period `index` at `points + 1` times, and checks the air gaps for breakdown from that
-/// period on. Returns the solver (its V–Q cycle and power) and the margin.
-pub fn breakdown_over_vq_cycle(
-    h: &HarvesterParams,
-    chain: &ChainParams,
-    options: &ChargeOptions,
-    trajectory: &Trajectory,
-    index: u64,
-    points: usize,
-) -> Result<(ChargeSolver, BreakdownMargin)> {
-    let mut s = ChargeSolver::for_chain(h, chain, options.clone())?
-        .with_vq_cycle(index, points)?
-        .with_breakdown_check(index as f64 * chain.period());
-    s.run_trajectory(trajectory)?;
-    let margin = s.breakdown_margin().copied().unwrap_or_default();
-    Ok((s, margin))
-}
-
 /// Runs `vibrotribo load-sweep`.
 pub fn run(args: &LoadSweepArgs) -> Result<()> {
     if !(args.from.is_finite() && args.from > 0.0 && args.to.is_finite() && args.to >= args.from) {
@@ -79,24 +84,37 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
     if args.plot && args.out.is_none() {
         bail!("--plot needs --out DIR");
     }
-    let loaded = args.input.load()?;
-    let chain = loaded.config.chain_params()?;
-    let spec = loaded.config.run_spec(&chain)?;
-    let mut harvester = loaded.harvester(&chain)?;
-    let configured = harvester.load_resistance;
-    harvester.load = LoadKind::Resistor;
-    let options = loaded.charge_options()?;
+    let config = args.input.load()?;
+    let spec = config.run_spec(false);
+    let chain = &spec.chain;
+    let configured = config
+        .harvester()
+        .load
+        .resistance()
+        .unwrap_or(Load::default().resistance().unwrap_or(1e5));
+    let resistor = |r: f64| Harvester {
+        params: HarvesterParams {
+            load: Load::Resistor { resistance: r },
+            ..config.harvester().clone()
+        },
+        ..Harvester::new(config.harvester().clone(), config.charge_options().clone())
+    };
+    let harvester = resistor(configured).params;
+    let options = config.charge_options().clone();
     let period = chain.period();
 
     // The coupling is one-way: simulate the mechanics once and replay it for every load.
-    let mut sim = Simulator::new(&chain, &spec.initial, loaded.config.sim_options()?)?;
-    let mut trajectory = Trajectory::new(&sim);
-    let progress = Progress::new(spec.periods, "mechanics", args.quiet);
-    for p in 1..=spec.periods {
-        sim.run_until(p as f64 * period, &mut trajectory)?;
-        progress.inc(1);
+    let mut watch = Watch {
+        progress: Progress::new(spec.periods, "mechanics", args.quiet),
+    };
+    let (trajectory, ending) = record_trajectory(&spec, 0, &mut watch)?;
+    watch.progress.finish();
+    if ending != Ending::Completed {
+        return Err(Interrupted {
+            what: "during the mechanical run; nothing was written".into(),
+        }
+        .into());
     }
-    progress.finish();
 
     let resistances = log_spaced(args.from, args.to, args.steps);
     let sweep = load_sweep(
@@ -108,12 +126,16 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         &options,
     )?;
     let at = |r: f64| -> Result<f64> {
-        let mut h = harvester.clone();
-        h.load_resistance = r;
-        let mut s = ChargeSolver::for_chain(&h, &chain, options.clone())?;
-        s.run_trajectory(&trajectory)?;
-        Ok(s.summary(spec.transient_periods as usize)
-            .map_or(f64::NAN, |s| s.average_power_w))
+        let replayed = replay(
+            &trajectory,
+            chain,
+            &resistor(r),
+            &ReplayOptions {
+                transient_periods: spec.transient_periods,
+                ..ReplayOptions::default()
+            },
+        )?;
+        Ok(replayed.electrical.power.map_or(f64::NAN, |s| s.average_power_w))
     };
     let p_configured = at(configured)?;
     let best = sweep.optimum;
@@ -162,11 +184,8 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         let mut cycles = Vec::new();
         let mut margins = Vec::new();
         for r in [configured, best.resistance_ohm] {
-            let mut h = harvester.clone();
-            h.load_resistance = r;
-            let (s, margin) =
-                breakdown_over_vq_cycle(&h, &chain, &options, &trajectory, last, args.vq_points)?;
-            if let Some(c) = s.vq_cycle() {
+            let (c, margin) = vq_cycle(&trajectory, chain, &resistor(r), last, args.vq_points)?;
+            {
                 for j in 0..c.times.len() {
                     vq.row([r, c.times[j], c.charge_c[j], c.voltage_v[j], c.current_a[j]])?;
                 }
@@ -202,7 +221,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
                 "periods": spec.periods,
                 "transient_periods": spec.transient_periods,
                 "harvester": harvester,
-                "settings": loaded.table,
+                "settings": config.table(),
             }),
         )?;
         if args.plot {

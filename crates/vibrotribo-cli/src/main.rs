@@ -3,7 +3,6 @@
 
 mod config;
 mod export_spice;
-mod harvester;
 mod job;
 mod limits;
 mod load_sweep;

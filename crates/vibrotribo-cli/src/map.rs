@@ -156,7 +156,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         "period_tolerance": o.period_tolerance,
         "mechanics_only": args.run.mechanics_only,
         "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
-        "settings": runner.base().table,
+        "settings": runner.base().table(),
     });
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
@@ -505,7 +505,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                 "optimal_mass_ratio": rs,
                 "transient_periods": runner.options().transient_periods,
                 "recorded_periods": runner.options().recorded_periods,
-                "settings": runner.base().table,
+                "settings": runner.base().table(),
             }),
         )?;
         if args.plot {

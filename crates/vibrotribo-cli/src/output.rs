@@ -5,7 +5,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use vibrotribo::analysis::PointResult;
+use vibrotribo::study::PointResult;
 
 /// A CSV file written row by row.
 pub struct CsvFile {

@@ -79,6 +79,24 @@ pub fn check_interrupt(what: impl FnOnce() -> String) -> anyhow::Result<()> {
     }
 }
 
+/// Watches a run of the library's run layer: one step of a progress bar per period, and a
+/// checkpoint that stops the run after SIGINT/SIGTERM.
+pub struct Watch {
+    /// The bar, one step per period.
+    pub progress: Progress,
+}
+
+impl vibrotribo::study::RunObserver for Watch {
+    fn period(&mut self, _periods: u64, _state: &vibrotribo::StateView<'_>) -> std::ops::ControlFlow<()> {
+        self.progress.inc(1);
+        if interrupted() {
+            std::ops::ControlFlow::Break(())
+        } else {
+            std::ops::ControlFlow::Continue(())
+        }
+    }
+}
+
 /// A progress bar drawn only when stderr is a terminal.
 pub struct Progress {
     bar: Option<ProgressBar>,

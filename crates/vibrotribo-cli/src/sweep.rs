@@ -7,10 +7,11 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow, bail};
 use rayon::prelude::*;
 use serde_json::json;
-use vibrotribo::analysis::{PointOptions, PointResult, run_point};
-use vibrotribo::{ChainParams, ChainState};
+use vibrotribo::ChainState;
+use vibrotribo::config::Config;
+use vibrotribo::study::{PointOptions, PointResult, run_point};
 
-use crate::config::{ConfigArgs, Loaded, RunSpec};
+use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::limits;
 use crate::output::{numbered, point_cells, point_columns};
@@ -147,19 +148,17 @@ pub fn grid(from: f64, to: f64, steps: usize) -> Vec<f64> {
 
 /// Everything needed to run one value of a sweep or a map.
 pub struct PointRunner {
-    base: Loaded,
-    masses: usize,
+    base: Config,
     options: PointOptions,
     mechanics_only: bool,
 }
 
 impl PointRunner {
     /// A runner for the configuration `base`.
-    pub fn new(base: Loaded, run: &RunArgs) -> Result<Self> {
-        let params = base.config.chain_params()?;
-        let spec = base.config.run_spec(&params)?;
-        let transient = run.transient.unwrap_or(spec.transient_periods);
-        let recorded = run.recorded.unwrap_or(spec.periods - spec.transient_periods);
+    pub fn new(base: Config, run: &RunArgs) -> Result<Self> {
+        let settings = base.run();
+        let transient = run.transient.unwrap_or(settings.transient());
+        let recorded = run.recorded.unwrap_or(settings.periods - settings.transient());
         if recorded == 0 {
             bail!("--recorded must be at least 1");
         }
@@ -171,7 +170,6 @@ impl PointRunner {
         }
         Ok(PointRunner {
             base,
-            masses: params.len(),
             options: PointOptions {
                 transient_periods: transient,
                 recorded_periods: recorded,
@@ -188,33 +186,22 @@ impl PointRunner {
     }
 
     /// The base configuration.
-    pub fn base(&self) -> &Loaded {
+    pub fn base(&self) -> &Config {
         &self.base
     }
 
     /// Number of masses of the chain (the same at every point: keys set numbers, not arrays).
     pub fn masses(&self) -> usize {
-        self.masses
+        self.base.chain().len()
     }
 
-    /// The base configuration with `keys` set to `values`: its chain and run settings.
-    fn configure(&self, keys: &[(&str, f64)]) -> Result<(Loaded, ChainParams, RunSpec)> {
-        let mut loaded = self.base.clone();
+    /// The base configuration with `keys` set to `values` (validated).
+    fn configure(&self, keys: &[(&str, f64)]) -> Result<Config> {
+        let mut config = self.base.clone();
         for (k, v) in keys {
-            loaded = loaded.with(k, *v)?;
+            config = crate::config::with(&config, k, *v)?;
         }
-        let params = loaded.config.chain_params()?;
-        let spec = loaded.config.run_spec(&params)?;
-        Ok((loaded, params, spec))
-    }
-
-    /// Checks that the configuration with `keys` set to `values` is valid, without running it.
-    pub fn check(&self, keys: &[(&str, f64)]) -> Result<()> {
-        let (loaded, params, _) = self.configure(keys)?;
-        if !self.mechanics_only {
-            loaded.harvester(&params)?;
-        }
-        Ok(())
+        Ok(config)
     }
 
     /// Checks every point of a grid (`keys` gives each point's settings); the error names
@@ -222,7 +209,7 @@ impl PointRunner {
     pub fn check_all<'k, P>(&self, points: &[P], keys: impl Fn(&P) -> Vec<(&'k str, f64)>) -> Result<()> {
         for p in points {
             let k = keys(p);
-            self.check(&k).with_context(|| {
+            self.configure(&k).with_context(|| {
                 k.iter()
                     .map(|(key, v)| format!("{key} = {v}"))
                     .collect::<Vec<_>>()
@@ -235,22 +222,18 @@ impl PointRunner {
     /// Runs the configuration with `keys` set to `values`, from `initial` (or the configured
     /// initial state).
     pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult> {
-        let (loaded, params, spec) = self.configure(keys)?;
-        let sim_options = loaded.config.sim_options()?;
-        let harvester = if self.mechanics_only {
-            None
-        } else {
-            Some((loaded.harvester(&params)?, loaded.charge_options()?))
-        };
+        let config = self.configure(keys)?;
+        let params = config.chain();
         let initial = match initial {
-            Some(s) if s.positions.len() == params.len() && params.validate_state(s).is_ok() => s.clone(),
-            _ => spec.initial,
+            Some(s) if s.positions.len() == params.len() && params.validate_state(s).is_ok() => s,
+            _ => config.initial_state(),
         };
+        let harvester = (!self.mechanics_only).then(|| (config.harvester(), config.charge_options()));
         Ok(run_point(
-            &params,
-            &initial,
-            &sim_options,
-            harvester.as_ref().map(|(h, o)| (h, o)),
+            params,
+            initial,
+            config.sim_options(),
+            harvester,
             &self.options,
         )?)
     }
@@ -394,7 +377,7 @@ fn settings_json(
         "electrical_warmup_periods": o.electrical_warmup_periods,
         "mechanics_only": args.run.mechanics_only,
         "shard": shard.map(|s| json!({"index": s.index, "count": s.count})),
-        "settings": runner.base().table,
+        "settings": runner.base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),
     })
 }

@@ -5,7 +5,7 @@
 //! electrical / mechanics is what to read off.
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind};
+use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, Load, Rectifier};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 const PERIODS: f64 = 10.0;
@@ -36,11 +36,11 @@ fn bench(c: &mut Criterion) {
     let mut trajectory = Trajectory::new(&sim);
     sim.run_until(PERIODS * chain.period(), &mut trajectory).unwrap();
     let resistor = |r: f64| HarvesterParams {
-        load_resistance: r,
+        load: Load::Resistor { resistance: r },
         ..HarvesterParams::default()
     };
     let rectifier = HarvesterParams {
-        load: LoadKind::Rectifier,
+        load: Load::Rectifier(Rectifier::default()),
         ..HarvesterParams::default()
     };
 

@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p vibrotribo --example electrical_work`
 use std::time::Instant;
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind};
+use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, Load, Rectifier};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 fn main() {
@@ -21,7 +21,7 @@ fn main() {
                 (
                     format!("R = {r:e} Ω"),
                     HarvesterParams {
-                        load_resistance: r,
+                        load: Load::Resistor { resistance: r },
                         ..HarvesterParams::default()
                     },
                 )
@@ -29,7 +29,7 @@ fn main() {
             .chain(std::iter::once((
                 "rectifier".to_string(),
                 HarvesterParams {
-                    load: LoadKind::Rectifier,
+                    load: Load::Rectifier(Rectifier::default()),
                     ..HarvesterParams::default()
                 },
             )))

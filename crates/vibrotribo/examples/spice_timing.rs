@@ -11,7 +11,9 @@
 //! The window is the last `periods` periods of a run twice as long (past the start-up).
 use std::time::Instant;
 use vibrotribo::electrical::spice::{SpiceOptions, run_ngspice};
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, PwlGaps};
+use vibrotribo::electrical::{
+    ChargeOptions, ChargeSolver, Diode, HarvesterParams, Load, LoadKind, PwlGaps, Rectifier,
+};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -43,16 +45,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut trajectory = Trajectory::new(&sim);
     sim.run_until(t_end, &mut trajectory)?;
     let pwl = PwlGaps::from_trajectory(&trajectory, chain.period() / 2000.0, t_end)?;
+    let load = match load {
+        LoadKind::Rectifier => Load::Rectifier(Rectifier {
+            // ngspice needs a conducting path at the floating bridge (see the spice module docs).
+            diode: Diode {
+                parallel_conductance: 1e-10,
+                ..Rectifier::default().diode
+            },
+            ..Rectifier::default()
+        }),
+        _ => Load::Resistor { resistance },
+    };
     let params = HarvesterParams {
         load,
-        load_resistance: resistance,
-        // ngspice needs a conducting path at the floating bridge (see the spice module docs).
-        diode_parallel_conductance: 1e-10,
         ..HarvesterParams::default()
     };
     println!(
         "{case} case, {periods} periods, {} load, {} PWL points, {} flow segments",
-        load.as_str(),
+        load.kind().as_str(),
         pwl.times().len(),
         trajectory.segments().len()
     );

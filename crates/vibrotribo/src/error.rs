@@ -6,13 +6,19 @@
 use thiserror::Error;
 
 /// A parameter failed validation.
+///
+/// Parameters are named in the library's terms: the path of the field in the structure that
+/// was validated (`masses[1]` of [`ChainParams`](crate::ChainParams), `area` of
+/// [`HarvesterParams`](crate::electrical::HarvesterParams)). A front end that reads them
+/// from a configuration maps the names to its keys with [`ParamError::within`]
+/// (`oscillator.masses[1]`, `harvester.area`).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum ParamError {
     /// A scalar parameter is out of its admissible range or not finite.
     #[error("invalid {name} = {value}: {reason}")]
     Invalid {
-        /// Parameter name as used in configuration files (e.g. `oscillator.masses[1]`).
+        /// Parameter name (e.g. `masses[1]`).
         name: String,
         /// The offending value.
         value: f64,
@@ -34,7 +40,7 @@ pub enum ParamError {
     TooFewMasses(usize),
     /// The initial positions make two neighbouring masses overlap.
     #[error(
-        "initial state interpenetrates at contact {contact} (between masses {contact} and {}): gap = {gap:.3e} m",
+        "initial positions interpenetrate at contact {contact} (between masses {contact} and {}): gap = {gap:.3e} m",
         contact + 1
     )]
     Interpenetration {
@@ -43,12 +49,47 @@ pub enum ParamError {
         /// The (negative) gap, m.
         gap: f64,
     },
-    /// Two parameters that exclude each other were both given, or neither.
-    #[error("{0}")]
-    Conflict(String),
+    /// A parameter's value does not fit the others (e.g. a transducer mode that needs more
+    /// gaps than the chain has).
+    #[error("{name}: {message}")]
+    Conflict {
+        /// Parameter name.
+        name: String,
+        /// What does not fit, and what to do about it.
+        message: String,
+    },
 }
 
 impl ParamError {
+    /// The same error with its parameter named by `map(name)`: how a configuration layer
+    /// turns the library's field paths into its keys. `map` returns `None` to keep a name.
+    pub fn renamed(self, map: impl Fn(&str) -> Option<String>) -> Self {
+        let rename = |name: String| map(&name).unwrap_or(name);
+        match self {
+            ParamError::Invalid { name, value, reason } => ParamError::Invalid {
+                name: rename(name),
+                value,
+                reason,
+            },
+            ParamError::Length { name, expected, got } => ParamError::Length {
+                name: rename(name),
+                expected,
+                got,
+            },
+            ParamError::Conflict { name, message } => ParamError::Conflict {
+                name: rename(name),
+                message,
+            },
+            other => other,
+        }
+    }
+
+    /// The same error with `prefix` and a dot before its parameter's name
+    /// (`area` → `harvester.area`).
+    pub fn within(self, prefix: &str) -> Self {
+        self.renamed(|n| Some(format!("{prefix}.{n}")))
+    }
+
     /// `name = value` is rejected because it `reason` (e.g. "must be positive").
     pub(crate) fn invalid(name: impl Into<String>, value: f64, reason: &'static str) -> Self {
         ParamError::Invalid {
@@ -140,6 +181,9 @@ pub enum SimError {
         /// Last mass of the cluster (1-based).
         last: usize,
     },
+    /// An observer failed the run (see [`Observer::proceed`](crate::Observer::proceed)).
+    #[error("{0}")]
+    Observer(String),
     /// A requested time lies before the current simulation time.
     #[error("cannot run backwards: requested t = {requested} s, current t = {current} s")]
     Backwards {

@@ -30,14 +30,17 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+#[cfg(feature = "config")]
+pub mod config;
 pub mod dynamics;
 pub mod electrical;
 mod error;
 pub mod model;
+pub mod study;
 
 pub use dynamics::{
-    ContactStatus, Event, EventKind, EventLog, Flow, Observer, Segment, Simulator, StateView, Trajectory,
-    UniformSampler,
+    ContactStatus, Event, EventKind, EventLog, Flow, Observer, RunEnd, Segment, Simulator, StateView,
+    Trajectory, UniformSampler,
 };
 pub use error::{ParamError, SimError};
 pub use model::{ChainParams, ChainState, Excitation, Frequency, NondimGroups, SimOptions};

@@ -4,7 +4,7 @@
 
 mod common;
 use common::period_stats;
-use vibrotribo::electrical::{ChargeOptions, HarvesterParams, LoadKind, PeriodStats};
+use vibrotribo::electrical::{ChargeOptions, HarvesterParams, Load, PeriodStats, Rectifier};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 fn trajectory(chain: &ChainParams, periods: f64) -> Trajectory {
@@ -28,7 +28,7 @@ fn check_case(name: &str, chain: &ChainParams, n_periods: f64, loads: &[f64]) {
     let default = ChargeOptions::default().rtol;
     for &r in loads {
         let params = HarvesterParams {
-            load_resistance: r,
+            load: Load::Resistor { resistance: r },
             ..HarvesterParams::default()
         };
         let reference = period_stats(chain, &traj, &params, default * 1e-5);
@@ -77,7 +77,7 @@ fn rectifier_energy_per_period_within_1e_6() {
     let chain = ChainParams::paper_chatter_case();
     let traj = trajectory(&chain, 6.0);
     let params = HarvesterParams {
-        load: LoadKind::Rectifier,
+        load: Load::Rectifier(Rectifier::default()),
         ..HarvesterParams::default()
     };
     let default = ChargeOptions::default().rtol;

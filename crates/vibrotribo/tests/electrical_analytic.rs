@@ -3,7 +3,8 @@
 //! harvester parameters' validation.
 
 use vibrotribo::electrical::{
-    ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, TransducerMode, VocModel, power_curve, summarize,
+    ChargeOptions, ChargeSolver, Diode, HarvesterParams, Load, LoadKind, Rectifier, TransducerMode, VocModel,
+    power_curve, summarize,
 };
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
@@ -51,9 +52,14 @@ fn sine_qeq(t: f64) -> (f64, f64) {
 }
 
 fn params(load: LoadKind, resistance: f64) -> HarvesterParams {
+    let load = match load {
+        LoadKind::Resistor => Load::Resistor { resistance },
+        LoadKind::Rectifier => Load::Rectifier(Rectifier::default()),
+        LoadKind::Open => Load::Open,
+        LoadKind::Short => Load::Short,
+    };
     HarvesterParams {
         load,
-        load_resistance: resistance,
         ..HarvesterParams::default()
     }
 }
@@ -282,9 +288,11 @@ fn rectifier_conserves_energy_and_reaches_target() {
     // Energy delivered through the bridge equals ½ C_s V_s² (no resistor across C_s).
     let cs = 1e-7;
     let p = HarvesterParams {
-        load: LoadKind::Rectifier,
-        storage_capacitance: cs,
-        target_voltage: Some(10.0),
+        load: Load::Rectifier(Rectifier {
+            storage_capacitance: cs,
+            target_voltage: Some(10.0),
+            ..Rectifier::default()
+        }),
         ..HarvesterParams::default()
     };
     let mut s = ChargeSolver::new(&p, 0.1, 2, ChargeOptions::default()).unwrap();
@@ -357,49 +365,58 @@ fn bad_parameters_are_rejected_naming_the_key() {
                 area: -0.01,
                 ..HarvesterParams::default()
             },
-            "harvester.area",
+            "invalid area = -0.01",
         ),
         (
             HarvesterParams {
                 relative_permittivity: [2.0, 0.0],
                 ..HarvesterParams::default()
             },
-            "harvester.relative_permittivity[1]",
+            "invalid relative_permittivity[1] = 0",
         ),
         (
             HarvesterParams {
-                load_resistance: -5.0,
+                load: Load::Resistor { resistance: -5.0 },
                 ..HarvesterParams::default()
             },
-            "harvester.load_resistance",
+            "invalid load_resistance = -5",
         ),
         (
             HarvesterParams {
                 charge_density: f64::NAN,
                 ..HarvesterParams::default()
             },
-            "harvester.charge_density",
+            "invalid charge_density = NaN",
         ),
         (
             HarvesterParams {
                 dielectric_thickness: [0.0, 0.0],
                 ..HarvesterParams::default()
             },
-            "harvester.dielectric_thickness",
+            "invalid dielectric_thickness = 0",
         ),
         (
             HarvesterParams {
-                diode_series_resistance: 0.0,
+                load: Load::Rectifier(Rectifier {
+                    diode: Diode {
+                        series_resistance: 0.0,
+                        ..Rectifier::default().diode
+                    },
+                    ..Rectifier::default()
+                }),
                 ..HarvesterParams::default()
             },
-            "harvester.diode_series_resistance",
+            "invalid diode_series_resistance = 0",
         ),
         (
             HarvesterParams {
-                storage_capacitance: f64::INFINITY,
+                load: Load::Rectifier(Rectifier {
+                    storage_capacitance: f64::INFINITY,
+                    ..Rectifier::default()
+                }),
                 ..HarvesterParams::default()
             },
-            "harvester.storage_capacitance",
+            "invalid storage_capacitance = inf",
         ),
     ];
     for (p, key) in cases {
@@ -412,8 +429,16 @@ fn bad_parameters_are_rejected_naming_the_key() {
         .unwrap_err()
         .to_string();
     assert!(
-        msg.contains("harvester.mode") && msg.contains("contact_separation"),
+        msg.starts_with("mode: ") && msg.contains("contact_separation"),
         "{msg}"
+    );
+    assert!(
+        HarvesterParams::default()
+            .validate_for_gaps(1)
+            .unwrap_err()
+            .within("harvester")
+            .to_string()
+            .starts_with("harvester.mode: ")
     );
     let p = HarvesterParams {
         mode: TransducerMode::ContactSeparation,
@@ -421,7 +446,7 @@ fn bad_parameters_are_rejected_naming_the_key() {
         ..HarvesterParams::default()
     };
     let msg = p.validate_for_gaps(2).unwrap_err().to_string();
-    assert!(msg.contains("harvester.contact"), "{msg}");
+    assert!(msg.contains("invalid contact = 2"), "{msg}");
     // The solver refuses them too, and bad options.
     let msg = ChargeSolver::new(
         &HarvesterParams::default(),
@@ -434,7 +459,7 @@ fn bad_parameters_are_rejected_naming_the_key() {
     )
     .unwrap_err()
     .to_string();
-    assert!(msg.contains("electrical.rtol"), "{msg}");
+    assert!(msg.contains("invalid rtol = 0.5"), "{msg}");
 }
 
 #[derive(serde::Deserialize)]
@@ -457,9 +482,11 @@ fn toml_harvester_table_deserializes_and_reports_bad_input() {
     "#;
     let c: Config = toml::from_str(text).unwrap();
     assert_eq!(c.harvester.voc_model, VocModel::Exact);
-    assert_eq!(c.harvester.load, LoadKind::Rectifier);
+    assert_eq!(c.harvester.load.kind(), LoadKind::Rectifier);
     assert_eq!(c.harvester.area, 0.02);
-    assert_eq!(c.harvester.storage_capacitance, 4.7e-6);
+    let r = c.harvester.load.rectifier().unwrap();
+    assert_eq!(r.storage_capacitance, 4.7e-6);
+    assert_eq!(r.diode.saturation_current, 1e-8);
     assert_eq!(c.harvester.charge_density, 15e-6, "defaults fill the rest");
     c.harvester.validate().unwrap();
 
@@ -480,7 +507,7 @@ fn toml_harvester_table_deserializes_and_reports_bad_input() {
     assert!(err.contains("areaa"), "{err}");
     let c: Config = toml::from_str("[harvester]\narea = -1.0\n").unwrap();
     let err = c.harvester.validate().unwrap_err().to_string();
-    assert!(err.contains("harvester.area") && err.contains("-1"), "{err}");
+    assert!(err.contains("invalid area = -1"), "{err}");
 }
 
 #[test]
@@ -520,9 +547,11 @@ fn rectifier_with_load_resistor_balances_energy() {
     // rule on a fine sample grid).
     let (cs, rl) = (1e-7, 2e5);
     let p = HarvesterParams {
-        load: LoadKind::Rectifier,
-        storage_capacitance: cs,
-        storage_load_resistance: Some(rl),
+        load: Load::Rectifier(Rectifier {
+            storage_capacitance: cs,
+            storage_load_resistance: Some(rl),
+            ..Rectifier::default()
+        }),
         ..HarvesterParams::default()
     };
     let dt = 2e-6;

@@ -7,7 +7,7 @@
 //! fail with a message saying so.
 
 use vibrotribo::electrical::spice::{SpiceError, SpiceOptions, SpiceRun, run_ngspice};
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind, PwlGaps};
+use vibrotribo::electrical::{ChargeOptions, ChargeSolver, Diode, HarvesterParams, Load, PwlGaps, Rectifier};
 use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator, Trajectory};
 
 const TOLERANCE: f64 = 1e-3;
@@ -25,16 +25,20 @@ fn ngspice(params: &HarvesterParams, pwl: &PwlGaps, t_end: f64) -> SpiceRun {
 fn loads() -> [HarvesterParams; 2] {
     [
         HarvesterParams {
-            load: LoadKind::Resistor,
-            load_resistance: 1e5,
+            load: Load::Resistor { resistance: 1e5 },
             ..HarvesterParams::default()
         },
         HarvesterParams {
-            load: LoadKind::Rectifier,
-            storage_capacitance: 1e-6,
-            // ngspice needs a conducting path at the floating bridge; the library models the
-            // same leakage (see the spice module docs).
-            diode_parallel_conductance: 1e-10,
+            load: Load::Rectifier(Rectifier {
+                storage_capacitance: 1e-6,
+                // ngspice needs a conducting path at the floating bridge; the library models
+                // the same leakage (see the spice module docs).
+                diode: Diode {
+                    parallel_conductance: 1e-10,
+                    ..Rectifier::default().diode
+                },
+                ..Rectifier::default()
+            }),
             ..HarvesterParams::default()
         },
     ]
@@ -49,7 +53,7 @@ fn compare(name: &str, pwl: &PwlGaps, period: f64) {
         let mut solver =
             ChargeSolver::new(&params, period, pwl.gap_count(), ChargeOptions::default()).unwrap();
         solver.run_pwl(pwl).unwrap();
-        let load = params.load.as_str();
+        let load = params.load.kind().as_str();
         let ours = solver.total_energy();
         let theirs = *spice.energy_j.last().unwrap();
         let rel = (theirs - ours) / ours;

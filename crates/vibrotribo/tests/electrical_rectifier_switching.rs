@@ -5,7 +5,7 @@
 
 mod common;
 use common::period_stats;
-use vibrotribo::electrical::{ChargeOptions, HarvesterParams, LoadKind};
+use vibrotribo::electrical::{ChargeOptions, HarvesterParams, Load, Rectifier};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 #[test]
@@ -17,8 +17,10 @@ fn rectifier_energy_per_period_within_1e_6_on_the_default_case() {
     let default = ChargeOptions::default().rtol;
     for storage in [1e-6, 1e-7] {
         let params = HarvesterParams {
-            load: LoadKind::Rectifier,
-            storage_capacitance: storage,
+            load: Load::Rectifier(Rectifier {
+                storage_capacitance: storage,
+                ..Rectifier::default()
+            }),
             ..HarvesterParams::default()
         };
         let reference = period_stats(&chain, &traj, &params, default * 1e-5);

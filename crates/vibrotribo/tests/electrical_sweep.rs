@@ -1,7 +1,7 @@
 //! The load sweep on one recorded trajectory: the refined optimum is a maximum of the average
 //! power (checked by independent solver runs either side of it), and bad input is refused.
 
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, load_sweep, log_spaced};
+use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, Load, load_sweep, log_spaced};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 fn setup() -> (ChainParams, Trajectory) {
@@ -14,7 +14,7 @@ fn setup() -> (ChainParams, Trajectory) {
 
 fn power(chain: &ChainParams, traj: &Trajectory, r: f64) -> f64 {
     let p = HarvesterParams {
-        load_resistance: r,
+        load: Load::Resistor { resistance: r },
         ..HarvesterParams::default()
     };
     let mut s = ChargeSolver::for_chain(&p, chain, ChargeOptions::default()).unwrap();

@@ -4,7 +4,7 @@
 //! the maximum on its dense output; this checks that against a dense independent sampling.
 
 use vibrotribo::electrical::breakdown::{BreakdownMargin, PaschenParams};
-use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, LoadKind};
+use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, Load};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};
 
 fn check(chain: &ChainParams, h: &HarvesterParams, periods: u64, from_period: u64) {
@@ -69,7 +69,7 @@ fn chatter_case_resistor_and_open_circuit() {
     let chain = ChainParams::paper_chatter_case();
     check(&chain, &HarvesterParams::default(), 10, 5);
     let open = HarvesterParams {
-        load: LoadKind::Open,
+        load: Load::Open,
         ..HarvesterParams::default()
     };
     check(&chain, &open, 6, 3);

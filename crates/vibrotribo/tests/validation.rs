@@ -22,11 +22,11 @@ fn default_parameters_are_valid() {
 fn non_positive_mass() {
     assert_eq!(
         err_of(&with(|p| p.masses[1] = -0.1)),
-        "invalid oscillator.masses[1] = -0.1: must be positive"
+        "invalid masses[1] = -0.1: must be positive"
     );
     assert_eq!(
         err_of(&with(|p| p.masses[0] = 0.0)),
-        "invalid oscillator.masses[0] = 0: must be positive"
+        "invalid masses[0] = 0: must be positive"
     );
 }
 
@@ -34,7 +34,7 @@ fn non_positive_mass() {
 fn non_positive_stiffness() {
     assert_eq!(
         err_of(&with(|p| p.stiffness[2] = 0.0)),
-        "invalid oscillator.stiffness[2] = 0: must be positive"
+        "invalid stiffness[2] = 0: must be positive"
     );
 }
 
@@ -42,11 +42,11 @@ fn non_positive_stiffness() {
 fn negative_damping_or_gap() {
     assert_eq!(
         err_of(&with(|p| p.damping[0] = -0.01)),
-        "invalid oscillator.damping[0] = -0.01: must not be negative"
+        "invalid damping[0] = -0.01: must not be negative"
     );
     assert_eq!(
         err_of(&with(|p| p.gaps[1] = -0.001)),
-        "invalid oscillator.gaps[1] = -0.001: must not be negative"
+        "invalid gaps[1] = -0.001: must not be negative"
     );
 }
 
@@ -54,11 +54,11 @@ fn negative_damping_or_gap() {
 fn restitution_outside_unit_interval() {
     assert_eq!(
         err_of(&with(|p| p.restitution = 1.5)),
-        "invalid oscillator.restitution = 1.5: must lie in [0, 1]"
+        "invalid restitution = 1.5: must lie in [0, 1]"
     );
     assert_eq!(
         err_of(&with(|p| p.restitution = -0.1)),
-        "invalid oscillator.restitution = -0.1: must lie in [0, 1]"
+        "invalid restitution = -0.1: must lie in [0, 1]"
     );
 }
 
@@ -70,7 +70,7 @@ fn nan_and_infinity() {
     );
     assert_eq!(
         err_of(&with(|p| p.masses[2] = f64::INFINITY)),
-        "invalid oscillator.masses[2] = inf: must be a finite number"
+        "invalid masses[2] = inf: must be a finite number"
     );
     assert_eq!(
         err_of(&with(|p| p.excitation.frequency = Frequency::OmegaRatio(f64::NAN))),
@@ -86,11 +86,11 @@ fn nan_and_infinity() {
 fn wrong_array_lengths() {
     assert_eq!(
         err_of(&with(|p| p.stiffness.pop().map(|_| ()).unwrap_or(()))),
-        "oscillator.stiffness has 2 entries, expected 3"
+        "stiffness has 2 entries, expected 3"
     );
     assert_eq!(
         err_of(&with(|p| p.gaps.push(0.01))),
-        "oscillator.gaps has 3 entries, expected 2"
+        "gaps has 3 entries, expected 2"
     );
     assert_eq!(
         err_of(&with(|p| {
@@ -110,7 +110,7 @@ fn interpenetrating_initial_state() {
     let err = Simulator::new(&params, &state, SimOptions::default()).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "initial state interpenetrates at contact 1 (between masses 1 and 2): gap = -1.000e-3 m"
+        "initial positions interpenetrate at contact 1 (between masses 1 and 2): gap = -1.000e-3 m"
     );
     assert!(matches!(
         err,
@@ -124,7 +124,7 @@ fn interpenetrating_initial_state() {
         Simulator::new(&params, &short, SimOptions::default())
             .unwrap_err()
             .to_string(),
-        "run.initial_positions has 2 entries, expected 3"
+        "positions has 2 entries, expected 3"
     );
     let nan = ChainState {
         positions: vec![0.0; 3],
@@ -134,7 +134,7 @@ fn interpenetrating_initial_state() {
         Simulator::new(&params, &nan, SimOptions::default())
             .unwrap_err()
             .to_string(),
-        "invalid run.initial_velocities[1] = NaN: must be a finite number"
+        "invalid velocities[1] = NaN: must be a finite number"
     );
 }
 
@@ -147,7 +147,7 @@ fn bad_options_and_backwards_time() {
     let err = Simulator::new(&ChainParams::default(), &ChainState::at_rest(3), options).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "invalid options.max_events_per_period = 0: must be positive"
+        "invalid max_events_per_period = 0: must be positive"
     );
     let mut sim = Simulator::new(
         &ChainParams::default(),

@@ -159,11 +159,11 @@ fn bad_input_is_named() {
         ),
         (
             &["simulate", "--set", "run.initial_positions=[0,0.05,0]"],
-            "interpenetrates at contact 1",
+            "interpenetrate at contact 1",
         ),
         (
             &["simulate", "--set", "run.periods=0"],
-            "run.periods must be at least 1",
+            "invalid run.periods = 0: must be at least 1",
         ),
         (&["simulate", "--set", "omega_ratio"], "expected key=value"),
         (

@@ -24,14 +24,12 @@ mod period;
 mod poincare;
 mod spectrum;
 mod stats;
-mod sweep;
 
 pub use fit::{QuadraticFit, fit_quadratic};
 pub use period::{PeriodOptions, Periodicity, detect_period};
 pub use poincare::{ImpactPoint, ImpactSection, StroboscopicOptions, StroboscopicSection};
 pub use spectrum::{Detrend, Psd, WelchOptions, Window, welch_psd};
 pub use stats::RunStats;
-pub use sweep::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 
 use crate::error::{ParamError, check_positive};
 use thiserror::Error;

@@ -5,7 +5,7 @@ use crate::dynamics::{Event, EventKind, Observer, StateView};
 
 /// Counts events per excitation period, per contact. Periods are numbered from 0 (the
 /// interval [0, T)).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RunStats {
     period: f64,
     /// Periods before this index are the transient, excluded from the `*_after_transient`

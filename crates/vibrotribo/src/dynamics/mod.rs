@@ -12,9 +12,9 @@ mod simulator;
 mod taylor;
 
 pub use observer::{
-    ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, Segment, StateView, Trajectory,
-    UniformSampler,
+    ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, ObserverError, Segment, StateView,
+    Trajectory, UniformSampler, Verdict,
 };
 pub use oscillator::Oscillator;
-pub use simulator::{ContactStatus, Simulator, initial_state};
+pub use simulator::{ContactStatus, RunEnd, Simulator, initial_state};
 pub(crate) use taylor::GapPolynomial;

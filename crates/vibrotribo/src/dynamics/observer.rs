@@ -6,6 +6,8 @@
 //! bifurcation diagram is a sweep with such an observer attached. All methods have no-op
 //! defaults.
 
+use std::ops::ControlFlow;
+
 use super::oscillator::{Forcing, Oscillator};
 
 /// What happened at an event.
@@ -172,12 +174,26 @@ pub struct Segment {
     pub clusters: Vec<ClusterFlow>,
 }
 
+/// An observer's failure, which ends the run (see [`Observer::proceed`]).
+pub type ObserverError = Box<dyn std::error::Error + Send + Sync>;
+
+/// What an observer says after a piece of flow or an event: go on, stop the run
+/// (`Ok(ControlFlow::Break(()))`), or fail it (`Err`).
+pub type Verdict = Result<ControlFlow<()>, ObserverError>;
+
 /// Receives the output of a simulation. Every method has a no-op default.
 pub trait Observer {
     /// Called with each interval of exact flow, in time order, before the event that ends it.
     fn flow(&mut self, _flow: &Flow<'_>) {}
     /// Called after each event with the state just after it.
     fn event(&mut self, _event: &Event, _state: &StateView<'_>) {}
+    /// Asked after every piece of flow and every batch of events: whether the run goes on.
+    /// `Break` stops [`Simulator::run_until`](super::Simulator::run_until) there (it returns
+    /// [`RunEnd::Stopped`](super::RunEnd::Stopped)); `Err` fails the run with
+    /// [`SimError::Observer`](crate::SimError::Observer). Default: go on.
+    fn proceed(&mut self) -> Verdict {
+        Ok(ControlFlow::Continue(()))
+    }
 }
 
 impl Observer for () {}
@@ -189,6 +205,9 @@ impl<O: Observer + ?Sized> Observer for &mut O {
     fn event(&mut self, event: &Event, state: &StateView<'_>) {
         (**self).event(event, state)
     }
+    fn proceed(&mut self) -> Verdict {
+        (**self).proceed()
+    }
 }
 
 impl<O: Observer + ?Sized> Observer for Box<O> {
@@ -197,6 +216,9 @@ impl<O: Observer + ?Sized> Observer for Box<O> {
     }
     fn event(&mut self, event: &Event, state: &StateView<'_>) {
         (**self).event(event, state)
+    }
+    fn proceed(&mut self) -> Verdict {
+        (**self).proceed()
     }
 }
 
@@ -212,6 +234,12 @@ impl<O: Observer> Observer for Option<O> {
             o.event(event, state)
         }
     }
+    fn proceed(&mut self) -> Verdict {
+        match self {
+            Some(o) => o.proceed(),
+            None => Ok(ControlFlow::Continue(())),
+        }
+    }
 }
 
 impl<O: Observer> Observer for Vec<O> {
@@ -225,6 +253,14 @@ impl<O: Observer> Observer for Vec<O> {
             o.event(event, state)
         }
     }
+    fn proceed(&mut self) -> Verdict {
+        for o in self.iter_mut() {
+            if let v @ (Err(_) | Ok(ControlFlow::Break(()))) = o.proceed() {
+                return v;
+            }
+        }
+        Ok(ControlFlow::Continue(()))
+    }
 }
 
 macro_rules! tuple_observer {
@@ -235,6 +271,14 @@ macro_rules! tuple_observer {
             }
             fn event(&mut self, event: &Event, state: &StateView<'_>) {
                 $(self.$idx.event(event, state);)+
+            }
+            fn proceed(&mut self) -> Verdict {
+                $(
+                    if let v @ (Err(_) | Ok(ControlFlow::Break(()))) = self.$idx.proceed() {
+                        return v;
+                    }
+                )+
+                Ok(ControlFlow::Continue(()))
             }
         }
     };
@@ -291,6 +335,21 @@ impl Trajectory {
             offsets: sim.offsets().to_vec(),
             gaps: sim.params().gaps.clone(),
             forcing: *sim.forcing(),
+        }
+    }
+
+    /// An empty trajectory for a simulation of `chain` (the same as [`new`](Self::new) on
+    /// a simulator of it).
+    pub fn for_chain(chain: &crate::ChainParams) -> Self {
+        let mut offsets = vec![0.0; chain.len()];
+        for i in 1..offsets.len() {
+            offsets[i] = offsets[i - 1] + chain.gaps[i - 1];
+        }
+        Trajectory {
+            segments: Vec::new(),
+            offsets,
+            gaps: chain.gaps.clone(),
+            forcing: Forcing::new(chain.excitation.amplitude, chain.omega()),
         }
     }
 

@@ -30,12 +30,27 @@
 //! Work is bounded: at most [`SimOptions::max_events_per_period`] events per period, after
 //! which the run ends with [`SimError::EventLimit`].
 
+use std::ops::ControlFlow;
+
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
 use super::oscillator::{Forcing, OscConstants, Oscillator};
 use super::roots::{Found, first_root};
 use super::signal::Signal;
 use crate::error::{ParamError, SimError};
 use crate::model::{ChainParams, ChainState, SimOptions};
+
+/// How [`Simulator::run_until`] ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunEnd {
+    /// The requested time was reached.
+    Reached,
+    /// An observer stopped the run at time `t`, s ([`Observer::proceed`]); the simulator
+    /// stands there and can go on.
+    Stopped {
+        /// Time, s.
+        t: f64,
+    },
+}
 
 /// Whether a contact is open or closed, as seen from outside the simulator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -234,8 +249,13 @@ impl Simulator {
             .collect()
     }
 
-    /// Runs to time `t_end`, s, reporting flow and events to `observer`.
-    pub fn run_until<O: Observer + ?Sized>(&mut self, t_end: f64, observer: &mut O) -> Result<(), SimError> {
+    /// Runs to time `t_end`, s, reporting flow and events to `observer`, which may stop the run
+    /// early or fail it ([`Observer::proceed`]).
+    pub fn run_until<O: Observer + ?Sized>(
+        &mut self,
+        t_end: f64,
+        observer: &mut O,
+    ) -> Result<RunEnd, SimError> {
         if t_end.is_nan() || t_end < self.t {
             return Err(SimError::Backwards {
                 requested: t_end,
@@ -250,6 +270,9 @@ impl Simulator {
             let t_next = next.map_or(stop, |(te, _)| te.max(self.t));
             self.emit_flow(t_next, observer);
             self.advance_state(t_next);
+            // A stop asked for after a piece of flow takes effect once the event that ends it
+            // is applied, so that the simulator stands in a consistent state.
+            let halt = Self::verdict(observer.proceed(), self.t)?.is_some();
             match next {
                 None => {
                     if stop >= boundary {
@@ -257,6 +280,9 @@ impl Simulator {
                         self.events_in_period = 0;
                     }
                     self.rebuild()?;
+                    if halt {
+                        return Ok(RunEnd::Stopped { t: self.t });
+                    }
                 }
                 Some((_, what)) => {
                     self.handle(what)?;
@@ -279,10 +305,22 @@ impl Simulator {
                             limit: self.options.max_events_per_period,
                         });
                     }
+                    if Self::verdict(observer.proceed(), self.t)?.is_some() || halt {
+                        return Ok(RunEnd::Stopped { t: self.t });
+                    }
                 }
             }
         }
-        Ok(())
+        Ok(RunEnd::Reached)
+    }
+
+    /// What an observer's verdict means for the run: go on (`None`), stop, or fail.
+    fn verdict(v: super::observer::Verdict, t: f64) -> Result<Option<RunEnd>, SimError> {
+        match v {
+            Ok(ControlFlow::Continue(())) => Ok(None),
+            Ok(ControlFlow::Break(())) => Ok(Some(RunEnd::Stopped { t })),
+            Err(e) => Err(SimError::Observer(e.to_string())),
+        }
     }
 
     fn emit_flow<O: Observer + ?Sized>(&self, t_end: f64, observer: &mut O) {

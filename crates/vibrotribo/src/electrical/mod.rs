@@ -20,7 +20,7 @@
 //! and for the two-plate contact-separation mode ([`ContactSeparation`])
 //! `C = ε₀S/(d₀ + D)`, `V_oc = σD/ε₀`. The gaps D come from the mechanical simulation.
 //!
-//! Loads ([`LoadKind`]): a resistor (`R dQ/dt = V`, the paper's), a full-wave diode bridge
+//! Loads ([`Load`]): a resistor (`R dQ/dt = V`, the paper's), a full-wave diode bridge
 //! charging a storage capacitor (optionally with a resistor across it; diodes of SPICE's
 //! level-1 law with series resistance, [`Diode`]), and the open- and short-circuit limits.
 //! The initial charge is the electrostatic equilibrium `Q(0) = C(0)·V_oc(0)` unless given.
@@ -36,25 +36,31 @@
 //!   [`GapWaveform`] (e.g. [`PwlGaps`]).
 //! - [`load_sweep`]: average power against load resistance on a recorded trajectory, with
 //!   the optimum refined.
-//! - [`spice`]: ngspice netlists of the same circuit for cross-checking.
+//! - `spice` (cargo feature `spice`, on by default): ngspice netlists of the same circuit for
+//!   cross-checking.
 
 pub mod breakdown;
 mod diode;
 mod params;
 mod radau;
 mod solver;
+#[cfg(feature = "spice")]
 pub mod spice;
 mod sweep;
+mod table;
 mod transducer;
 mod waveform;
 
 pub use diode::{BridgeCurrents, Diode};
-pub use params::{BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, LoadKind, TransducerMode, VocModel};
+pub use params::{
+    BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, Load, LoadKind, Rectifier, TransducerMode, VocModel,
+};
 pub use solver::{
     ChargeOptions, ChargeSolver, ElectricalSamples, PeriodStats, PowerSummary, SolverStats, power_curve,
     summarize,
 };
 pub use sweep::{LoadPoint, LoadSweep, load_sweep, log_spaced};
+pub use table::HarvesterTable;
 pub use transducer::{ContactSeparation, Freestanding, Transducer, TransducerState};
 pub use waveform::{GapWaveform, PwlGaps, PwlPiece};
 

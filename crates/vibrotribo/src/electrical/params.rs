@@ -58,20 +58,19 @@ impl VocModel {
     }
 }
 
-/// What the transducer's electrodes are connected to.
+/// Which kind of load the transducer's electrodes are connected to (the name of a [`Load`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum LoadKind {
-    /// A resistor of `load_resistance` (the paper's load).
+    /// A resistor (the paper's load).
     #[default]
     Resistor,
-    /// A full-wave bridge of four identical diodes charging a storage capacitor of
-    /// `storage_capacitance`, optionally with a resistor `storage_load_resistance` across it.
+    /// A full-wave diode bridge charging a storage capacitor.
     Rectifier,
-    /// Open circuit (R → ∞): the charge stays at its initial value.
+    /// Open circuit (R → ∞).
     Open,
-    /// Short circuit (R → 0): the charge follows `C·V_oc` exactly; nothing is dissipated.
+    /// Short circuit (R → 0).
     Short,
 }
 
@@ -87,19 +86,112 @@ impl LoadKind {
     }
 }
 
-/// Physical parameters of the triboelectric harvester: transducer and load (the `[harvester]`
-/// table of a configuration file; every field is a key of that table).
+/// What the transducer's electrodes are connected to, with the load's own parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Load {
+    /// A resistor (the paper's load): `R dQ/dt = V`.
+    Resistor {
+        /// Resistance R, Ω (`harvester.load_resistance`). Default 1e5 Ω.
+        resistance: f64,
+    },
+    /// A full-wave bridge of four identical diodes charging a storage capacitor.
+    Rectifier(Rectifier),
+    /// Open circuit (R → ∞): the charge stays at its initial value.
+    Open,
+    /// Short circuit (R → 0): the charge follows `C·V_oc` exactly; nothing is dissipated.
+    Short,
+}
+
+impl Default for Load {
+    /// The paper's 100 kΩ resistor.
+    fn default() -> Self {
+        Load::Resistor { resistance: 1e5 }
+    }
+}
+
+impl Load {
+    /// The kind of this load.
+    pub fn kind(&self) -> LoadKind {
+        match self {
+            Load::Resistor { .. } => LoadKind::Resistor,
+            Load::Rectifier(_) => LoadKind::Rectifier,
+            Load::Open => LoadKind::Open,
+            Load::Short => LoadKind::Short,
+        }
+    }
+
+    /// The resistance of a resistor load, Ω.
+    pub fn resistance(&self) -> Option<f64> {
+        match self {
+            Load::Resistor { resistance } => Some(*resistance),
+            _ => None,
+        }
+    }
+
+    /// The rectifier, if this is one.
+    pub fn rectifier(&self) -> Option<&Rectifier> {
+        match self {
+            Load::Rectifier(r) => Some(r),
+            _ => None,
+        }
+    }
+}
+
+/// A full-wave diode bridge into a storage capacitor (see [`diode`](super::Diode) for the
+/// diode law), optionally with a resistor across the capacitor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rectifier {
+    /// Storage capacitance, F (`harvester.storage_capacitance`). Default 1e-6 F.
+    pub storage_capacitance: f64,
+    /// Resistor across the storage capacitor, Ω (`harvester.storage_load_resistance`);
+    /// `None` (default) for none.
+    pub storage_load_resistance: Option<f64>,
+    /// Storage capacitor voltage at the start, V (`harvester.storage_initial_voltage`).
+    /// Default 0 V.
+    pub storage_initial_voltage: f64,
+    /// Storage voltage whose first crossing time is reported, V (`harvester.target_voltage`);
+    /// `None` (default) for none.
+    pub target_voltage: Option<f64>,
+    /// The bridge's diodes (`harvester.diode_*`). Default: a 1N4148 (I_s = 2.52 nA,
+    /// n = 1.752, R_s = 0.568 Ω) at 27 °C, no leakage.
+    pub diode: Diode,
+}
+
+impl Default for Rectifier {
+    fn default() -> Self {
+        Rectifier {
+            storage_capacitance: 1e-6,
+            storage_load_resistance: None,
+            storage_initial_voltage: 0.0,
+            target_voltage: None,
+            diode: Diode {
+                saturation_current: 2.52e-9,
+                ideality: 1.752,
+                thermal_voltage: BOLTZMANN_OVER_CHARGE * 300.15,
+                series_resistance: 0.568,
+                parallel_conductance: 0.0,
+            },
+        }
+    }
+}
+
+/// Physical parameters of the triboelectric harvester: transducer and load. In a
+/// configuration file this is the `[harvester]` table, where the load's parameters are keys
+/// of the table beside `load = "…"` (see [`HarvesterTable`](super::HarvesterTable)).
 ///
 /// [`Default`] is the paper's case (Sect. 3): freestanding mode with eq. 13, S = 0.01 m²,
 /// σ = 15 µC/m², d₁ = d₂ = 0.1 mm, ε_r = 2.0, R = 100 kΩ.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
+#[cfg_attr(
+    feature = "serde",
+    serde(try_from = "super::HarvesterTable", into = "super::HarvesterTable")
+)]
 pub struct HarvesterParams {
-    /// Transducer (`harvester.mode`): `"freestanding"` (default) or `"contact_separation"`.
+    /// Transducer (`harvester.mode`): freestanding (default) or contact-separation.
     pub mode: TransducerMode,
-    /// Open-circuit voltage law of the freestanding mode (`harvester.voc_model`): `"paper"`
-    /// (default, eq. 13) or `"exact"`. Ignored in contact-separation mode.
+    /// Open-circuit voltage law of the freestanding mode (`harvester.voc_model`): the
+    /// paper's eq. 13 (default) or Gauss's law. Ignored in contact-separation mode.
     pub voc_model: VocModel,
     /// First contact used (`harvester.contact`), 0-based (contact k is the gap between mass k
     /// and k+1). Contact-separation mode uses this contact; freestanding mode uses it as D₁
@@ -116,41 +208,12 @@ pub struct HarvesterParams {
     /// Relative permittivities ε_r1, ε_r2 of the films (`harvester.relative_permittivity`),
     /// dimensionless. Default [2.0, 2.0] (PTFE).
     pub relative_permittivity: [f64; 2],
-    /// Load (`harvester.load`): `"resistor"` (default), `"rectifier"`, `"open"`, `"short"`.
-    pub load: LoadKind,
-    /// Load resistance R of the resistor load, Ω (`harvester.load_resistance`).
-    /// Default 1e5 Ω.
-    pub load_resistance: f64,
-    /// Storage capacitance behind the rectifier, F (`harvester.storage_capacitance`).
-    /// Default 1e-6 F.
-    pub storage_capacitance: f64,
-    /// Resistor across the storage capacitor, Ω (`harvester.storage_load_resistance`);
-    /// absent (default) for none.
-    pub storage_load_resistance: Option<f64>,
-    /// Storage capacitor voltage at the start, V (`harvester.storage_initial_voltage`).
-    /// Default 0 V.
-    pub storage_initial_voltage: f64,
-    /// Storage voltage whose first crossing time is reported, V (`harvester.target_voltage`);
-    /// absent (default) for none.
-    pub target_voltage: Option<f64>,
+    /// The load and its parameters (`harvester.load` and the keys of that load). Default a
+    /// 100 kΩ resistor.
+    pub load: Load,
     /// Charge transferred between the electrodes at the start, C (`harvester.initial_charge`).
-    /// Absent (default): electrostatic equilibrium `Q(0) = C(0)·V_oc(0)`.
+    /// `None` (default): electrostatic equilibrium `Q(0) = C(0)·V_oc(0)`.
     pub initial_charge: Option<f64>,
-    /// Diode saturation current I_s, A (`harvester.diode_saturation_current`).
-    /// Default 2.52e-9 A (a 1N4148).
-    pub diode_saturation_current: f64,
-    /// Diode ideality (emission) factor n, dimensionless (`harvester.diode_ideality`).
-    /// Default 1.752.
-    pub diode_ideality: f64,
-    /// Diode series resistance R_s, Ω (`harvester.diode_series_resistance`). Must be positive.
-    /// Default 0.568 Ω.
-    pub diode_series_resistance: f64,
-    /// Thermal voltage V_T = kT/q, V (`harvester.diode_thermal_voltage`). Default
-    /// 0.025 864 V (T = 300.15 K, ngspice's default 27 °C).
-    pub diode_thermal_voltage: f64,
-    /// Leakage conductance across each diode, S (`harvester.diode_parallel_conductance`).
-    /// Default 0. (ngspice needs some, e.g. 1e-10 S, to solve the floating bridge robustly.)
-    pub diode_parallel_conductance: f64,
 }
 
 impl Default for HarvesterParams {
@@ -163,66 +226,41 @@ impl Default for HarvesterParams {
             charge_density: 15e-6,
             dielectric_thickness: [1e-4, 1e-4],
             relative_permittivity: [2.0, 2.0],
-            load: LoadKind::default(),
-            load_resistance: 1e5,
-            storage_capacitance: 1e-6,
-            storage_load_resistance: None,
-            storage_initial_voltage: 0.0,
-            target_voltage: None,
+            load: Load::default(),
             initial_charge: None,
-            diode_saturation_current: 2.52e-9,
-            diode_ideality: 1.752,
-            diode_series_resistance: 0.568,
-            diode_thermal_voltage: BOLTZMANN_OVER_CHARGE * 300.15,
-            diode_parallel_conductance: 0.0,
         }
     }
 }
 
 impl HarvesterParams {
-    /// Checks every parameter on its own; returns the first problem, naming its key
-    /// (`harvester.area`, `harvester.relative_permittivity[1]`, …).
+    /// Checks every parameter on its own; returns the first problem, naming the parameter by
+    /// its key in the `[harvester]` table (`area`, `relative_permittivity[1]`,
+    /// `load_resistance`, …; a configuration prefixes `harvester.`).
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_positive("harvester.area", self.area)?;
-        check_finite("harvester.charge_density", self.charge_density)?;
+        check_positive("area", self.area)?;
+        check_finite("charge_density", self.charge_density)?;
         for (i, &d) in self.dielectric_thickness.iter().enumerate() {
-            check_non_negative(&format!("harvester.dielectric_thickness[{i}]"), d)?;
+            check_non_negative(&format!("dielectric_thickness[{i}]"), d)?;
         }
         for (i, &e) in self.relative_permittivity.iter().enumerate() {
-            check_positive(&format!("harvester.relative_permittivity[{i}]"), e)?;
+            check_positive(&format!("relative_permittivity[{i}]"), e)?;
         }
         if self.effective_thickness() <= 0.0 {
             return Err(ParamError::invalid(
-                "harvester.dielectric_thickness",
+                "dielectric_thickness",
                 0.0,
                 "at least one film must have positive thickness (the capacitance at contact \
                  would be infinite)",
             ));
         }
-        check_positive("harvester.load_resistance", self.load_resistance)?;
-        check_positive("harvester.storage_capacitance", self.storage_capacitance)?;
-        if let Some(r) = self.storage_load_resistance {
-            check_positive("harvester.storage_load_resistance", r)?;
-        }
-        check_finite("harvester.storage_initial_voltage", self.storage_initial_voltage)?;
-        if let Some(v) = self.target_voltage {
-            check_finite("harvester.target_voltage", v)?;
-        }
         if let Some(q) = self.initial_charge {
-            check_finite("harvester.initial_charge", q)?;
+            check_finite("initial_charge", q)?;
         }
-        check_positive(
-            "harvester.diode_saturation_current",
-            self.diode_saturation_current,
-        )?;
-        check_positive("harvester.diode_ideality", self.diode_ideality)?;
-        check_positive("harvester.diode_series_resistance", self.diode_series_resistance)?;
-        check_positive("harvester.diode_thermal_voltage", self.diode_thermal_voltage)?;
-        check_non_negative(
-            "harvester.diode_parallel_conductance",
-            self.diode_parallel_conductance,
-        )?;
-        Ok(())
+        match &self.load {
+            Load::Resistor { resistance } => check_positive("load_resistance", *resistance),
+            Load::Rectifier(r) => r.validate(),
+            Load::Open | Load::Short => Ok(()),
+        }
     }
 
     /// [`validate`](Self::validate), then checks that the transducer's contacts exist in a
@@ -232,15 +270,18 @@ impl HarvesterParams {
         match self.mode {
             TransducerMode::Freestanding => {
                 if gaps < 2 {
-                    return Err(ParamError::Conflict(format!(
-                        "harvester.mode = \"freestanding\" needs two gaps (at least 3 masses), but the \
-                         chain has {} masses; use harvester.mode = \"contact_separation\"",
-                        gaps + 1
-                    )));
+                    return Err(ParamError::Conflict {
+                        name: "mode".into(),
+                        message: format!(
+                            "\"freestanding\" needs two gaps (at least 3 masses), but the chain has {} \
+                             masses; use \"contact_separation\"",
+                            gaps + 1
+                        ),
+                    });
                 }
                 if self.contact + 1 >= gaps {
                     return Err(ParamError::invalid(
-                        "harvester.contact",
+                        "contact",
                         self.contact as f64,
                         "freestanding mode uses contacts `contact` and `contact + 1`, which must \
                          both exist in the chain",
@@ -250,7 +291,7 @@ impl HarvesterParams {
             TransducerMode::ContactSeparation => {
                 if self.contact >= gaps {
                     return Err(ParamError::invalid(
-                        "harvester.contact",
+                        "contact",
                         self.contact as f64,
                         "no such contact in the chain (0-based, at most N − 2)",
                     ));
@@ -287,15 +328,24 @@ impl HarvesterParams {
             }),
         }
     }
+}
 
-    /// The bridge diodes these parameters describe.
-    pub fn diode(&self) -> Diode {
-        Diode {
-            saturation_current: self.diode_saturation_current,
-            ideality: self.diode_ideality,
-            thermal_voltage: self.diode_thermal_voltage,
-            series_resistance: self.diode_series_resistance,
-            parallel_conductance: self.diode_parallel_conductance,
+impl Rectifier {
+    /// Checks the rectifier's parameters, naming them by their `[harvester]` keys.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check_positive("storage_capacitance", self.storage_capacitance)?;
+        if let Some(r) = self.storage_load_resistance {
+            check_positive("storage_load_resistance", r)?;
         }
+        check_finite("storage_initial_voltage", self.storage_initial_voltage)?;
+        if let Some(v) = self.target_voltage {
+            check_finite("target_voltage", v)?;
+        }
+        let d = &self.diode;
+        check_positive("diode_saturation_current", d.saturation_current)?;
+        check_positive("diode_ideality", d.ideality)?;
+        check_positive("diode_series_resistance", d.series_resistance)?;
+        check_positive("diode_thermal_voltage", d.thermal_voltage)?;
+        check_non_negative("diode_parallel_conductance", d.parallel_conductance)
     }
 }

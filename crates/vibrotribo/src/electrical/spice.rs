@@ -33,7 +33,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use super::params::{BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, LoadKind, VocModel};
+use super::params::{BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, Load, LoadKind, VocModel};
 use super::transducer::{ChargeMap, Transducer};
 use super::waveform::PwlGaps;
 use crate::error::ParamError;
@@ -199,11 +199,14 @@ pub fn netlist(
     data_file: &str,
 ) -> Result<String, ParamError> {
     params.validate_for_gaps(pwl.gap_count())?;
-    if params.load == LoadKind::Open || params.load == LoadKind::Short {
-        return Err(ParamError::Conflict(format!(
-            "harvester.load = \"{}\" has no circuit to simulate in ngspice",
-            params.load.as_str()
-        )));
+    if matches!(params.load, Load::Open | Load::Short) {
+        return Err(ParamError::Conflict {
+            name: "load".into(),
+            message: format!(
+                "\"{}\" has no circuit to simulate in ngspice",
+                params.load.kind().as_str()
+            ),
+        });
     }
     let t0 = pwl.times()[0];
     if !t_end.is_finite() || t_end <= t0 {
@@ -222,7 +225,7 @@ pub fn netlist(
         w,
         "* vibrotribo triboelectric harvester: {} mode, {} load",
         params.mode.as_str(),
-        params.load.as_str()
+        params.load.kind().as_str()
     );
     let _ = writeln!(
         w,
@@ -270,22 +273,23 @@ pub fn netlist(
     let _ = writeln!(w, "Ce e 0 1");
     let mut ic = format!(".ic v(q)={} v(e)=0", num(q0 * CHARGE_SCALE));
     let mut probes = String::from("v(q) v(e) v(a,c)");
-    match params.load {
-        LoadKind::Resistor => {
-            let _ = writeln!(w, "Rload a1 c {}", num(params.load_resistance));
+    match &params.load {
+        Load::Resistor { resistance } => {
+            let _ = writeln!(w, "Rload a1 c {}", num(*resistance));
             let _ = writeln!(w, "Vgnd c 0 0");
             let _ = writeln!(w, "Be 0 e I = {{ (V(a1,c)*i(Vsense))*{} }}", num(ENERGY_SCALE));
         }
-        LoadKind::Rectifier => {
-            let vt = params.diode_thermal_voltage;
+        Load::Rectifier(rect) => {
+            let d = &rect.diode;
+            let vt = d.thermal_voltage;
             let celsius = vt / BOLTZMANN_OVER_CHARGE - 273.15;
             let _ = writeln!(w, "* full-wave bridge into the storage capacitor");
             let _ = writeln!(w, "D1 a1 p dbridge");
             let _ = writeln!(w, "D2 c p dbridge");
             let _ = writeln!(w, "D3 0 a1 dbridge");
             let _ = writeln!(w, "D4 0 c dbridge");
-            if params.diode_parallel_conductance > 0.0 {
-                let r = num(1.0 / params.diode_parallel_conductance);
+            if d.parallel_conductance > 0.0 {
+                let r = num(1.0 / d.parallel_conductance);
                 let _ = writeln!(w, "* leakage across each diode");
                 for (k, (p, n)) in [("a1", "p"), ("c", "p"), ("0", "a1"), ("0", "c")]
                     .iter()
@@ -295,29 +299,29 @@ pub fn netlist(
                 }
             }
             let _ = writeln!(w, "Vout p s 0");
-            let _ = writeln!(w, "Cs s 0 {}", num(params.storage_capacitance));
-            if let Some(r) = params.storage_load_resistance {
+            let _ = writeln!(w, "Cs s 0 {}", num(rect.storage_capacitance));
+            if let Some(r) = rect.storage_load_resistance {
                 let _ = writeln!(w, "Rs s 0 {}", num(r));
             }
             let _ = writeln!(
                 w,
                 ".model dbridge D(IS={} N={} RS={})",
-                num(params.diode_saturation_current),
-                num(params.diode_ideality),
-                num(params.diode_series_resistance)
+                num(d.saturation_current),
+                num(d.ideality),
+                num(d.series_resistance)
             );
             let _ = writeln!(w, ".options temp={} tnom={}", num(celsius), num(celsius));
             let _ = writeln!(w, "Be 0 e I = {{ (V(s)*i(Vout))*{} }}", num(ENERGY_SCALE));
-            let vs0 = num(params.storage_initial_voltage);
+            let vs0 = num(rect.storage_initial_voltage);
             let _ = write!(ic, " v(s)={vs0} v(p)={vs0}");
             probes.push_str(" v(s)");
         }
-        LoadKind::Open | LoadKind::Short => unreachable!("rejected above"),
+        Load::Open | Load::Short => unreachable!("rejected above"),
     }
     let _ = writeln!(w, "{ic}");
     let mut opts = format!(
         ".options reltol={} trtol={}",
-        num(options.reltol_for(params.load)),
+        num(options.reltol_for(params.load.kind())),
         num(options.trtol)
     );
     if let Some(a) = options.abstol {
@@ -437,7 +441,11 @@ fn run_in(
             l.contains("error") || l.contains("too small") || l.contains("aborted")
         })
         .collect();
-    let hint = if params.load == LoadKind::Rectifier && params.diode_parallel_conductance == 0.0 {
+    let hint = if params
+        .load
+        .rectifier()
+        .is_some_and(|r| r.diode.parallel_conductance == 0.0)
+    {
         " (with the rectifier, give ngspice a path at the floating bridge: set \
          harvester.diode_parallel_conductance, e.g. 1e-10 S)"
     } else {
@@ -470,7 +478,7 @@ fn run_in(
         charge_c: scale(col("v(q)")?, CHARGE_SCALE),
         energy_j: scale(col("v(e)")?, ENERGY_SCALE),
         voltage_v: col("v(a,c)")?,
-        storage_voltage_v: if params.load == LoadKind::Rectifier {
+        storage_voltage_v: if params.load.kind() == LoadKind::Rectifier {
             col("v(s)")?
         } else {
             Vec::new()

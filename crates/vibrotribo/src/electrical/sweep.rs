@@ -2,7 +2,7 @@
 //! is one-way, so the mechanics is simulated once and replayed for every load).
 
 use super::ElectricalError;
-use super::params::{HarvesterParams, LoadKind};
+use super::params::{HarvesterParams, Load};
 use super::solver::{ChargeOptions, ChargeSolver};
 use crate::dynamics::Trajectory;
 use crate::error::ParamError;
@@ -84,8 +84,7 @@ pub fn load_sweep(
     let gaps = trajectory.gap_count();
     let evaluate = |r: f64| -> Result<LoadPoint, ElectricalError> {
         let mut p = params.clone();
-        p.load = LoadKind::Resistor;
-        p.load_resistance = r;
+        p.load = Load::Resistor { resistance: r };
         let mut solver = ChargeSolver::new(&p, period, gaps, options.clone())?;
         solver.run_trajectory(trajectory)?;
         let s = solver.summary(transient).ok_or_else(|| ParamError::Invalid {

@@ -119,7 +119,7 @@ impl Transducer {
     }
 
     /// Full state from the chain's gaps (m) and their rates (m/s), indexed by contact (the
-    /// charge solver's own evaluation, [`ChargeMap`]).
+    /// charge solver's own evaluation, `ChargeMap`).
     pub fn state(&self, gaps: &[f64], rates: &[f64]) -> TransducerState {
         ChargeMap::new(self).state_with_rates(gaps, rates)
     }

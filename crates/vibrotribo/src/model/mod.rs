@@ -127,36 +127,31 @@ impl ChainParams {
         self.masses.is_empty()
     }
 
-    /// Checks every parameter; returns the first problem found, naming the parameter with the
-    /// configuration key it comes from (`oscillator.masses[1]`, `excitation.amplitude`, …).
+    /// Checks every parameter; returns the first problem found, naming the parameter by its
+    /// field (`masses[1]`, `excitation.amplitude`, `excitation.omega_ratio`, …).
     pub fn validate(&self) -> Result<(), ParamError> {
         let n = self.masses.len();
         if n < 2 {
             return Err(ParamError::TooFewMasses(n));
         }
-        check_len("oscillator.stiffness", &self.stiffness, n)?;
-        check_len("oscillator.damping", &self.damping, n)?;
-        check_len("oscillator.gaps", &self.gaps, n - 1)?;
+        check_len("stiffness", &self.stiffness, n)?;
+        check_len("damping", &self.damping, n)?;
+        check_len("gaps", &self.gaps, n - 1)?;
         for (i, &m) in self.masses.iter().enumerate() {
-            check_positive(&format!("oscillator.masses[{i}]"), m)?;
+            check_positive(&format!("masses[{i}]"), m)?;
         }
         for (i, &k) in self.stiffness.iter().enumerate() {
-            check_positive(&format!("oscillator.stiffness[{i}]"), k)?;
+            check_positive(&format!("stiffness[{i}]"), k)?;
         }
         for (i, &c) in self.damping.iter().enumerate() {
-            check_non_negative(&format!("oscillator.damping[{i}]"), c)?;
+            check_non_negative(&format!("damping[{i}]"), c)?;
         }
         for (i, &d) in self.gaps.iter().enumerate() {
-            check_non_negative(&format!("oscillator.gaps[{i}]"), d)?;
+            check_non_negative(&format!("gaps[{i}]"), d)?;
         }
         let mu = self.restitution;
-        check_finite("oscillator.restitution", mu)?;
-        check(
-            "oscillator.restitution",
-            mu,
-            (0.0..=1.0).contains(&mu),
-            "must lie in [0, 1]",
-        )?;
+        check_finite("restitution", mu)?;
+        check("restitution", mu, (0.0..=1.0).contains(&mu), "must lie in [0, 1]")?;
         check_non_negative("excitation.amplitude", self.excitation.amplitude)?;
         match self.excitation.frequency {
             Frequency::OmegaRatio(w) => check_positive("excitation.omega_ratio", w)?,
@@ -214,13 +209,13 @@ impl ChainParams {
     /// Checks an initial state against the chain: lengths, finiteness, no interpenetration.
     pub fn validate_state(&self, state: &ChainState) -> Result<(), ParamError> {
         let n = self.len();
-        check_len("run.initial_positions", &state.positions, n)?;
-        check_len("run.initial_velocities", &state.velocities, n)?;
+        check_len("positions", &state.positions, n)?;
+        check_len("velocities", &state.velocities, n)?;
         for (i, &x) in state.positions.iter().enumerate() {
-            check_finite(&format!("run.initial_positions[{i}]"), x)?;
+            check_finite(&format!("positions[{i}]"), x)?;
         }
         for (i, &v) in state.velocities.iter().enumerate() {
-            check_finite(&format!("run.initial_velocities[{i}]"), v)?;
+            check_finite(&format!("velocities[{i}]"), v)?;
         }
         for k in 0..n - 1 {
             let gap = self.gaps[k] - (state.positions[k + 1] - state.positions[k]);
@@ -276,9 +271,11 @@ impl ChainState {
     }
 }
 
-/// Numerical settings of the event-driven simulator.
+/// Numerical settings of the event-driven simulator (the `[options]` table of a
+/// configuration).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct SimOptions {
     /// Guard against pathological motion: at most this many events (impacts, sticks,
     /// releases) within one excitation period before the run stops with
@@ -309,20 +306,20 @@ impl SimOptions {
     /// Checks the options.
     pub fn validate(&self) -> Result<(), ParamError> {
         check(
-            "options.max_events_per_period",
+            "max_events_per_period",
             self.max_events_per_period as f64,
             self.max_events_per_period > 0,
             "must be positive",
         )?;
-        check_positive("options.chatter_tolerance", self.chatter_tolerance)?;
+        check_positive("chatter_tolerance", self.chatter_tolerance)?;
         check(
-            "options.chatter_tolerance",
+            "chatter_tolerance",
             self.chatter_tolerance,
             self.chatter_tolerance < 1e-2,
             "must be below 1e-2",
         )?;
         check(
-            "options.max_impact_iterations",
+            "max_impact_iterations",
             self.max_impact_iterations as f64,
             self.max_impact_iterations > 0,
             "must be positive",

@@ -9,12 +9,16 @@
 //! whether chatter, sticking or grazing occurred, the average power of a harvester if one is
 //! given, and the final state (for continuation to the next parameter value).
 
-use super::{PeriodOptions, Periodicity, RunStats, StroboscopicOptions, StroboscopicSection, detect_period};
-use crate::dynamics::{Event, EventKind, Flow, Observer, Simulator, StateView};
-use crate::electrical::{ChargeOptions, ChargeSolver, HarvesterParams};
+use thiserror::Error;
+
+use super::observer::{Mechanics, RunObserver};
+use super::settings::{ElectricalFailure, Harvester, RunSpec};
+use super::simulate::{Ending, StudyError, simulate};
+use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, StroboscopicSection, detect_period};
+use crate::dynamics::{Event, EventKind, Observer, StateView};
+use crate::electrical::{ChargeOptions, HarvesterParams};
 use crate::error::SimError;
 use crate::model::{ChainParams, ChainState, SimOptions};
-use thiserror::Error;
 
 /// Settings of [`run_point`].
 #[derive(Debug, Clone, PartialEq)]
@@ -132,6 +136,9 @@ pub enum PointError {
     /// The mechanics stopped.
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// The run could not be set up (or failed otherwise).
+    #[error(transparent)]
+    Study(#[from] StudyError),
 }
 
 /// Records impacts after the transient and flags grazing.
@@ -171,24 +178,17 @@ impl Observer for Impacts {
     }
 }
 
-/// Passes flows to the charge solver from a start time on.
-struct FromTime<O> {
-    from: f64,
-    inner: O,
-}
-
-impl<O: Observer> Observer for FromTime<O> {
-    fn flow(&mut self, flow: &Flow<'_>) {
-        if flow.t_start >= self.from {
-            self.inner.flow(flow);
-        }
+impl RunObserver for Impacts {
+    fn event(&mut self, event: &Event, state: &StateView<'_>) {
+        Observer::event(self, event, state);
     }
 }
 
 /// Runs one sweep point: `params` from `initial` for `transient + recorded` periods (see the
 /// module docs). With `harvester`, the charge solver starts
 /// [`electrical_warmup_periods`](PointOptions::electrical_warmup_periods) before the recorded
-/// window and the average power over the recorded periods is reported.
+/// window and the average power over the recorded periods is reported; a failure of the
+/// charge solver is reported beside the motion, which goes on.
 pub fn run_point(
     params: &ChainParams,
     initial: &ChainState,
@@ -200,8 +200,23 @@ pub fn run_point(
     let period = params.period();
     let transient = options.transient_periods;
     let total = transient + options.recorded_periods;
-    let mut sim = Simulator::new(params, initial, sim_options.clone())?;
-    let mut strobe = StroboscopicSection::new(
+    let warmup = options.electrical_warmup_periods.min(transient);
+    let spec = RunSpec {
+        chain: params.clone(),
+        initial: initial.clone(),
+        options: sim_options.clone(),
+        harvester: harvester.map(|(h, o)| Harvester {
+            params: h.clone(),
+            options: o.clone(),
+            start_period: transient - warmup,
+            on_failure: ElectricalFailure::KeepMechanics,
+        }),
+        periods: total,
+        transient_periods: transient,
+        sampling: None,
+        breakdown_check: false,
+    };
+    let strobe = StroboscopicSection::new(
         n,
         period,
         StroboscopicOptions {
@@ -210,30 +225,27 @@ pub fn run_point(
         },
     )
     .expect("valid stroboscopic options");
-    let mut stats = RunStats::new(n - 1, period, transient);
-    let mut impacts = Impacts {
-        after: transient as f64 * period,
-        grazing_speed: options.grazing_ratio * params.excitation.amplitude * params.omega(),
-        last_rebound: vec![0.0; n - 1],
-        records: Vec::new(),
-        grazing: false,
-    };
-    let warmup = options.electrical_warmup_periods.min(transient);
-    let mut solver = match harvester {
-        Some((h, o)) => Some(FromTime {
-            from: (transient - warmup) as f64 * period,
-            inner: ChargeSolver::for_chain(h, params, o.clone()).map_err(|e| PointError::Sim(e.into()))?,
-        }),
-        None => None,
-    };
-    sim.run_until(
-        total as f64 * period,
-        &mut (&mut strobe, &mut stats, &mut impacts, &mut solver),
-    )?;
-    let (average_power_w, electrical_error) = match &solver {
-        Some(s) => match s.inner.status() {
-            Ok(()) => (s.inner.summary(warmup as usize).map(|s| s.average_power_w), None),
-            Err(e) => (None, Some(e.to_string())),
+    let mut watch = (
+        Mechanics::new(strobe),
+        Impacts {
+            after: transient as f64 * period,
+            grazing_speed: options.grazing_ratio * params.excitation.amplitude * params.omega(),
+            last_rebound: vec![0.0; n - 1],
+            records: Vec::new(),
+            grazing: false,
+        },
+    );
+    let outcome = simulate(&spec, &mut watch)?;
+    match outcome.ending {
+        Ending::Failed(StudyError::Sim(e)) => return Err(e.into()),
+        Ending::Failed(e) => return Err(PointError::Study(e)),
+        Ending::Completed | Ending::Stopped => {}
+    }
+    let (strobe, impacts) = (watch.0.inner, watch.1);
+    let (average_power_w, electrical_error) = match &outcome.electrical {
+        Some(e) => match &e.power {
+            Some(p) if e.solver_error.is_none() => (Some(p.average_power_w), None),
+            _ => (None, e.solver_error.as_ref().map(ToString::to_string)),
         },
         None => (None, None),
     };
@@ -243,6 +255,7 @@ pub fn run_point(
     } else {
         None
     };
+    let stats = &outcome.stats;
     Ok(PointResult {
         strobe_periods: strobe.indices,
         strobe: strobe.positions,
@@ -254,14 +267,14 @@ pub fn run_point(
         grazing: impacts.grazing,
         average_power_w,
         electrical_error,
-        final_state: sim.state(),
+        final_state: outcome.final_state,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Trajectory;
+    use crate::{Simulator, Trajectory};
 
     /// Each mass's stroboscopic series is its position at t = nT, n = strobe_periods, read
     /// from a separately recorded trajectory of the same run.

@@ -1,0 +1,487 @@
+//! Rendering: the font, the PNG and SVG backends, axis ranges and ticks, and x–y charts
+//! (lines, rasterised points, clipping).
+
+use super::figure::{FAMILY, Figure, Format, HeatMap, Legend, Scale, Series, ensure_font};
+use super::heat::draw_heat_map;
+use anyhow::{Context, Result, anyhow, ensure};
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+use std::ops::Range;
+use std::path::Path;
+
+/// What an x–y chart draws: lines, then points on top.
+pub(super) struct Layers<'s, 'a> {
+    pub(super) lines: &'s [Series<'a>],
+    pub(super) points: &'s [Series<'a>],
+    pub(super) marker_px: u32,
+}
+
+impl Layers<'_, '_> {
+    fn all(&self) -> impl Iterator<Item = &Series<'_>> {
+        self.lines.iter().chain(self.points)
+    }
+}
+
+/// Line colours: the Tableau 10 palette, distinguishable and colour-blind aware.
+pub(super) const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+pub(super) const TITLE_PX: u32 = 28;
+pub(super) const LABEL_PX: u32 = 22;
+pub(super) const TICK_PX: u32 = 17;
+
+pub(super) fn font(px: u32) -> TextStyle<'static> {
+    (FAMILY, px).into_font().color(&BLACK)
+}
+
+/// Something that can draw itself on any plotters backend.
+pub(super) trait Render {
+    /// Draws on `root`, a backend of `format`.
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, format: Format) -> Result<()>;
+}
+
+/// An x–y chart, checked, with its axis ranges (see [`xy_chart`]).
+pub(super) struct XyChart<'f, 's, 'a> {
+    pub(super) figure: &'f Figure,
+    pub(super) layers: Layers<'s, 'a>,
+    pub(super) x: Range<f64>,
+    pub(super) y: Range<f64>,
+}
+
+impl Render for XyChart<'_, '_, '_> {
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, format: Format) -> Result<()> {
+        draw_xy(root, self, format)
+    }
+}
+
+/// A heat map with its colour range.
+pub(super) struct HeatChart<'f, 'm, 'a> {
+    pub(super) figure: &'f Figure,
+    pub(super) map: &'m HeatMap<'a>,
+    pub(super) range: (f64, f64),
+}
+
+impl Render for HeatChart<'_, '_, '_> {
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, _format: Format) -> Result<()> {
+        draw_heat_map(root, self.figure, self.map, self.range)
+    }
+}
+
+/// Renders `chart` with the backend that `path`'s extension asks for and writes the file.
+pub(super) fn write(path: &Path, size: (u32, u32), chart: &impl Render) -> Result<()> {
+    ensure_font()?;
+    let (w, h) = size;
+    ensure!(
+        w >= 200 && h >= 150,
+        "plot size {w} × {h} px is too small (minimum 200 × 150)"
+    );
+    let context = || format!("cannot write plot {}", path.display());
+    let format = Format::from_path(path)?;
+    match format {
+        Format::Png => {
+            let root = BitMapBackend::new(path, size).into_drawing_area();
+            chart.render(&root, format).with_context(context)?;
+            root.present().map_err(err).with_context(context)?;
+        }
+        Format::Svg => {
+            let root = SVGBackend::new(path, size).into_drawing_area();
+            chart.render(&root, format).with_context(context)?;
+            root.present().map_err(err).with_context(context)?;
+        }
+    }
+    Ok(())
+}
+
+/// Maps a plotters error (whose backend error need not be `Send`) to `anyhow`.
+pub(super) fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("plotting failed: {e}")
+}
+
+/// Smallest and largest finite value, if any.
+pub(super) fn finite_bounds(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    values.filter(|v| v.is_finite()).fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+    })
+}
+
+/// Gives an empty range some width.
+pub(super) fn widen(lo: f64, hi: f64) -> (f64, f64) {
+    if hi > lo {
+        (lo, hi)
+    } else {
+        let d = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
+        (lo - d, hi + d)
+    }
+}
+
+/// The axis range: as given, or the data's range with 3 % margins (on a log axis, a factor
+/// margin over the positive values).
+pub(super) fn axis_range(
+    given: Option<(f64, f64)>,
+    data: impl Iterator<Item = f64>,
+    scale: Scale,
+    axis: &str,
+) -> Result<Range<f64>> {
+    if let Some((a, b)) = given {
+        ensure!(
+            a.is_finite() && b.is_finite() && a < b,
+            "{axis} range must be finite and increasing, got {a} to {b}"
+        );
+        ensure!(
+            scale == Scale::Linear || a > 0.0,
+            "{axis} range of a log axis must be positive, got {a} to {b}"
+        );
+        return Ok(a..b);
+    }
+    match scale {
+        Scale::Linear => {
+            let (lo, hi) =
+                finite_bounds(data).ok_or_else(|| anyhow!("no finite data to plot on the {axis} axis"))?;
+            let (lo, hi) = widen(lo, hi);
+            let m = 0.03 * (hi - lo);
+            Ok(lo - m..hi + m)
+        }
+        Scale::Log => {
+            let (lo, hi) = finite_bounds(data.filter(|v| *v > 0.0))
+                .ok_or_else(|| anyhow!("no positive data to plot on the logarithmic {axis} axis"))?;
+            let (lo, hi) = if hi > lo { (lo, hi) } else { (lo / 2.0, hi * 2.0) };
+            let m = (hi / lo).powf(0.03);
+            Ok(lo / m..hi * m)
+        }
+    }
+}
+
+/// Fills `root` white and sets the title in a band at its top; returns the area below.
+pub(super) fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> Result<DrawingArea<DB, Shift>> {
+    root.fill(&WHITE).map_err(err)?;
+    root.margin(10, 0, 0, 0)
+        .titled(title, font(TITLE_PX))
+        .map_err(err)
+}
+
+/// Compact tick label: plain decimals for moderate magnitudes, else scientific notation.
+pub(super) fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".to_string()
+    } else if (1e-3..1e5).contains(&a) {
+        let s = format!("{v:.6}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" { "0".to_string() } else { s.to_string() }
+    } else {
+        let s = format!("{v:.3e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        format!("{mantissa}e{exponent}")
+    }
+}
+
+pub(super) fn check_series(s: &Series<'_>, index: usize) -> Result<()> {
+    ensure!(
+        s.x.len() == s.y.len(),
+        "series {} ({}) has {} x values but {} y values",
+        index + 1,
+        s.label.unwrap_or("unlabelled"),
+        s.x.len(),
+        s.y.len()
+    );
+    Ok(())
+}
+
+/// Checks the series and works out the axis ranges, before any file is created.
+pub(super) fn xy_chart<'f, 's, 'a>(
+    figure: &'f Figure,
+    layers: Layers<'s, 'a>,
+) -> Result<XyChart<'f, 's, 'a>> {
+    ensure!(layers.all().next().is_some(), "nothing to plot: no series given");
+    for (i, s) in layers.all().enumerate() {
+        check_series(s, i)?;
+    }
+    let x = axis_range(
+        figure.x_range,
+        layers.all().flat_map(|s| s.x.iter().copied()),
+        Scale::Linear,
+        "x",
+    )?;
+    let y_data = layers.all().flat_map(|s| {
+        s.x.iter()
+            .zip(s.y)
+            .filter(|(x, _)| x.is_finite())
+            .map(|(_, y)| *y)
+    });
+    let y = axis_range(figure.y_range, y_data, figure.y_scale, "y")?;
+    Ok(XyChart { figure, layers, x, y })
+}
+
+pub(super) fn draw_xy<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &XyChart<'_, '_, '_>,
+    format: Format,
+) -> Result<()> {
+    let area = titled(root, &chart.figure.title)?;
+    let (x, y) = (chart.x.clone(), chart.y.clone());
+    let y_span = y.end - y.start;
+    match chart.figure.y_scale {
+        Scale::Linear => draw_xy_on(
+            root,
+            &area,
+            chart.figure,
+            &chart.layers,
+            format,
+            x,
+            y,
+            Some(y_span),
+        ),
+        Scale::Log => draw_xy_on(
+            root,
+            &area,
+            chart.figure,
+            &chart.layers,
+            format,
+            x,
+            y.log_scale(),
+            None,
+        ),
+    }
+}
+
+/// Builds the chart on `area` with y coordinate `y` and draws mesh, lines, points, legend.
+/// `y_span` is the extent of a linear y axis (for tick labels), `None` for a log axis.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn draw_xy_on<DB, Y>(
+    root: &DrawingArea<DB, Shift>,
+    area: &DrawingArea<DB, Shift>,
+    figure: &Figure,
+    layers: &Layers<'_, '_>,
+    format: Format,
+    x: Range<f64>,
+    y: Y,
+    y_span: Option<f64>,
+) -> Result<()>
+where
+    DB: DrawingBackend,
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    // Ticks of a linear axis that are rounding away from 0 (e.g. −5.6e-17) read as 0.
+    let x_span = x.end - x.start;
+    let snap = |v: f64, span: Option<f64>| match span {
+        Some(span) if v.abs() < 1e-9 * span.abs() => 0.0,
+        _ => v,
+    };
+    let fx = move |v: &f64| tick_label(snap(*v, Some(x_span)));
+    let fy = move |v: &f64| tick_label(snap(*v, y_span));
+    let mut chart = ChartBuilder::on(area)
+        .margin(16)
+        .margin_right(28)
+        .x_label_area_size(60)
+        .y_label_area_size(90)
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(&figure.x_label)
+        .y_desc(&figure.y_label)
+        .axis_desc_style(font(LABEL_PX))
+        .label_style(font(TICK_PX))
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(210, 210, 210))
+        .draw()
+        .map_err(err)?;
+
+    // The plotting area in pixels: drawing there clips to the axes.
+    let plot = chart.plotting_area().strip_coord_spec();
+    let log_y = figure.y_scale == Scale::Log;
+    let usable = |x: f64, y: f64| x.is_finite() && y.is_finite() && (!log_y || y > 0.0);
+    for (i, s) in layers.lines.iter().enumerate() {
+        let colour = PALETTE[i % PALETTE.len()];
+        // One polyline per run of usable points, in pixels of the plotting area, thinned
+        // to points at least 2 px apart (the last point of a run is always kept): dense
+        // series draw as clean lines and stay small in SVG, at a visual error under 2 px.
+        let base = plot.get_base_pixel();
+        let mut runs: Vec<Vec<(i32, i32)>> = vec![Vec::new()];
+        let mut pending: Option<(i32, i32)> = None;
+        for (&px, &py) in s.x.iter().zip(s.y) {
+            let run = runs.last_mut().expect("runs is never empty");
+            if !usable(px, py) {
+                run.extend(pending.take());
+                if !run.is_empty() {
+                    runs.push(Vec::new());
+                }
+                continue;
+            }
+            let (bx, by) = chart.backend_coord(&(px, py));
+            let here = (bx - base.0, by - base.1);
+            match run.last() {
+                Some(&(lx, ly)) if (here.0 - lx).abs() + (here.1 - ly).abs() < 2 => pending = Some(here),
+                _ => {
+                    run.push(here);
+                    pending = None;
+                }
+            }
+        }
+        runs.last_mut().expect("runs is never empty").extend(pending);
+        let (w, h) = plot.dim_in_pixel();
+        for run in runs.iter().flat_map(|r| clip_polyline(r, w as i32, h as i32)) {
+            match format {
+                Format::Svg => plot
+                    .draw(&PathElement::new(run, colour.stroke_width(2)))
+                    .map_err(err)?,
+                // plotters' bitmap lines wider than 1 px come out hollow on steep segments:
+                // draw the 1-px line three times, offset by a pixel right and down.
+                Format::Png => {
+                    for (ox, oy) in [(0, 0), (1, 0), (0, 1)] {
+                        let shifted: Vec<(i32, i32)> = run.iter().map(|&(x, y)| (x + ox, y + oy)).collect();
+                        plot.draw(&PathElement::new(shifted, colour.stroke_width(1)))
+                            .map_err(err)?;
+                    }
+                }
+            }
+        }
+        if let Some(label) = s.label {
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(err)?
+                .label(label)
+                .legend(move |(lx, ly)| {
+                    PathElement::new(vec![(lx, ly), (lx + 24, ly)], colour.stroke_width(3))
+                });
+        }
+    }
+
+    // Points: rasterise to the plotting area's pixels, then mark each occupied pixel once.
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let (width, height) = (
+        (xs.end - xs.start).max(0) as usize,
+        (ys.end - ys.start).max(0) as usize,
+    );
+    let mut occupied = vec![false; width * height];
+    let half = (layers.marker_px.max(1) as i32 - 1) / 2;
+    for (i, s) in layers.points.iter().enumerate() {
+        let colour = if layers.lines.is_empty() {
+            PALETTE[i % PALETTE.len()]
+        } else {
+            BLACK
+        };
+        occupied.iter_mut().for_each(|o| *o = false);
+        for (&px, &py) in s.x.iter().zip(s.y) {
+            if !usable(px, py) {
+                continue;
+            }
+            let (bx, by) = chart.backend_coord(&(px, py));
+            if !xs.contains(&bx) || !ys.contains(&by) {
+                continue;
+            }
+            let cell = (by - ys.start) as usize * width + (bx - xs.start) as usize;
+            if occupied[cell] {
+                continue;
+            }
+            occupied[cell] = true;
+            if half == 0 {
+                root.draw_pixel((bx, by), &colour).map_err(err)?;
+            } else {
+                root.draw(&Rectangle::new(
+                    [(bx - half, by - half), (bx + half, by + half)],
+                    colour.filled(),
+                ))
+                .map_err(err)?;
+            }
+        }
+        if let Some(label) = s.label {
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(err)?
+                .label(label)
+                .legend(move |(lx, ly)| {
+                    Rectangle::new([(lx + 6, ly - 5), (lx + 16, ly + 5)], colour.filled())
+                });
+        }
+    }
+
+    let position = match figure.legend {
+        Legend::UpperRight => SeriesLabelPosition::UpperRight,
+        Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+        Legend::Hidden => return Ok(()),
+    };
+    if layers.all().any(|s| s.label.is_some()) {
+        chart
+            .configure_series_labels()
+            .position(position)
+            .label_font(font(TICK_PX))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(150, 150, 150))
+            .margin(12)
+            .draw()
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// The visible pieces of a polyline inside the rectangle `[0, w) × [0, h)` (drawing areas
+/// clamp points outside to their edge, which would draw false lines along it).
+pub(super) fn clip_polyline(points: &[(i32, i32)], w: i32, h: i32) -> Vec<Vec<(i32, i32)>> {
+    let mut pieces: Vec<Vec<(i32, i32)>> = Vec::new();
+    if let [only] = points {
+        if (0..w).contains(&only.0) && (0..h).contains(&only.1) {
+            pieces.push(vec![*only]);
+        }
+        return pieces;
+    }
+    for pair in points.windows(2) {
+        let Some((p, q)) = clip_segment(pair[0], pair[1], w, h) else {
+            continue;
+        };
+        match pieces.last_mut() {
+            Some(piece) if piece.last() == Some(&p) => piece.push(q),
+            _ => pieces.push(vec![p, q]),
+        }
+    }
+    pieces
+}
+
+/// Liang–Barsky clipping of the segment a–b to `[0, w−1] × [0, h−1]`.
+pub(super) fn clip_segment(a: (i32, i32), b: (i32, i32), w: i32, h: i32) -> Option<((i32, i32), (i32, i32))> {
+    let (x0, y0) = (a.0 as f64, a.1 as f64);
+    let (dx, dy) = (b.0 as f64 - x0, b.1 as f64 - y0);
+    let (xmax, ymax) = ((w - 1) as f64, (h - 1) as f64);
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [(-dx, x0), (dx, xmax - x0), (-dy, y0), (dy, ymax - y0)] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    if t0 > t1 {
+        return None;
+    }
+    let at = |t: f64| ((x0 + t * dx).round() as i32, (y0 + t * dy).round() as i32);
+    Some((
+        if t0 > 0.0 { at(t0) } else { a },
+        if t1 < 1.0 { at(t1) } else { b },
+    ))
+}

@@ -1,0 +1,351 @@
+//! [`simulate`]: one run of a chain and its harvester, the library's single entry point that
+//! wires the event-driven mechanics, the charge solver, the statistics and the samples
+//! together.
+
+use std::ops::ControlFlow;
+
+use thiserror::Error;
+
+use super::observer::{ElectricalSample, RunObserver, Sample};
+use super::settings::{ElectricalFailure, RunSpec, Sampling};
+use crate::analysis::RunStats;
+use crate::dynamics::{Event, Flow, Observer, RunEnd, Simulator, StateView, Verdict};
+use crate::electrical::breakdown::BreakdownMargin;
+use crate::electrical::{
+    ChargeSolver, ElectricalError, ElectricalSamples, PeriodStats, PowerSummary, SolverStats, power_curve,
+};
+use crate::error::{ParamError, SimError};
+use crate::model::ChainState;
+
+/// A run could not be carried out, or failed on the way.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum StudyError {
+    /// The parameters are invalid.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// The mechanics stopped.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The charge solver stopped.
+    #[error("charge solver: {0}")]
+    Electrical(#[from] ElectricalError),
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    /// All the periods asked for were simulated.
+    Completed,
+    /// An observer stopped it at a period's end.
+    Stopped,
+    /// It failed; the results cover the periods before the failure.
+    Failed(StudyError),
+}
+
+/// What the harvester delivered in a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ElectricalOutcome {
+    /// Per excitation period (from the harvester's start on).
+    pub periods: Vec<PeriodStats>,
+    /// Average power and related figures after the transient (`None` if no complete period
+    /// after it).
+    pub power: Option<PowerSummary>,
+    /// The worst air-breakdown ratio after the transient (if checked).
+    pub breakdown: Option<BreakdownMargin>,
+    /// Storage capacitor voltage at the end, V (rectifier).
+    pub storage_voltage: Option<f64>,
+    /// First time the storage voltage reached the target, s (rectifier with a target).
+    pub time_to_target: Option<f64>,
+    /// The solver's work counters.
+    pub solver: SolverStats,
+    /// The solver's failure, if it failed while the mechanics went on
+    /// ([`ElectricalFailure::KeepMechanics`]).
+    pub solver_error: Option<ElectricalError>,
+    /// Excitation period, s.
+    pub period: f64,
+}
+
+impl ElectricalOutcome {
+    /// The running average power `P_a(N)`, W, N = 1, 2, … periods (seed eq. 14).
+    pub fn power_curve(&self) -> Vec<f64> {
+        power_curve(&self.periods, self.period)
+    }
+
+    /// Average power and related figures over the complete periods after the first
+    /// `transient` of the harvester's ([`summarize`](crate::electrical::summarize)).
+    pub fn power_after(&self, transient: usize) -> Option<PowerSummary> {
+        crate::electrical::summarize(&self.periods, self.period, transient)
+    }
+}
+
+/// The results of [`simulate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutcome {
+    /// Complete excitation periods simulated.
+    pub periods: u64,
+    /// How the run ended.
+    pub ending: Ending,
+    /// Event statistics (impacts per period and contact, sticking, chatter, closing speeds).
+    pub stats: RunStats,
+    /// What the harvester delivered (with a harvester).
+    pub electrical: Option<ElectricalOutcome>,
+    /// State at the end, at `t = periods·T` (or where the run failed).
+    pub final_state: ChainState,
+    /// Time at the end, s.
+    pub final_time: f64,
+}
+
+impl RunOutcome {
+    /// The failure, if the run failed.
+    pub fn failure(&self) -> Option<&StudyError> {
+        match &self.ending {
+            Ending::Failed(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// Runs `spec`: the chain from its initial state for `spec.periods` excitation periods, the
+/// charge of its harvester solved alongside (from the harvester's start period on), event
+/// statistics kept, and `observer` shown the flow, the events, the samples (if it wants
+/// them) and every period's end, where it may stop the run.
+///
+/// Invalid parameters are an error; a failure on the way (an event limit, a charge solver
+/// failure that [`ElectricalFailure::StopRun`] makes fatal) ends the run with
+/// [`Ending::Failed`] and results for the periods before it.
+///
+/// ```
+/// use vibrotribo::study::{RunSpec, simulate};
+/// use vibrotribo::ChainParams;
+///
+/// let outcome = simulate(&RunSpec::new(ChainParams::default(), 20), &mut ())?;
+/// assert_eq!(outcome.periods, 20);
+/// assert!(outcome.stats.events > 0);
+/// # Ok::<(), vibrotribo::study::StudyError>(())
+/// ```
+pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Result<RunOutcome, StudyError> {
+    let chain = &spec.chain;
+    let period = chain.period();
+    let mut sim = Simulator::new(chain, &spec.initial, spec.options.clone())?;
+    let transient_time = spec.transient_periods as f64 * period;
+    let solver = match &spec.harvester {
+        Some(h) => {
+            let mut s = ChargeSolver::for_chain(&h.params, chain, h.options.clone())?;
+            if spec.breakdown_check {
+                s = s.with_breakdown_check(transient_time);
+            }
+            if observer.wants_samples() {
+                s = match spec.sampling {
+                    Some(Sampling::PerPeriod(per)) => s.with_periodic_sampling(per)?,
+                    Some(Sampling::Uniform { start, step }) => s.with_sampling(start, step)?,
+                    None => s,
+                };
+            }
+            Some(s)
+        }
+        None => None,
+    };
+    let samples = match spec.sampling {
+        Some(grid) if observer.wants_samples() => Some(SampleGrid::new(grid, period, chain)),
+        _ => None,
+    };
+    let mut rec = Recorder {
+        user: observer,
+        stats: RunStats::new(chain.len() - 1, period, spec.transient_periods),
+        solver,
+        electrical_from: spec
+            .harvester
+            .as_ref()
+            .map_or(0.0, |h| h.start_period as f64 * period),
+        stop_on_electrical_failure: spec
+            .harvester
+            .as_ref()
+            .is_some_and(|h| h.on_failure == ElectricalFailure::StopRun),
+        samples,
+    };
+    let mut done = 0;
+    let mut ending = Ending::Completed;
+    for p in 1..=spec.periods {
+        match sim.run_until(p as f64 * period, &mut rec) {
+            Ok(RunEnd::Reached) => {}
+            Ok(RunEnd::Stopped { .. }) => {
+                ending = Ending::Stopped;
+                break;
+            }
+            Err(SimError::Observer(_)) => {
+                let e = rec
+                    .electrical_error()
+                    .expect("only the charge solver fails a run");
+                ending = Ending::Failed(StudyError::Electrical(e));
+                break;
+            }
+            Err(e) => {
+                ending = Ending::Failed(e.into());
+                break;
+            }
+        }
+        done = p;
+        let state = sim.state();
+        let view = StateView {
+            time: sim.time(),
+            positions: &state.positions,
+            velocities: &state.velocities,
+        };
+        if rec.user.period(p, &view).is_break() {
+            if p < spec.periods {
+                ending = Ending::Stopped;
+            }
+            break;
+        }
+    }
+    let electrical = rec.solver.as_ref().map(|s| ElectricalOutcome {
+        periods: s.periods().to_vec(),
+        power: s.summary(
+            spec.transient_periods
+                .saturating_sub(spec.harvester.as_ref().map_or(0, |h| h.start_period)) as usize,
+        ),
+        breakdown: s.breakdown_margin().copied(),
+        storage_voltage: s.storage_voltage(),
+        time_to_target: s.time_to_target(),
+        solver: s.stats(),
+        solver_error: s.status().err(),
+        period,
+    });
+    Ok(RunOutcome {
+        periods: done,
+        ending,
+        stats: rec.stats,
+        electrical,
+        final_state: sim.state(),
+        final_time: sim.time(),
+    })
+}
+
+/// The mechanical half of the samples: grid times inside each piece of flow.
+struct SampleGrid {
+    grid: Sampling,
+    period: f64,
+    next: u64,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    d: Vec<f64>,
+    gaps: Vec<f64>,
+}
+
+impl SampleGrid {
+    fn new(grid: Sampling, period: f64, chain: &crate::ChainParams) -> Self {
+        let n = chain.len();
+        SampleGrid {
+            grid,
+            period,
+            next: 0,
+            x: vec![0.0; n],
+            v: vec![0.0; n],
+            d: vec![0.0; n - 1],
+            gaps: chain.gaps.clone(),
+        }
+    }
+
+    /// Time of sample j (the charge solver's grid uses the same formula).
+    fn time(&self, j: u64) -> f64 {
+        match self.grid {
+            Sampling::PerPeriod(per) => 0.0 + self.period * (j as f64 / per as f64),
+            Sampling::Uniform { start, step } => start + step * (j as f64 / 1.0),
+        }
+    }
+
+    /// Emits the samples inside `flow` to `user`, the electrical ones taken from `electrical`
+    /// (the charge solver's samples of the same grid, recorded for this flow).
+    fn emit<O: RunObserver + ?Sized>(
+        &mut self,
+        flow: &Flow<'_>,
+        electrical: Option<&ElectricalSamples>,
+        user: &mut O,
+    ) {
+        let mut cursor = 0;
+        loop {
+            let t = self.time(self.next);
+            if t > flow.t_end {
+                break;
+            }
+            if t < flow.t_start {
+                self.next += 1;
+                continue;
+            }
+            flow.state_at(t, &mut self.x, &mut self.v);
+            let (base, _) = flow.base_at(t);
+            for (k, d) in self.d.iter_mut().enumerate() {
+                *d = self.gaps[k] - (self.x[k + 1] - self.x[k]);
+            }
+            let e = electrical.filter(|s| s.times.get(cursor).is_some_and(|&ts| ts == t));
+            let sample = e.map(|s| {
+                let i = cursor;
+                ElectricalSample {
+                    charge_c: s.charge_c[i],
+                    current_a: s.current_a[i],
+                    voltage_v: s.voltage_v[i],
+                    capacitance_f: s.capacitance_f[i],
+                    voc_v: s.voc_v[i],
+                    storage_voltage_v: s.storage_voltage_v.get(i).copied(),
+                }
+            });
+            if sample.is_some() {
+                cursor += 1;
+            }
+            user.sample(&Sample {
+                index: self.next,
+                time: t,
+                positions: &self.x,
+                velocities: &self.v,
+                base,
+                gaps: &self.d,
+                electrical: sample,
+            });
+            self.next += 1;
+        }
+    }
+}
+
+/// The observer of the simulator inside [`simulate`].
+struct Recorder<'o, O: ?Sized> {
+    user: &'o mut O,
+    stats: RunStats,
+    solver: Option<ChargeSolver>,
+    electrical_from: f64,
+    stop_on_electrical_failure: bool,
+    samples: Option<SampleGrid>,
+}
+
+impl<O: RunObserver + ?Sized> Recorder<'_, O> {
+    fn electrical_error(&self) -> Option<ElectricalError> {
+        self.solver.as_ref().and_then(|s| s.status().err())
+    }
+}
+
+impl<O: RunObserver + ?Sized> Observer for Recorder<'_, O> {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        if let Some(s) = &mut self.solver
+            && flow.t_start >= self.electrical_from
+        {
+            s.flow(flow);
+        }
+        self.user.flow(flow);
+        if let Some(grid) = &mut self.samples {
+            let fresh = self.solver.as_mut().map(ChargeSolver::take_samples);
+            grid.emit(flow, fresh.as_ref(), &mut *self.user);
+        }
+    }
+
+    fn event(&mut self, event: &Event, state: &StateView<'_>) {
+        self.stats.event(event, state);
+        self.user.event(event, state);
+    }
+
+    fn proceed(&mut self) -> Verdict {
+        match &mut self.solver {
+            Some(s) if self.stop_on_electrical_failure => s.proceed(),
+            _ => Ok(ControlFlow::Continue(())),
+        }
+    }
+}
