@@ -15,6 +15,9 @@
 //!   certified search that cannot step over a grazing contact. See [`dynamics`].
 //! - An [`Observer`] watches a run: [`EventLog`] keeps the events, [`Trajectory`] keeps the
 //!   exact flow for evaluation at any time, [`UniformSampler`] samples it on a grid.
+//! - [`sensitivity`] differentiates the non-smooth flow exactly (state-transition matrix with
+//!   saltation matrices at impacts, sticking, release and chatter jumps) and in parameters.
+//!   Matrices are [`nalgebra`]'s, re-exported here.
 //!
 //! ```
 //! use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator};
@@ -34,6 +37,9 @@ pub mod dynamics;
 pub mod electrical;
 mod error;
 pub mod model;
+pub mod sensitivity;
+
+pub use nalgebra;
 
 pub use dynamics::{
     ContactStatus, Event, EventKind, EventLog, Flow, Observer, Segment, Simulator, StateView, Trajectory,

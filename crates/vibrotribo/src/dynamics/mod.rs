@@ -15,6 +15,7 @@ pub use observer::{
     ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, Segment, StateView, Trajectory,
     UniformSampler,
 };
+pub(crate) use oscillator::Forcing;
 pub use oscillator::Oscillator;
 pub use simulator::{ContactStatus, Simulator, initial_state};
 pub(crate) use taylor::GapPolynomial;
