@@ -37,6 +37,7 @@ pub mod dynamics;
 pub mod electrical;
 mod error;
 pub mod model;
+pub mod orbits;
 pub mod sensitivity;
 
 pub use nalgebra;

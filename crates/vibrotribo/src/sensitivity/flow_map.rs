@@ -62,9 +62,9 @@ pub struct FlowMap {
 
 /// Records the events of a run.
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Events(pub Vec<Event>);
+pub(crate) struct EventRecorder(pub Vec<Event>);
 
-impl Observer for Events {
+impl Observer for EventRecorder {
     fn event(&mut self, event: &Event, _state: &StateView<'_>) {
         self.0.push(*event);
     }
@@ -97,7 +97,7 @@ pub fn flow_map(
     let t_end = horizon.end_time(params);
     let mut sim = Simulator::new(params, initial, sim_options.clone())?;
     let mut stm = Sensitivity::new(params, options.clone());
-    let mut events = Events::default();
+    let mut events = EventRecorder::default();
     sim.run_until(t_end, &mut (&mut stm, &mut events))?;
     let phi = match stm.stm() {
         Ok(phi) => phi.clone(),
@@ -195,7 +195,7 @@ where
     let run = |q: f64| -> Result<(DVector<f64>, Vec<Event>), SensitivityError> {
         let params = params_of(q);
         let mut sim = Simulator::new(&params, initial, options.sim.clone())?;
-        let mut events = Events::default();
+        let mut events = EventRecorder::default();
         sim.run_until(horizon.end_time(&params), &mut events)?;
         Ok((state_vector(&sim.state()), events.0))
     };

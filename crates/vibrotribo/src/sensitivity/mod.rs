@@ -123,6 +123,7 @@ mod saltation;
 mod stm;
 
 pub use error::{NonSmoothPoint, SensitivityError};
+pub(crate) use flow_map::EventRecorder;
 pub use flow_map::{
     DerivativeOptions, FlowMap, Horizon, ParameterDerivative, flow_map, parameter_derivative,
     state_from_vector, state_vector,
