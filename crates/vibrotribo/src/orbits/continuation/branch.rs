@@ -126,6 +126,20 @@ where
         let direction = if to > from { 1.0 } else { -1.0 };
         let (mut branch, doublings) = follow(&problem, &seed, (lo, hi), direction);
         let index = branches.len();
+        // A doubled branch that came back to its parent at another period doubling was
+        // followed from both ends: drop the seed at the other end.
+        if let BranchEnd::Collapsed { parameter } = branch.end {
+            let near = 1e-3 * (hi - lo);
+            queue.retain(|s| {
+                let Some((b, k)) = s.parent else { return true };
+                let other = &mut branches[b].bifurcations[k];
+                let same = s.period == branch.period && (other.parameter - parameter).abs() <= near;
+                if same {
+                    other.child = Some(index);
+                }
+                !same
+            });
+        }
         for d in doublings {
             if index + 1 + queue.len() >= options.max_branches {
                 break;
@@ -218,15 +232,47 @@ fn failure(ev: &super::corrector::Evaluated) -> Failure {
     }
 }
 
-/// Whether an orbit of a doubled branch (period 2P) is in fact of period P: its state after
-/// P periods equals its section state to 1e-7 of the units.
-fn collapsed<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, p: &StepPoint) -> bool {
+/// For an orbit of even period 2P: how far its state after P periods is from its section
+/// state, in the units (0 when it is in fact of period P).
+fn cycle_amplitude<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, p: &StepPoint) -> f64 {
     let half = (problem.period / 2) as usize;
     let sections = &p.ev.eval.sections;
     match (sections.first(), sections.get(half)) {
-        (Some(a), Some(b)) if problem.period.is_multiple_of(2) => problem.scale.norm(&(b - a)) < 1e-7,
-        _ => false,
+        (Some(a), Some(b)) if problem.period.is_multiple_of(2) => problem.scale.norm(&(b - a)),
+        _ => f64::INFINITY,
     }
+}
+
+/// Whether an orbit of a doubled branch (period 2P) is in fact of period P: its state after
+/// P periods equals its section state to 1e-7 of the units.
+fn collapsed<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, p: &StepPoint) -> bool {
+    cycle_amplitude(problem, p) < 1e-7
+}
+
+/// Whether a step of a doubled branch (period 2P) went through the branch of period P onto
+/// the other half of its pitchfork: the new point is nearer the old point's state after P
+/// periods (the same orbit, shifted by P periods) than the old point itself.
+fn flipped<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, a: &StepPoint, b: &StepPoint) -> bool {
+    let half = (problem.period / 2) as usize;
+    let (Some(za), Some(shifted), Some(zb)) = (
+        a.ev.eval.sections.first(),
+        a.ev.eval.sections.get(half),
+        b.ev.eval.sections.first(),
+    ) else {
+        return false;
+    };
+    problem.period.is_multiple_of(2)
+        && problem.scale.norm(&(zb - shifted)) < 0.5 * problem.scale.norm(&(zb - za))
+}
+
+/// What [`detect`] found that ends a branch.
+#[derive(Default)]
+struct Ending {
+    /// A period doubling at the deepest level.
+    cascade: Option<f64>,
+    /// A doubled branch back on the branch of half its period (at the other end of a
+    /// period-doubling bubble).
+    rejoin: Option<f64>,
 }
 
 /// Follows one branch from its seed.
@@ -371,7 +417,15 @@ fn follow<F: Fn(f64) -> ChainParams>(
             },
             None => new,
         };
-        let mut cascade = None;
+        let mut ending = Ending::default();
+        if seed.depth > 0 && flipped(&problem, &base_point, &target) {
+            let closer = if cycle_amplitude(&problem, &base_point) < cycle_amplitude(&problem, &target) {
+                &base_point
+            } else {
+                &target
+            };
+            ending.rejoin = Some(closer.described.point.parameter);
+        }
         detect(
             &problem,
             &step,
@@ -381,20 +435,21 @@ fn follow<F: Fn(f64) -> ChainParams>(
             seed,
             &mut branch,
             &mut doublings,
-            &mut cascade,
+            &mut ending,
         );
         branch.points.push(target.described.point.clone());
         if seed.depth > 0 && collapsed(&problem, &target) {
-            branch.end = BranchEnd::Collapsed {
-                parameter: target.described.point.parameter,
-            };
+            ending.rejoin.get_or_insert(target.described.point.parameter);
+        }
+        if let Some(parameter) = ending.rejoin {
+            branch.end = BranchEnd::Collapsed { parameter };
             return (branch, doublings);
         }
         if let Some(b) = bound {
             branch.end = BranchEnd::RangeEnd { parameter: b };
             return (branch, doublings);
         }
-        if let Some(parameter) = cascade {
+        if let Some(parameter) = ending.cascade {
             branch.end = BranchEnd::CascadeDepth { parameter };
             return (branch, doublings);
         }
@@ -431,7 +486,7 @@ fn detect<F: Fn(f64) -> ChainParams>(
     seed: &Seed,
     branch: &mut Branch,
     doublings: &mut Vec<Doubling>,
-    cascade: &mut Option<f64>,
+    ending: &mut Ending,
 ) {
     let mut found: Vec<(f64, Bifurcation, Option<Doubling>)> = Vec::new();
     let mut intervals = vec![(base.clone(), target.clone())];
@@ -498,7 +553,7 @@ fn detect<F: Fn(f64) -> ChainParams>(
                         }
                     })
             } else {
-                cascade.get_or_insert(l.point.described.point.parameter);
+                ending.cascade.get_or_insert(l.point.described.point.parameter);
                 None
             };
             found.push((l.point.theta, b, doubling));

@@ -83,22 +83,26 @@ pub(crate) fn locate_change_in_parameter<F: Fn(f64) -> ChainParams>(
     let tol = problem.options.location_tolerance;
     let (mut a, mut b) = (a.clone(), b.clone());
     let parameter = |s: &StepPoint| s.described.point.parameter;
+    // The far end of the bracket: b's parameter, or closer where no orbit converged.
+    let mut p_b = parameter(&b);
     for _ in 0..MAX_LOCATE {
-        if (parameter(&b) - parameter(&a)).abs() <= tol {
+        if (p_b - parameter(&a)).abs() <= tol {
             break;
         }
-        let p = 0.5 * (parameter(&a) + parameter(&b));
+        let p = 0.5 * (parameter(&a) + p_b);
         let s = 0.5 * (a.described.point.arclength + b.described.point.arclength);
-        let from_a = orbit_at(problem, &problem.state(&a.ev.u), p, s);
-        match from_a {
+        match orbit_at(problem, &problem.state(&a.ev.u), p, s) {
             Some(c) if c.described.signature == a.described.signature => a = c,
             _ => match orbit_at(problem, &problem.state(&b.ev.u), p, s) {
-                Some(c) if c.described.signature == b.described.signature => b = c,
+                Some(c) if c.described.signature == b.described.signature => {
+                    b = c;
+                    p_b = p;
+                }
                 // Neither side's orbit reaches the midpoint: the change is at or before it.
-                _ => break,
+                _ => p_b = p,
             },
         }
     }
-    let precision = (parameter(&b) - parameter(&a)).abs();
+    let precision = (p_b - parameter(&a)).abs();
     (a, b, precision)
 }
