@@ -18,6 +18,9 @@
 //! - [`sensitivity`] differentiates the non-smooth flow exactly (state-transition matrix with
 //!   saltation matrices at impacts, sticking, release and chatter jumps) and in parameters.
 //!   Matrices are [`nalgebra`]'s, re-exported here.
+//! - [`orbits`] finds periodic orbits by shooting (stable or not), their Floquet multipliers,
+//!   and continues them in a parameter through folds, period doublings (cascades included),
+//!   Neimark–Sacker points, grazings and the onset of sticking.
 //!
 //! ```
 //! use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator};

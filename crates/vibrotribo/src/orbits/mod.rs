@@ -21,10 +21,32 @@
 //!
 //! The Floquet multipliers are the eigenvalues of the monodromy matrix Φ(PT)
 //! ([`floquet_multipliers`]); the orbit is stable when all lie inside the unit circle. A
-//! contact stuck over the whole period contributes two zero multipliers (Φ projects the gap
-//! and relative-velocity directions away).
+//! contact that sticks somewhere on the orbit contributes two zero multipliers (while it is
+//! stuck Φ projects the gap and relative-velocity directions away, and nothing restores
+//! them). Newton's method reports an orbit through a non-differentiable point (grazing or
+//! simultaneous impacts) as [`OrbitError::NonSmooth`] and `period = 0` as
+//! [`OrbitError::ZeroPeriod`]. [`PeriodicOrbit::replay`] runs the orbit again with any
+//! observer attached: the hook for its average power.
+//!
+//! # Continuation
+//!
+//! [`continue_orbit`] follows an orbit in a scalar parameter given as a closure
+//! `Fn(f64) -> ChainParams` (any combination of frequency, amplitude, masses, gaps,
+//! restitution, …) by pseudo-arclength continuation, locates folds, period doublings (and
+//! follows the doubled branches, so a cascade is followed to a chosen depth),
+//! Neimark–Sacker points, grazings and the onset of sticking, and marks why every branch
+//! ends; the method is described in [`continuation`].
+//!
+//! # Extending to other contacts
+//!
+//! A contact against a wall with prescribed motion (a rigid stop fixed in space or moving
+//! with the base) fits the same scheme: its gap `h = δ − (x_k − w(t))` depends on time
+//! explicitly, so the impact saltation's denominator becomes `∇h·f⁻ + ∂h/∂t = −(v_k − w')`,
+//! and its reset changes one cluster only, `V⁺ = w' − μ(V⁻ − w')`, i.e. `R = I` except
+//! `∂V⁺/∂V⁻ = −μ`. The observer dispatches on the events' contact index; a wall contact
+//! needs its own `Impact` kind in `sensitivity::saltation` and nothing else here.
 
-mod continuation;
+pub mod continuation;
 mod error;
 mod floquet;
 mod gaps;

@@ -55,7 +55,7 @@ struct Doubling {
 
 /// Pseudo-arclength continuation of the periodic orbit of period `period` near `guess` at
 /// parameter `from`, for the family `family` (any scalar that changes [`ChainParams`],
-/// called `name`), towards `to`; see the [module docs](super).
+/// called `name`), towards `to`; see the [module docs](crate::orbits::continuation).
 ///
 /// The first orbit is found by [`find_periodic_orbit`] at `from`. Every branch is followed
 /// until it leaves `[min(from, to), max(from, to)]` or ends otherwise ([`BranchEnd`]).

@@ -10,14 +10,22 @@
 //!
 //! Between consecutive points the continuation looks for
 //!
-//! - sign changes of the test functions of [`floquet_multipliers`](super::floquet_multipliers)'s
-//!   module: `det(Φ − I)` (fold if the tangent's parameter component turns, else branch
-//!   point), `det(Φ + I)` (period doubling), `Π_{i<j}(λ_iλ_j − 1)` (Neimark–Sacker when the
-//!   critical pair is complex), located by the Illinois method along the step;
+//! - sign changes of the test functions of the multipliers λ_i: `det(Φ − I)` (fold if the
+//!   tangent's parameter component turns, else branch point), `det(Φ + I)` (period
+//!   doubling), `Π_{i<j}(λ_iλ_j − 1)` (Neimark–Sacker when the critical pair is complex, not
+//!   two real multipliers with product 1), located by the Illinois method along the step;
 //! - changes of the event sequence over a period (chatter sequences counted as one entry),
 //!   located by bisection: grazing (an impact appears or disappears with closing speed → 0),
 //!   sticking onset or end, or another change. Φ is discontinuous there, so the smooth test
 //!   functions are only searched on either side of it.
+//!
+//! At a grazing the branch has a corner (on the side with the new impact the orbit moves like
+//! the square root of the distance): when the step falls to its floor the continuation tries
+//! natural-parameter steps across it, and a branch that cannot go on ends with
+//! [`BranchEnd::Grazing`] if one of its gap minima is vanishing, else
+//! [`BranchEnd::StepFloor`] with the corrector's residuals. A doubled branch that comes back
+//! to its parent at another period doubling (a bubble) ends [`BranchEnd::Collapsed`] and is
+//! followed once.
 //!
 //! Internally a branch is represented on a section t ≡ θ (mod T) kept away from the orbit's
 //! events (an impact crossing the section would make the stroboscopic map jump); points are

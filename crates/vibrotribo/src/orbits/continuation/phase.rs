@@ -16,7 +16,7 @@ use super::locate::StepPoint;
 use crate::dynamics::{Event, Simulator};
 use crate::model::ChainParams;
 use crate::orbits::shooting::newton;
-use crate::sensitivity::{Sensitivity, state_from_vector, state_vector};
+use crate::sensitivity::{Sensitivity, SensitivityError, state_from_vector, state_vector};
 
 /// An event closer than this fraction of the excitation period to the section moves it.
 pub(crate) const CLEARANCE: f64 = 0.02;
@@ -60,23 +60,22 @@ pub(crate) fn move_section<F: Fn(f64) -> ChainParams>(
         }
     }
     let shift = (start + 0.5 * length).rem_euclid(duration);
-    // Carry the state and Φ over [θ, θ + shift].
+    // Carry the state and Φ over [θ, θ + shift], and the state at p ± h (below).
     let z = problem.state(&point.ev.u);
     let opts = &problem.options.shooting;
-    let mut sim = Simulator::new_at(
-        &params,
-        problem.phase,
-        &state_from_vector(z.as_slice()),
-        opts.sim.clone(),
-    )
-    .ok()?;
-    let mut stm = Sensitivity::new(&params, opts.sensitivity.clone());
-    sim.run_until(problem.phase + shift, &mut stm).ok()?;
-    let carried = state_vector(&sim.state());
-    let phi = if shift > 0.0 {
-        stm.stm().ok()?.clone()
-    } else {
-        DMatrix::identity(z.len(), z.len())
+    let carry = |q: f64, stm: &mut Option<Sensitivity>| -> Option<DVector<f64>> {
+        let params = (problem.family)(q);
+        let start = state_from_vector(z.as_slice());
+        let mut sim = Simulator::new_at(&params, problem.phase, &start, opts.sim.clone()).ok()?;
+        sim.run_until(problem.phase + shift, stm).ok()?;
+        Some(state_vector(&sim.state()))
+    };
+    let mut stm = Some(Sensitivity::new(&params, opts.sensitivity.clone()));
+    let carried = carry(p, &mut stm)?;
+    let phi = match stm.as_ref()?.stm() {
+        Ok(phi) => phi.clone(),
+        Err(SensitivityError::Empty) => DMatrix::identity(z.len(), z.len()),
+        Err(_) => return None,
     };
     let phase = (problem.phase + shift).rem_euclid(duration);
     let moved = problem.with_phase(phase);
@@ -90,19 +89,7 @@ pub(crate) fn move_section<F: Fn(f64) -> ChainParams>(
     let n = dim / 2;
     let s = |i: usize| problem.scale.of_component(i, n);
     let h = problem.options.parameter_step * p.abs().max(problem.p_scale);
-    let carry = |q: f64| -> Option<DVector<f64>> {
-        let params = (problem.family)(q);
-        let mut sim = Simulator::new_at(
-            &params,
-            problem.phase,
-            &state_from_vector(z.as_slice()),
-            opts.sim.clone(),
-        )
-        .ok()?;
-        sim.run_until(problem.phase + shift, &mut ()).ok()?;
-        Some(state_vector(&sim.state()))
-    };
-    let dz_dp = (carry(p + h)? - carry(p - h)?) / (2.0 * h);
+    let dz_dp = (carry(p + h, &mut None)? - carry(p - h, &mut None)?) / (2.0 * h);
     let t_z = DVector::from_fn(dim, |i, _| tangent[i] * s(i));
     let carried_t = &phi * t_z + dz_dp * (tangent[dim] * problem.p_scale);
     let previous = DVector::from_fn(dim + 1, |i, _| {
