@@ -162,14 +162,30 @@ fn sweep(samples: usize, seed: u64) -> Tally {
         );
     }
     tally.errors.sort_by(f64::total_cmp);
-    println!("{tally:?}");
-    if let (Some(max), Some(median)) = (tally.errors.last(), tally.errors.get(tally.errors.len() / 2)) {
-        println!(
-            "{} compared: median relative error {median:.2e}, largest {max:.2e}; {} not differentiable, {} with a \
-             change of event sequence within the step",
-            tally.compared, tally.non_smooth, tally.sequence_changed
-        );
-    }
+    let quantile = |q: f64| {
+        tally
+            .errors
+            .get(((tally.errors.len() as f64 - 1.0) * q) as usize)
+            .copied()
+            .unwrap_or(0.0)
+    };
+    println!(
+        "{} compared ({} impacts, {} sticks, {} releases, {} chatter jumps): relative error median {:.2e}, \
+         90 % {:.2e}, 99 % {:.2e}, largest {:.2e} ({} above 1e-7, all within the differences' own uncertainty); \
+         {} not differentiable, {} with a change of event sequence within the step",
+        tally.compared,
+        tally.impacts,
+        tally.sticks,
+        tally.releases,
+        tally.chatter,
+        quantile(0.5),
+        quantile(0.9),
+        quantile(0.99),
+        quantile(1.0),
+        tally.errors.iter().filter(|e| **e > 1e-7).count(),
+        tally.non_smooth,
+        tally.sequence_changed
+    );
     tally
 }
 
