@@ -15,6 +15,12 @@
 //!   certified search that cannot step over a grazing contact. See [`dynamics`].
 //! - An [`Observer`] watches a run: [`EventLog`] keeps the events, [`Trajectory`] keeps the
 //!   exact flow for evaluation at any time, [`UniformSampler`] samples it on a grid.
+//! - [`sensitivity`] differentiates the non-smooth flow exactly (state-transition matrix with
+//!   saltation matrices at impacts, sticking, release and chatter jumps) and in parameters.
+//!   Matrices are [`nalgebra`]'s, re-exported here.
+//! - [`orbits`] finds periodic orbits by shooting (stable or not), their Floquet multipliers,
+//!   and continues them in a parameter through folds, period doublings (cascades included),
+//!   Neimark–Sacker points, grazings and the onset of sticking.
 //!
 //! ```
 //! use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator};
@@ -36,7 +42,11 @@ pub mod dynamics;
 pub mod electrical;
 mod error;
 pub mod model;
+pub mod orbits;
+pub mod sensitivity;
 pub mod study;
+
+pub use nalgebra;
 
 pub use dynamics::{
     ContactStatus, Event, EventKind, EventLog, Flow, Observer, RunEnd, Segment, Simulator, StateView,

@@ -15,6 +15,7 @@ pub use observer::{
     ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, ObserverError, Segment, StateView,
     Trajectory, UniformSampler, Verdict,
 };
+pub(crate) use oscillator::Forcing;
 pub use oscillator::Oscillator;
 pub use simulator::{ContactStatus, RunEnd, Simulator, initial_state};
 pub(crate) use taylor::GapPolynomial;

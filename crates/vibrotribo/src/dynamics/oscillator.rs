@@ -269,6 +269,17 @@ impl Oscillator {
         self.t0
     }
 
+    /// The Jacobian `∂(s, s')(t) / ∂(s, s')(t₀)` of this flow, row-major: the forced part
+    /// does not depend on the initial state, so it is the homogeneous propagator's,
+    /// `[[c + αs, s], [−ω_n² s, c − αs]]` with `(c, s)` of the module docs (decay included).
+    /// Its determinant is `e^{−2α(t − t₀)}` (Liouville).
+    #[inline]
+    pub(crate) fn state_jacobian(&self, t: f64) -> [[f64; 2]; 2] {
+        let (c, s) = self.propagator(t - self.t0);
+        let a = self.alpha;
+        [[c + a * s, s], [-self.wn2 * s, c - a * s]]
+    }
+
     /// A rate Λ, 1/s, that bounds how fast the Taylor coefficients of the motion can grow:
     /// at least ω (the forced part) and 2α + ω_n (every root of `λ² + 2αλ + ω_n² = 0` in all
     /// damping regimes, and the two coefficients of that recurrence). See [`taylor`](Self::taylor).

@@ -164,9 +164,26 @@ impl Simulator {
     /// A simulator at time 0 in `initial` state. Contacts that start closed with zero relative
     /// velocity stick if their contact force is compressive.
     pub fn new(params: &ChainParams, initial: &ChainState, options: SimOptions) -> Result<Self, SimError> {
+        Self::new_at(params, 0.0, initial, options)
+    }
+
+    /// A simulator at time `t0` ≥ 0, s, in `initial` state (the base motion's phase is that of
+    /// `t0`); otherwise as [`new`](Self::new).
+    pub fn new_at(
+        params: &ChainParams,
+        t0: f64,
+        initial: &ChainState,
+        options: SimOptions,
+    ) -> Result<Self, SimError> {
         params.validate()?;
         params.validate_state(initial)?;
         options.validate()?;
+        crate::error::check(
+            "start time",
+            t0,
+            t0.is_finite() && t0 >= 0.0,
+            "must be finite and not negative",
+        )?;
         let n = params.len();
         let mut offsets = vec![0.0; n];
         for i in 1..n {
@@ -177,8 +194,8 @@ impl Simulator {
             params: params.clone(),
             options,
             offsets,
-            t: 0.0,
-            period_index: 0,
+            t: t0,
+            period_index: (t0 / params.period()).floor() as u64,
             events_in_period: 0,
             clusters: Vec::with_capacity(n),
             consts: Vec::with_capacity(n),

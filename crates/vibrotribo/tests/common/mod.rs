@@ -168,3 +168,48 @@ pub fn period_stats(
     s.run_trajectory(traj).unwrap();
     s.periods().to_vec()
 }
+
+/// A fixed-seed generator (64-bit LCG, Knuth's constants), uniform in [0, 1).
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    pub fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    pub fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.next()
+    }
+}
+
+/// A random chain of `n` masses (30–200 g, 80–200 N/m, up to 0.05 N s/m, gaps 3–20 mm,
+/// A = 20–80 mm, Ω = 0.3–1.2) with restitution `mu`, and a random admissible state
+/// (neighbours up to half a gap apart beyond contact, speeds up to 0.3 of the speed scale).
+pub fn random_chain(rng: &mut Lcg, n: usize, mu: f64) -> (ChainParams, vibrotribo::ChainState) {
+    use vibrotribo::{ChainState, Excitation, Frequency};
+    let params = ChainParams {
+        masses: (0..n).map(|_| rng.range(0.03, 0.2)).collect(),
+        stiffness: (0..n).map(|_| rng.range(80.0, 200.0)).collect(),
+        damping: (0..n).map(|_| rng.range(0.0, 0.05)).collect(),
+        gaps: (0..n - 1).map(|_| rng.range(0.003, 0.02)).collect(),
+        restitution: mu,
+        excitation: Excitation {
+            amplitude: rng.range(0.02, 0.08),
+            frequency: Frequency::OmegaRatio(rng.range(0.3, 1.2)),
+        },
+    };
+    let v = vibrotribo::sensitivity::speed_scale(&params);
+    let mut x = vec![0.0; n];
+    for i in 1..n {
+        x[i] = x[i - 1] + rng.range(-0.5, 0.9) * params.gaps[i - 1];
+    }
+    let state = ChainState {
+        positions: x,
+        velocities: (0..n).map(|_| rng.range(-0.3, 0.3) * v).collect(),
+    };
+    (params, state)
+}

@@ -1,0 +1,50 @@
+//! Pseudo-arclength continuation of periodic orbits in a scalar parameter, with detection
+//! and location of their bifurcations.
+//!
+//! The branch `{(z, p): φ(PT; z, p) = z}` is followed in the scaled unknowns `u = (ẑ, p̂)`
+//! (state in L and L·ω, parameter in units of the range): from a point `u₀` with unit
+//! tangent `t₀` (the null vector of the Jacobian `[Φ − I | ∂φ/∂p]`, oriented along the
+//! previous one), predict `u₀ + ds·t₀` and correct by Newton's method on
+//! `φ(z; p) = z, t₀ᵀ(u − u₀ − ds·t₀) = 0`, which passes folds (the parameter may turn back).
+//! The step grows after easy corrections and halves after failures, down to a floor.
+//!
+//! Between consecutive points the continuation looks for
+//!
+//! - sign changes of the test functions of the multipliers λ_i: `det(Φ − I)` (fold if the
+//!   tangent's parameter component turns, else branch point), `det(Φ + I)` (period
+//!   doubling), `Π_{i<j}(λ_iλ_j − 1)` (Neimark–Sacker when the critical pair is complex, not
+//!   two real multipliers with product 1), located by the Illinois method along the step;
+//! - changes of the event sequence over a period (chatter sequences counted as one entry),
+//!   located by bisection: grazing (an impact appears or disappears with closing speed → 0),
+//!   sticking onset or end, or another change. Φ is discontinuous there, so the smooth test
+//!   functions are only searched on either side of it.
+//!
+//! At a grazing the branch has a corner (on the side with the new impact the orbit moves like
+//! the square root of the distance): when the step falls to its floor the continuation tries
+//! natural-parameter steps across it, and a branch that cannot go on ends with
+//! [`BranchEnd::Grazing`] if one of its gap minima is vanishing, else
+//! [`BranchEnd::StepFloor`] with the corrector's residuals. A doubled branch that comes back
+//! to its parent at another period doubling (a bubble) ends [`BranchEnd::Collapsed`] and is
+//! followed once.
+//!
+//! Internally a branch is represented on a section t ≡ θ (mod T) kept away from the orbit's
+//! events (an impact crossing the section would make the stroboscopic map jump); points are
+//! reported at t ≡ 0.
+//!
+//! Every location stops at [`ContinuationOptions::location_tolerance`] in the parameter. At
+//! a period doubling the doubled branch is started along the eigenvector of the multiplier
+//! −1 (the pitchfork of the doubled map) and followed in turn, to
+//! [`ContinuationOptions::doubling_depth`] levels. Every loop is bounded: points per branch,
+//! branches, corrector iterations, location steps and the step floor.
+
+mod branch;
+mod bridge;
+mod corrector;
+mod locate;
+mod phase;
+mod types;
+
+pub use branch::continue_orbit;
+pub use types::{
+    Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
+};

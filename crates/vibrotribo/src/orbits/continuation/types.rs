@@ -1,0 +1,259 @@
+//! What a continuation returns, and its settings.
+
+use nalgebra::Complex;
+
+use super::super::error::NewtonFailure;
+use super::super::shooting::ShootingOptions;
+use crate::error::{ParamError, check, check_positive};
+use crate::model::ChainState;
+use crate::sensitivity::NonSmoothPoint;
+
+/// Settings of [`continue_orbit`](super::continue_orbit).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContinuationOptions {
+    /// First arclength step, in scaled units (state in L and L·ω, parameter in its range
+    /// |to − from|). Default 0.02.
+    pub initial_step: f64,
+    /// Smallest step: a branch that cannot be continued with it ends with
+    /// [`BranchEnd::StepFloor`]. Default 1e-6.
+    pub min_step: f64,
+    /// Largest step. Default 0.1.
+    pub max_step: f64,
+    /// Most points per branch ([`BranchEnd::MaxPoints`] beyond). Default 2000.
+    pub max_points: usize,
+    /// Most branches in all (the first plus the period-doubled ones). Default 16.
+    pub max_branches: usize,
+    /// Period doublings to follow: at a period doubling of a branch of period 2^k·P with
+    /// k < `doubling_depth` the doubled branch is followed too, so a cascade P → 2P → 4P …
+    /// is followed `doubling_depth` levels deep. Default 3.
+    pub doubling_depth: u32,
+    /// Bifurcations and sequence changes are located to this accuracy in the parameter, in
+    /// its unit. Default 1e-8.
+    pub location_tolerance: f64,
+    /// Scaled residual at which a corrector step has converged. Default 1e-11.
+    pub corrector_tolerance: f64,
+    /// Newton iterations per corrector step. Default 8.
+    pub corrector_iterations: usize,
+    /// Relative step of the central difference of the flow map in the parameter (the
+    /// parameter column of the Jacobian). Default 1e-7.
+    pub parameter_step: f64,
+    /// Settings of the first orbit (Newton at `from`), of the simulations and of the
+    /// sensitivities.
+    pub shooting: ShootingOptions,
+}
+
+impl Default for ContinuationOptions {
+    fn default() -> Self {
+        ContinuationOptions {
+            initial_step: 0.02,
+            min_step: 1e-6,
+            max_step: 0.1,
+            max_points: 2000,
+            max_branches: 16,
+            doubling_depth: 3,
+            location_tolerance: 1e-8,
+            corrector_tolerance: 1e-11,
+            corrector_iterations: 8,
+            parameter_step: 1e-7,
+            shooting: ShootingOptions::default(),
+        }
+    }
+}
+
+impl ContinuationOptions {
+    /// Checks the options.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check_positive("initial_step", self.initial_step)?;
+        check_positive("min_step", self.min_step)?;
+        check_positive("max_step", self.max_step)?;
+        check(
+            "max_step",
+            self.max_step,
+            self.min_step <= self.initial_step && self.initial_step <= self.max_step,
+            "must satisfy min_step ≤ initial_step ≤ max_step",
+        )?;
+        check(
+            "max_points",
+            self.max_points as f64,
+            self.max_points >= 2,
+            "must be at least 2",
+        )?;
+        check(
+            "max_branches",
+            self.max_branches as f64,
+            self.max_branches >= 1,
+            "must be positive",
+        )?;
+        check_positive("location_tolerance", self.location_tolerance)?;
+        check_positive("corrector_tolerance", self.corrector_tolerance)?;
+        check(
+            "corrector_iterations",
+            self.corrector_iterations as f64,
+            self.corrector_iterations > 0,
+            "must be positive",
+        )?;
+        check_positive("parameter_step", self.parameter_step)?;
+        self.shooting.validate()
+    }
+}
+
+/// One periodic orbit on a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BranchPoint {
+    /// Parameter value.
+    pub parameter: f64,
+    /// Section state at t ≡ 0 (mod T): positions, m, and velocities, m/s.
+    pub state: ChainState,
+    /// Floquet multipliers, largest modulus first.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Whether all multipliers lie inside the unit circle.
+    pub stable: bool,
+    /// Impacts per excitation period at each contact (chatter bounces included).
+    pub impacts_per_period: Vec<f64>,
+    /// The slowest impact that is not a chatter bounce: (contact, closing speed in m/s).
+    pub min_closing_speed: Option<(usize, f64)>,
+    /// Whether a contact sticks on the orbit.
+    pub sticks: bool,
+    /// Arclength from the branch's start, scaled units.
+    pub arclength: f64,
+}
+
+impl BranchPoint {
+    /// Largest multiplier modulus.
+    pub fn spectral_radius(&self) -> f64 {
+        self.multipliers.first().map_or(0.0, |l| l.norm())
+    }
+}
+
+/// What happens at a located bifurcation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum BifurcationKind {
+    /// A real multiplier crosses +1 and the branch turns back in the parameter
+    /// (saddle-node).
+    Fold,
+    /// A real multiplier crosses +1 without a turn in the parameter (a branch point).
+    BranchPoint,
+    /// A real multiplier crosses −1: a branch of twice the period is born.
+    PeriodDoubling,
+    /// A complex pair crosses the unit circle at `exp(±i·angle)`.
+    NeimarkSacker {
+        /// Argument of the critical pair, rad (in (0, π)).
+        angle: f64,
+    },
+    /// An impact at `contact` appears or disappears with closing speed → 0: the impact
+    /// sequence changes. `appears` is true when the later side along the branch has it.
+    Grazing {
+        /// Contact, 0-based.
+        contact: usize,
+        /// Whether the impact exists after the point (along the branch).
+        appears: bool,
+    },
+    /// Sticking at `contact` begins (`onset`) or ends along the branch.
+    Sticking {
+        /// Contact, 0-based.
+        contact: usize,
+        /// Whether sticking exists after the point (along the branch).
+        onset: bool,
+    },
+    /// The event sequence changes otherwise (chatter appears, the order of impacts changes,
+    /// or an impact appears with a closing speed that does not tend to zero).
+    SequenceChange,
+}
+
+/// A bifurcation located on a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bifurcation {
+    /// What happens.
+    pub kind: BifurcationKind,
+    /// Parameter value at the point.
+    pub parameter: f64,
+    /// Width of the final bracket in the parameter: the location's accuracy.
+    pub precision: f64,
+    /// The orbit at the point (for a sequence change: the last orbit before it along the
+    /// branch).
+    pub point: BranchPoint,
+    /// For a sequence change: the first orbit after it.
+    pub after: Option<BranchPoint>,
+    /// For a period doubling: the index of the doubled branch in
+    /// [`Continuation::branches`], if it was followed.
+    pub child: Option<usize>,
+}
+
+/// Why a branch ended.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum BranchEnd {
+    /// The branch left the parameter range at this value (a point there is the last).
+    RangeEnd {
+        /// The range end reached.
+        parameter: f64,
+    },
+    /// [`ContinuationOptions::max_points`] points were computed.
+    MaxPoints,
+    /// The corrector failed down to the smallest step: a turning point it cannot follow, a
+    /// non-smooth point ahead (`non_smooth`), or no orbit beyond.
+    StepFloor {
+        /// Parameter of the last point.
+        parameter: f64,
+        /// Why the last attempt failed.
+        reason: NewtonFailure,
+        /// Where the map was not differentiable, if that was the reason.
+        non_smooth: Option<NonSmoothPoint>,
+        /// Residuals of the last attempt.
+        residuals: Vec<f64>,
+    },
+    /// The branch runs into a grazing it cannot cross: a smooth local minimum of the gap at
+    /// `contact` tends to zero (last seen at `gap` m), and no orbit with the new impact was
+    /// found beyond it (the branch may turn back there, or the orbit cease to exist).
+    Grazing {
+        /// Parameter of the last point.
+        parameter: f64,
+        /// Contact, 0-based.
+        contact: usize,
+        /// The smallest gap minimum at the last point, m.
+        gap: f64,
+    },
+    /// A period doubling of a branch at the deepest level asked for
+    /// ([`ContinuationOptions::doubling_depth`]): the cascade goes on beyond (towards a
+    /// chaotic window), and the branch is not followed past it.
+    CascadeDepth {
+        /// Parameter of the period doubling.
+        parameter: f64,
+    },
+    /// The doubled branch could not be started from its period doubling.
+    SwitchFailed {
+        /// Parameter of the period doubling.
+        parameter: f64,
+    },
+    /// The branch of period 2P fell back onto the orbit of period P.
+    Collapsed {
+        /// Parameter of the point where it happened.
+        parameter: f64,
+    },
+}
+
+/// One branch of periodic orbits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// Period of its orbits, in excitation periods.
+    pub period: u32,
+    /// Where it was born: (index of the parent branch, index of the period doubling in its
+    /// `bifurcations`); `None` for the first branch.
+    pub parent: Option<(usize, usize)>,
+    /// The orbits in order along the branch.
+    pub points: Vec<BranchPoint>,
+    /// Bifurcations in order along the branch.
+    pub bifurcations: Vec<Bifurcation>,
+    /// Why it ended.
+    pub end: BranchEnd,
+}
+
+/// The result of [`continue_orbit`](super::continue_orbit).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Continuation {
+    /// Name of the parameter.
+    pub parameter: String,
+    /// The branches: the first, then the period-doubled ones in the order they were found.
+    pub branches: Vec<Branch>,
+}
