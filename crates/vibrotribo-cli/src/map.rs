@@ -16,9 +16,10 @@ use crate::output::{CsvFile, create_dir, point_cells, point_columns, write_json}
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
 use crate::sweep::{
-    MergeArgs, PointRunner, RunArgs, Shard, check_distinct, estimate_point_memory, estimate_point_output,
-    grid, header_len, run_grid, set_threads,
+    MergeArgs, RunArgs, Shard, check_all, check_distinct, estimate_point_memory, estimate_point_output,
+    header_len, run_points, set_threads,
 };
+use vibrotribo::sweep::grid;
 
 /// Options of `vibrotribo map`.
 #[derive(Debug, clap::Args)]
@@ -113,7 +114,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
-    let runner = PointRunner::new(base, &args.run)?;
+    let runner = args.run.runner(base)?;
     let (xs, ys) = (
         grid(args.x_from, args.x_to, args.x_steps),
         grid(args.y_from, args.y_to, args.y_steps),
@@ -129,7 +130,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
             .map(|(_, p)| p)
             .collect();
     }
-    runner.check_all(&points, |&(x, y)| {
+    check_all(&runner, &points, |&(x, y)| {
         vec![(args.x.as_str(), x), (args.y.as_str(), y)]
     })?;
     let threads = rayon::current_num_threads() as f64;
@@ -169,7 +170,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     };
     let started = Instant::now();
     let (xk, yk) = (args.x.as_str(), args.y.as_str());
-    let computed = run_grid(
+    let computed = run_points(
         &runner,
         &points[skip..],
         |&(x, y)| vec![(xk, x), (yk, y)],
@@ -366,7 +367,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
-    let runner = PointRunner::new(base, &args.run)?;
+    let runner = args.run.runner(base)?;
     let contacts = runner.masses() - 1;
     let (omegas, ratios) = (
         grid(args.omega_from, args.omega_to, args.omega_steps),
@@ -376,7 +377,9 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         .iter()
         .flat_map(|&w| ratios.iter().map(move |&r| (w, r)))
         .collect();
-    runner.check_all(&points, |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)])?;
+    check_all(&runner, &points, |&(w, r)| {
+        vec![("omega_ratio", w), ("mass_ratio", r)]
+    })?;
     let mut power = vec![f64::NAN; points.len()];
     let mut index = 0;
     let mut grid_csv = match &args.out {
@@ -397,7 +400,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         None => None,
     };
     let started = Instant::now();
-    let done = run_grid(
+    let done = run_points(
         &runner,
         &points,
         |&(w, r)| vec![("omega_ratio", w), ("mass_ratio", r)],

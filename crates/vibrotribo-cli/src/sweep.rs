@@ -1,33 +1,22 @@
 //! `vibrotribo sweep` and `vibrotribo merge`: one-parameter sweeps (orbit diagrams,
 //! impact-velocity diagrams, power curves), parallel, continued, or sharded across machines.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
-use rayon::prelude::*;
 use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::config::Config;
-use vibrotribo::study::{PointOptions, PointResult, run_point};
+use vibrotribo::study::{PointOptions, PointResult};
+use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_continued, run_grid};
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::limits;
 use crate::output::{numbered, point_cells, point_columns};
 use crate::progress::{Interrupted, Progress, interrupted};
-
-/// Direction of parameter continuation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Continuation {
-    /// Every value starts from the configured initial state; values run in parallel.
-    None,
-    /// Values in increasing order, each starting from the previous one's final state.
-    Up,
-    /// Values in decreasing order, each starting from the previous one's final state.
-    Down,
-}
 
 /// `I/N`: the I-th (0-based) of N interleaved slices of the grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,7 +98,7 @@ pub struct SweepArgs {
     pub steps: usize,
     /// Carry the final state to the next value (`up`, `down`), or start every value afresh
     /// (`none`, parallel).
-    #[arg(long, value_enum, default_value_t = Continuation::None)]
+    #[arg(long, default_value = "none", value_parser = clap::value_parser!(Continuation), value_name = "none|up|down")]
     pub continuation: Continuation,
     /// Compute only the I-th of N interleaved slices of the grid (0 ≤ I < N), e.g.
     /// `--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`; combine with `vibrotribo merge`.
@@ -129,121 +118,55 @@ pub struct SweepArgs {
     pub run: RunArgs,
 }
 
-/// The grid of a sweep: `steps` values from `from` to `to`.
-pub fn grid(from: f64, to: f64, steps: usize) -> Vec<f64> {
-    match steps {
-        0 => Vec::new(),
-        1 => vec![from],
-        _ => (0..steps)
-            .map(|j| {
-                if j == steps - 1 {
-                    to
-                } else {
-                    from + (to - from) * j as f64 / (steps - 1) as f64
-                }
-            })
-            .collect(),
-    }
-}
-
-/// Everything needed to run one value of a sweep or a map.
-pub struct PointRunner {
-    base: Config,
-    options: PointOptions,
-    mechanics_only: bool,
-}
-
-impl PointRunner {
-    /// A runner for the configuration `base`.
-    pub fn new(base: Config, run: &RunArgs) -> Result<Self> {
+impl RunArgs {
+    /// The point runner of these settings on `base`.
+    pub fn runner(&self, base: Config) -> Result<PointRunner> {
         let settings = base.run();
-        let transient = run.transient.unwrap_or(settings.transient());
-        let recorded = run.recorded.unwrap_or(settings.periods - settings.transient());
+        let transient = self.transient.unwrap_or(settings.transient());
+        let recorded = self.recorded.unwrap_or(settings.periods - settings.transient());
         if recorded == 0 {
             bail!("--recorded must be at least 1");
         }
-        if !(run.period_tolerance > 0.0 && run.period_tolerance < 1.0) {
+        if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
             bail!(
                 "--period-tolerance must lie in (0, 1), got {}",
-                run.period_tolerance
+                self.period_tolerance
             );
         }
-        Ok(PointRunner {
-            base,
-            options: PointOptions {
-                transient_periods: transient,
-                recorded_periods: recorded,
-                period_tolerance: run.period_tolerance,
-                ..PointOptions::default()
-            },
-            mechanics_only: run.mechanics_only,
-        })
-    }
-
-    /// The point options in use.
-    pub fn options(&self) -> &PointOptions {
-        &self.options
-    }
-
-    /// The base configuration.
-    pub fn base(&self) -> &Config {
-        &self.base
-    }
-
-    /// Number of masses of the chain (the same at every point: keys set numbers, not arrays).
-    pub fn masses(&self) -> usize {
-        self.base.chain().len()
-    }
-
-    /// The base configuration with `keys` set to `values` (validated).
-    fn configure(&self, keys: &[(&str, f64)]) -> Result<Config> {
-        let mut config = self.base.clone();
-        for (k, v) in keys {
-            config = crate::config::with(&config, k, *v)?;
-        }
-        Ok(config)
-    }
-
-    /// Checks every point of a grid (`keys` gives each point's settings); the error names
-    /// the first bad point.
-    pub fn check_all<'k, P>(&self, points: &[P], keys: impl Fn(&P) -> Vec<(&'k str, f64)>) -> Result<()> {
-        for p in points {
-            let k = keys(p);
-            self.configure(&k).with_context(|| {
-                k.iter()
-                    .map(|(key, v)| format!("{key} = {v}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            })?;
-        }
-        Ok(())
-    }
-
-    /// Runs the configuration with `keys` set to `values`, from `initial` (or the configured
-    /// initial state).
-    pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult> {
-        let config = self.configure(keys)?;
-        let params = config.chain();
-        let initial = match initial {
-            Some(s) if s.positions.len() == params.len() && params.validate_state(s).is_ok() => s,
-            _ => config.initial_state(),
+        let options = PointOptions {
+            transient_periods: transient,
+            recorded_periods: recorded,
+            period_tolerance: self.period_tolerance,
+            ..PointOptions::default()
         };
-        let harvester = (!self.mechanics_only).then(|| (config.harvester(), config.charge_options()));
-        Ok(run_point(
-            params,
-            initial,
-            config.sim_options(),
-            harvester,
-            &self.options,
-        )?)
+        Ok(PointRunner::new(base, options, self.mechanics_only))
     }
 }
 
-/// Runs `points` in parallel chunks, calling `write` with each point's result in grid order
-/// (so the output does not depend on the thread count) and with `None` after each chunk, and
-/// ticking a progress bar (label, points done before, points in all); stops after the
-/// current chunk on SIGINT/SIGTERM, keeping what was written. Returns how many were written.
-pub fn run_grid<'k, P, W>(
+/// Checks every point of a grid (`keys` gives each point's settings); the error names the
+/// first bad point.
+pub fn check_all<'k, P>(
+    runner: &PointRunner,
+    points: &[P],
+    keys: impl Fn(&P) -> Vec<(&'k str, f64)>,
+) -> Result<()> {
+    for p in points {
+        let k = keys(p);
+        runner.configure(&k).with_context(|| {
+            k.iter()
+                .map(|(key, v)| format!("{key} = {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })?;
+    }
+    Ok(())
+}
+
+/// Runs `points` in parallel chunks (see [`vibrotribo::sweep::run_grid`]), calling `write`
+/// with each point's result in grid order and with `None` after each chunk, ticking a
+/// progress bar (label, points done before, points in all) and stopping after the current
+/// chunk on SIGINT/SIGTERM, keeping what was written. Returns how many were written.
+pub fn run_points<'k, P, W>(
     runner: &PointRunner,
     points: &[P],
     keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
@@ -256,25 +179,30 @@ where
     W: FnMut(Option<(&P, &Result<PointResult, String>)>) -> Result<()>,
 {
     let progress = Progress::new(total, what, quiet).starting_at(before);
-    let chunk = rayon::current_num_threads() * 4;
-    let mut done = 0;
-    for block in points.chunks(chunk) {
-        let results: Vec<Result<PointResult, String>> = block
-            .par_iter()
-            .map(|p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")))
-            .collect();
-        for (p, r) in block.iter().zip(&results) {
-            write(Some((p, r)))?;
-            done += 1;
-            progress.inc(1);
+    let mut failure = None;
+    let done = run_grid(runner, points, keys, rayon::current_num_threads() * 4, |d| {
+        let (written, checkpoint) = match d {
+            Delivery::Point(p, r) => {
+                progress.inc(1);
+                (write(Some((p, &r.map_err(|e| format!("{e:#}"))))), false)
+            }
+            Delivery::Chunk(_) => (write(None), true),
+        };
+        if let Err(e) = written {
+            failure = Some(e);
+            return ControlFlow::Break(());
         }
-        write(None)?;
-        if interrupted() {
-            break;
+        if checkpoint && interrupted() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
         }
-    }
+    });
     progress.finish();
-    Ok(done)
+    match failure {
+        Some(e) => Err(e),
+        None => Ok(done),
+    }
 }
 
 /// Installs the worker-thread count (once per process).
@@ -434,12 +362,12 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
-    let runner = PointRunner::new(base, &args.run)?;
+    let runner = args.run.runner(base)?;
     let masses = runner.masses();
     let values = grid(args.from, args.to, args.steps);
     check_distinct("--from/--to/--steps", &values)?;
     // Fail early on a bad key or on any value of the grid that makes a bad configuration.
-    runner.check_all(&values, |&v| vec![(args.param.as_str(), v)])?;
+    check_all(&runner, &values, |&v| vec![(args.param.as_str(), v)])?;
     let mut order: Vec<usize> = (0..values.len()).collect();
     if args.continuation == Continuation::Down {
         order.reverse();
@@ -498,7 +426,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let key = args.param.as_str();
     let todo = &order[skip..];
     let computed = match args.continuation {
-        Continuation::None => run_grid(
+        Continuation::None => run_points(
             &runner,
             todo,
             |&j| vec![(key, values[j])],
@@ -516,26 +444,31 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         Continuation::Up | Continuation::Down => {
             let progress =
                 Progress::new(order.len() as u64, "values", args.run.quiet).starting_at(skip as u64);
-            let mut done = 0usize;
-            for &j in todo {
-                let r = runner
-                    .run(&[(key, values[j])], state.as_ref())
-                    .map_err(|e| format!("{e:#}"));
-                if let Ok(p) = &r {
-                    state = Some(p.final_state.clone());
-                }
+            let mut written = 0usize;
+            let mut failure = None;
+            let (done, _) = run_continued(&runner, key, &values, todo, state, |j, r, state| {
+                let r = r.map_err(|e| format!("{e:#}"));
                 failed += usize::from(r.is_err());
-                done += 1;
+                written += 1;
                 if let Some(o) = out.as_mut() {
-                    write_value(o, values[j], &r, contacts)?;
-                    o.checkpoint(skip + done, json!(state))?;
+                    let w = write_value(o, values[j], &r, contacts)
+                        .and_then(|()| o.checkpoint(skip + written, json!(state)));
+                    if let Err(e) = w {
+                        failure = Some(e);
+                        return Ok(ControlFlow::Break(()));
+                    }
                 }
                 progress.inc(1);
-                if interrupted() {
-                    break;
-                }
-            }
+                Ok(if interrupted() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                })
+            })?;
             progress.finish();
+            if let Some(e) = failure {
+                return Err(e);
+            }
             done
         }
     };

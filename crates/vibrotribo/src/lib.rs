@@ -45,6 +45,8 @@ pub mod model;
 pub mod orbits;
 pub mod sensitivity;
 pub mod study;
+#[cfg(feature = "config")]
+pub mod sweep;
 
 pub use nalgebra;
 

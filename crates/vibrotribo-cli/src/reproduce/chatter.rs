@@ -7,7 +7,7 @@ use super::draw::{d1_figures, impact_figure, lines, orbit_figure};
 use super::runs::{arr, config, describe_ranges, mean, run_series, sweep, with};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
-use crate::sweep::grid;
+use vibrotribo::sweep::grid;
 
 pub(super) fn figs_20_25(ctx: &mut Ctx) -> Result<()> {
     let base = config(&[

@@ -12,7 +12,8 @@ use super::runs::{arr, config, describe_ranges, f, run_series, sweep, with};
 use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
-use crate::sweep::{PointRunner, RunArgs, grid};
+use crate::sweep::RunArgs;
+use vibrotribo::sweep::grid;
 
 pub(super) fn fig_13(ctx: &mut Ctx) -> Result<()> {
     let mut images = Vec::new();
@@ -216,7 +217,7 @@ pub(super) fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     // Fig. 16: R_mo(Ω).
     let omegas = grid(0.55, 0.95, if ctx.quick { 5 } else { 9 });
     let ratios = grid(1.2, 7.0, if ctx.quick { 30 } else { 117 });
-    let runner = PointRunner::new(base.clone(), &ctx.run_args(false))?;
+    let runner = ctx.run_args(false).runner(base.clone())?;
     let pts: Vec<(f64, f64)> = omegas
         .iter()
         .flat_map(|&w| ratios.iter().map(move |&r| (w, r)))
@@ -228,7 +229,7 @@ pub(super) fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
                 .run(&[("omega_ratio", w), ("mass_ratio", r)], None)
                 .map(|p| p.average_power_w.unwrap_or(f64::NAN))
         })
-        .collect::<Result<_>>()?;
+        .collect::<Result<_, _>>()?;
     let opt = optima(&omegas, &ratios, &pw);
     let ws: Vec<f64> = opt.iter().map(|o| o.0).collect();
     let rs: Vec<f64> = opt.iter().map(|o| o.1).collect();
@@ -427,14 +428,12 @@ pub(super) fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         .collect();
     let doubling = !cascades.is_empty();
     // Fig. 19: Poincaré sections at R_m = 4.21.
-    let long = PointRunner::new(
-        base.clone(),
-        &RunArgs {
-            transient: Some(if ctx.quick { 300 } else { 1000 }),
-            recorded: Some(if ctx.quick { 300 } else { 2000 }),
-            ..ctx.run_args(true)
-        },
-    )?;
+    let long = (RunArgs {
+        transient: Some(if ctx.quick { 300 } else { 1000 }),
+        recorded: Some(if ctx.quick { 300 } else { 2000 }),
+        ..ctx.run_args(true)
+    })
+    .runner(base.clone())?;
     let p = long.run(&[("mass_ratio", 4.21)], None)?;
     let mut images = Vec::new();
     for i in 0..3 {

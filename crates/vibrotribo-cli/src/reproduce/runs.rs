@@ -11,7 +11,6 @@ use vibrotribo::{ChainParams, Event, EventKind, StateView};
 
 use super::context::Ctx;
 use crate::progress::check_interrupt;
-use crate::sweep::PointRunner;
 
 /// A configuration built from `sets` on top of the paper's defaults.
 pub(super) fn config(sets: &[(&str, Value)]) -> Result<Config> {
@@ -44,10 +43,10 @@ pub(super) fn sweep(
     values: &[f64],
     mechanics_only: bool,
 ) -> Result<Vec<PointResult>> {
-    let runner = PointRunner::new(base.clone(), &ctx.run_args(mechanics_only))?;
+    let runner = ctx.run_args(mechanics_only).runner(base.clone())?;
     let results: Vec<Result<PointResult>> = values
         .par_iter()
-        .map(|&v| runner.run(&[(key, v)], None))
+        .map(|&v| runner.run(&[(key, v)], None).map_err(anyhow::Error::from))
         .collect();
     check_interrupt(|| format!("during a sweep of {key}; REPORT.md is written only by a complete run"))?;
     let results: Vec<PointResult> = results

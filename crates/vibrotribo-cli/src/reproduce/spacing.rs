@@ -10,7 +10,8 @@ use super::draw::{closing_speeds, d1_figures, impact_figure, lines, orbit_figure
 use super::runs::{arr, config, f, mean, run_series, sweep, with};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
-use crate::sweep::{PointRunner, RunArgs, grid};
+use crate::sweep::RunArgs;
+use vibrotribo::sweep::grid;
 
 pub(super) fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     let base = config(&[
@@ -199,14 +200,12 @@ pub(super) fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     );
 
     // Fig. 10–11: four motions, long runs.
-    let long = PointRunner::new(
-        base.clone(),
-        &RunArgs {
-            transient: Some(if ctx.quick { 600 } else { 2000 }),
-            recorded: Some(256),
-            ..ctx.run_args(false)
-        },
-    )?;
+    let long = (RunArgs {
+        transient: Some(if ctx.quick { 600 } else { 2000 }),
+        recorded: Some(256),
+        ..ctx.run_args(false)
+    })
+    .runner(base.clone())?;
     let points = [
         (1.415, "periodic"),
         (1.423, "non-periodic"),
@@ -216,7 +215,7 @@ pub(super) fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     let res: Vec<PointResult> = points
         .par_iter()
         .map(|(r, _)| long.run(&[("gap_ratio", *r)], None))
-        .collect::<Result<_>>()?;
+        .collect::<Result<_, _>>()?;
     let mut images = Vec::new();
     let mut lines_text = Vec::new();
     let mut matches = 0;

@@ -1,0 +1,258 @@
+//! Parameter sweeps over a configuration's keys: the points of a grid, each a
+//! [`run_point`](crate::study::run_point) of the configuration with some keys set, run in
+//! parallel in chunks and delivered in grid order (so results do not depend on the thread
+//! count), or continued from one value to the next. The command line and the Python package
+//! both run their sweeps and maps through here.
+
+use std::ops::ControlFlow;
+
+use rayon::prelude::*;
+
+use crate::config::{Config, ConfigError};
+use crate::model::ChainState;
+use crate::study::{PointError, PointOptions, PointResult, run_point};
+
+/// How the points of a one-parameter sweep start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+pub enum Continuation {
+    /// Every value starts from the configured initial state; values run in parallel.
+    #[default]
+    None,
+    /// Values in increasing order, each starting from the previous one's final state.
+    Up,
+    /// Values in decreasing order, each starting from the previous one's final state.
+    Down,
+}
+
+impl std::str::FromStr for Continuation {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "none" => Ok(Continuation::None),
+            "up" => Ok(Continuation::Up),
+            "down" => Ok(Continuation::Down),
+            other => Err(format!(
+                "unknown continuation {other:?}: expected none, up or down"
+            )),
+        }
+    }
+}
+
+impl Continuation {
+    /// The name used on the command line and in files: `none`, `up`, `down`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Continuation::None => "none",
+            Continuation::Up => "up",
+            Continuation::Down => "down",
+        }
+    }
+}
+
+/// `steps` values equally spaced from `from` to `to` (both included; `to` exactly).
+pub fn grid(from: f64, to: f64, steps: usize) -> Vec<f64> {
+    match steps {
+        0 => Vec::new(),
+        1 => vec![from],
+        _ => (0..steps)
+            .map(|j| {
+                if j == steps - 1 {
+                    to
+                } else {
+                    from + (to - from) * j as f64 / (steps - 1) as f64
+                }
+            })
+            .collect(),
+    }
+}
+
+/// A sweep point could not be set up or failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SweepError {
+    /// Setting the point's keys gave a bad configuration.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The point's run failed.
+    #[error(transparent)]
+    Point(#[from] PointError),
+}
+
+/// Runs the points of a sweep or a map: the base configuration with keys set, condensed by
+/// [`run_point`].
+#[derive(Debug, Clone)]
+pub struct PointRunner {
+    base: Config,
+    options: PointOptions,
+    mechanics_only: bool,
+}
+
+impl PointRunner {
+    /// Points of `base` with `options` (transient, recorded periods, …); with the harvester
+    /// unless `mechanics_only`.
+    pub fn new(base: Config, options: PointOptions, mechanics_only: bool) -> Self {
+        PointRunner {
+            base,
+            options,
+            mechanics_only,
+        }
+    }
+
+    /// The point options in use.
+    pub fn options(&self) -> &PointOptions {
+        &self.options
+    }
+
+    /// The base configuration.
+    pub fn base(&self) -> &Config {
+        &self.base
+    }
+
+    /// Whether the harvester is left out.
+    pub fn mechanics_only(&self) -> bool {
+        self.mechanics_only
+    }
+
+    /// Number of masses of the chain (the same at every point: keys set numbers, not arrays).
+    pub fn masses(&self) -> usize {
+        self.base.chain().len()
+    }
+
+    /// The base configuration with each `(key, value)` of `keys` set (validated).
+    pub fn configure(&self, keys: &[(&str, f64)]) -> Result<Config, ConfigError> {
+        let mut config = self.base.clone();
+        config.set_all(keys.iter().map(|&(k, v)| (k, toml::Value::Float(v))))?;
+        Ok(config)
+    }
+
+    /// Runs the configuration with `keys` set, from `initial` (if it fits the chain) or the
+    /// configured initial state.
+    pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult, SweepError> {
+        let config = self.configure(keys)?;
+        let params = config.chain();
+        let initial = match initial {
+            Some(s) if s.positions.len() == params.len() && params.validate_state(s).is_ok() => s,
+            _ => config.initial_state(),
+        };
+        let harvester = (!self.mechanics_only).then(|| (config.harvester(), config.charge_options()));
+        Ok(run_point(
+            params,
+            initial,
+            config.sim_options(),
+            harvester,
+            &self.options,
+        )?)
+    }
+}
+
+/// What [`run_grid`] hands over, in grid order (handed over once, by value: its size does
+/// not matter).
+#[derive(Debug)]
+#[allow(clippy::large_enum_variant)]
+pub enum Delivery<'a, P> {
+    /// A point and its result.
+    Point(&'a P, Result<PointResult, SweepError>),
+    /// The end of a chunk, with the number of points delivered so far: a checkpoint.
+    Chunk(usize),
+}
+
+/// Runs `points` (each set up by `keys`) in parallel chunks of `chunk` points on the current
+/// rayon pool and hands each point's result to `on` in grid order, then the end of the chunk
+/// ([`Delivery::Chunk`]); `on` may stop the run (a progress bar, an interrupt, a file
+/// checkpoint, a failed write). Returns how many points were delivered.
+pub fn run_grid<'k, P, F>(
+    runner: &PointRunner,
+    points: &[P],
+    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
+    chunk: usize,
+    mut on: F,
+) -> usize
+where
+    P: Sync,
+    F: FnMut(Delivery<'_, P>) -> ControlFlow<()>,
+{
+    let mut done = 0;
+    for block in points.chunks(chunk.max(1)) {
+        let results: Vec<Result<PointResult, SweepError>> =
+            block.par_iter().map(|p| runner.run(&keys(p), None)).collect();
+        for (p, r) in block.iter().zip(results) {
+            done += 1;
+            if on(Delivery::Point(p, r)).is_break() {
+                return done;
+            }
+        }
+        if on(Delivery::Chunk(done)).is_break() {
+            break;
+        }
+    }
+    done
+}
+
+/// Runs the values `order` (indices into `values`) of `key` one after the other, each from the
+/// previous one's final state (`state` to start with; a failed point passes the state it
+/// got on), calling `deliver` with each result and its final state, and stopping when it
+/// says so. Returns how many were delivered and the last final state.
+pub fn run_continued<D>(
+    runner: &PointRunner,
+    key: &str,
+    values: &[f64],
+    order: &[usize],
+    mut state: Option<ChainState>,
+    mut deliver: D,
+) -> Result<(usize, Option<ChainState>), SweepError>
+where
+    D: FnMut(
+        usize,
+        Result<PointResult, SweepError>,
+        Option<&ChainState>,
+    ) -> Result<ControlFlow<()>, SweepError>,
+{
+    let mut done = 0;
+    for &j in order {
+        let r = runner.run(&[(key, values[j])], state.as_ref());
+        if let Ok(p) = &r {
+            state = Some(p.final_state.clone());
+        }
+        done += 1;
+        if deliver(j, r, state.as_ref())?.is_break() {
+            break;
+        }
+    }
+    Ok((done, state))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grids_end_exactly() {
+        assert_eq!(grid(0.5, 0.9, 1), vec![0.5]);
+        let g = grid(0.55, 0.95, 24);
+        assert_eq!(g.len(), 24);
+        assert_eq!(g[23], 0.95);
+        assert!(grid(1.0, 2.0, 0).is_empty());
+    }
+
+    /// A point run through the runner is the same as a simulation of the configuration with
+    /// the key set, and runs from rest unless given a state.
+    #[test]
+    fn points_follow_their_configuration() {
+        let options = PointOptions {
+            transient_periods: 20,
+            recorded_periods: 10,
+            ..PointOptions::default()
+        };
+        let runner = PointRunner::new(Config::default(), options.clone(), true);
+        let p = runner.run(&[("omega_ratio", 0.75)], None).unwrap();
+        let c = Config::default()
+            .with("excitation.omega_ratio", 0.75.into())
+            .unwrap();
+        let q = run_point(c.chain(), c.initial_state(), c.sim_options(), None, &options).unwrap();
+        assert_eq!(p, q);
+        let e = runner.run(&[("omega_ratio", -1.0)], None).unwrap_err();
+        assert!(e.to_string().contains("excitation.omega_ratio"), "{e}");
+    }
+}
