@@ -2,12 +2,14 @@
 //! files and plots. All physics lives in the `vibrotribo` library.
 
 mod config;
+mod continuation;
 mod export_spice;
 mod job;
 mod limits;
 mod load_sweep;
 mod map;
 mod output;
+mod periodic;
 mod plot;
 mod plots;
 mod progress;
@@ -35,6 +37,10 @@ enum Command {
     LoadSweep(load_sweep::LoadSweepArgs),
     /// Write an ngspice netlist of a run's harvester driven by its gap waveforms.
     ExportSpice(export_spice::ExportSpiceArgs),
+    /// The periodic orbit near a run, by shooting: Floquet multipliers, stability, power.
+    Periodic(periodic::PeriodicArgs),
+    /// Follow a periodic orbit in a parameter: stability, bifurcations, power along the branch.
+    Continue(continuation::ContinueArgs),
     /// Sweep one parameter: orbit diagram, impact velocities, period, power.
     Sweep(sweep::SweepArgs),
     /// Combine the shards of one sweep (`sweep --shard I/N`) into the unsharded output.
@@ -67,6 +73,8 @@ fn run() -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&args),
         Command::LoadSweep(args) => load_sweep::run(&args),
         Command::ExportSpice(args) => export_spice::run(&args),
+        Command::Periodic(args) => periodic::run(&args),
+        Command::Continue(args) => continuation::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => sweep::merge(&args),
         Command::Map(args) => map::run(&args),

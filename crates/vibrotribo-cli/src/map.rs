@@ -12,12 +12,12 @@ use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::limits;
-use crate::output::{CsvFile, create_dir, point_cells, point_columns, write_json};
+use crate::output::{CsvFile, PointColumns, create_dir, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
 use crate::sweep::{
     MergeArgs, RunArgs, Shard, check_all, check_distinct, estimate_point_memory, estimate_point_output,
-    header_len, run_points, set_threads,
+    floquet_of, header_len, point_columns, run_points, set_threads,
 };
 use vibrotribo::sweep::grid;
 
@@ -78,9 +78,9 @@ fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
 }
 
 /// Files of a map directory: `map.csv` (one row per point) and the manifest `map.json`.
-fn map_layout(contacts: usize) -> Layout {
+fn map_layout(columns: PointColumns) -> Layout {
     let mut cols = vec!["x".to_string(), "y".to_string()];
-    cols.extend(point_columns(contacts));
+    cols.extend(columns.names());
     Layout {
         manifest: "map.json",
         files: vec![CsvSpec {
@@ -146,9 +146,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
             args.run.allow_large,
         )?;
     }
-    let contacts = runner.masses() - 1;
+    let columns = point_columns(runner.masses(), runner.options().floquet);
     let o = runner.options();
-    let settings = json!({
+    let mut settings = json!({
         "command": "map",
         "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": args.x_steps, "values": xs},
         "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": args.y_steps, "values": ys},
@@ -159,14 +159,17 @@ pub fn run(args: &MapArgs) -> Result<()> {
         "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
         "settings": runner.base().table(),
     });
+    if o.floquet {
+        settings["floquet"] = json!(true);
+    }
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
         Some(dir) if args.resume => {
-            let (o, done) = GridOutput::resume(dir, map_layout(contacts), settings, &keys, keys.len())?;
+            let (o, done) = GridOutput::resume(dir, map_layout(columns), settings, &keys, keys.len())?;
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, map_layout(contacts), settings)?), 0),
+        Some(dir) => (Some(GridOutput::create(dir, map_layout(columns), settings)?), 0),
     };
     let started = Instant::now();
     let (xk, yk) = (args.x.as_str(), args.y.as_str());
@@ -182,7 +185,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
                 return out.commit();
             };
             let mut row = vec![x.to_string(), y.to_string()];
-            row.extend(point_cells(r, contacts));
+            row.extend(columns.cells(r));
             out.row(0, row)
         },
     )?;
@@ -225,8 +228,10 @@ pub fn run(args: &MapArgs) -> Result<()> {
 
 /// Merges the shards of a map (`vibrotribo merge`).
 pub fn merge(args: &MergeArgs) -> Result<()> {
-    // map.csv: x, y, then the point columns: 7 and one per contact.
-    let contacts = header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2 + 7);
+    // map.csv: x, y, then the point columns: 7, one per contact, and the Floquet column.
+    let floquet = floquet_of(&args.shards[0], "map.json")?;
+    let contacts = header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2 + 7 + usize::from(floquet));
+    let columns = PointColumns { contacts, floquet };
     let keys = |m: &serde_json::Value| -> Result<Vec<String>> {
         let axis = |a: &str| -> Result<Vec<f64>> {
             m[a]["values"]
@@ -244,7 +249,7 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
             .map(point_key)
             .collect())
     };
-    crate::job::merge(&args.shards, &args.out, &map_layout(contacts), keys)
+    crate::job::merge(&args.shards, &args.out, &map_layout(columns), keys)
 }
 
 /// Options of `vibrotribo optimize-mass-ratio`.
@@ -416,7 +421,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             index += 1;
             if let Some(csv) = grid_csv.as_mut() {
                 // Of the point's columns: average_power_w, impacts_per_period, period, error.
-                let mut cells = point_cells(res, contacts);
+                let mut cells = point_columns(contacts + 1, false).cells(res);
                 let error = cells.pop().unwrap_or_default();
                 cells.truncate(3);
                 csv.row(

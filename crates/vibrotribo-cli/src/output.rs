@@ -218,45 +218,69 @@ pub fn si(value: f64, unit: &str) -> String {
 
 /// The columns describing one sweep or map point, after its key columns: `average_power_w`,
 /// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
-/// `impacts_per_period_1..contacts`, `error`.
-pub fn point_columns(contacts: usize) -> Vec<String> {
-    let mut cols: Vec<String> = [
-        "average_power_w",
-        "impacts_per_period",
-        "period",
-        "chatter",
-        "sticking",
-        "grazing",
-    ]
-    .map(String::from)
-    .to_vec();
-    cols.extend(numbered("impacts_per_period_", contacts, ""));
-    cols.push("error".into());
-    cols
+/// `impacts_per_period_1..contacts`, `error`, and with `floquet` `max_abs_multiplier`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointColumns {
+    /// Contacts of the chain (N − 1).
+    pub contacts: usize,
+    /// Whether the largest Floquet multiplier modulus is a column (`--floquet`).
+    pub floquet: bool,
 }
 
-/// The cells of [`point_columns`] for one point: its results, or blanks and the reason it
-/// failed. `error` also holds an electrical failure of a point whose mechanics succeeded.
-pub fn point_cells(result: &Result<PointResult, String>, contacts: usize) -> Vec<String> {
-    match result {
-        Ok(p) => {
-            let mut row = vec![
-                p.average_power_w.map_or(String::new(), |v| v.to_string()),
-                p.total_impacts_per_period().to_string(),
-                p.period().to_string(),
-                p.chatter.to_string(),
-                p.sticking.to_string(),
-                p.grazing.to_string(),
-            ];
-            row.extend(p.impacts_per_period.iter().map(f64::to_string));
-            row.push(p.electrical_error.as_deref().map_or(String::new(), csv_text));
-            row
+impl PointColumns {
+    /// The column names.
+    pub fn names(&self) -> Vec<String> {
+        let mut cols: Vec<String> = [
+            "average_power_w",
+            "impacts_per_period",
+            "period",
+            "chatter",
+            "sticking",
+            "grazing",
+        ]
+        .map(String::from)
+        .to_vec();
+        cols.extend(numbered("impacts_per_period_", self.contacts, ""));
+        cols.push("error".into());
+        if self.floquet {
+            cols.push("max_abs_multiplier".into());
         }
-        Err(e) => {
-            let mut row = vec![String::new(); 6 + contacts];
-            row.push(csv_text(e));
-            row
+        cols
+    }
+
+    /// The cells for one point: its results, or blanks and the reason it failed. `error`
+    /// also holds an electrical failure of a point whose mechanics succeeded;
+    /// `max_abs_multiplier` is blank where shooting failed or no period was detected.
+    pub fn cells(&self, result: &Result<PointResult, String>) -> Vec<String> {
+        let mut row = match result {
+            Ok(p) => {
+                let mut row = vec![
+                    p.average_power_w.map_or(String::new(), |v| v.to_string()),
+                    p.total_impacts_per_period().to_string(),
+                    p.period().to_string(),
+                    p.chatter.to_string(),
+                    p.sticking.to_string(),
+                    p.grazing.to_string(),
+                ];
+                row.extend(p.impacts_per_period.iter().map(f64::to_string));
+                row.push(p.electrical_error.as_deref().map_or(String::new(), csv_text));
+                row
+            }
+            Err(e) => {
+                let mut row = vec![String::new(); 6 + self.contacts];
+                row.push(csv_text(e));
+                row
+            }
+        };
+        if self.floquet {
+            let m = result
+                .as_ref()
+                .ok()
+                .and_then(|p| p.max_abs_multiplier.as_ref())
+                .and_then(|m| m.as_ref().ok());
+            row.push(m.map_or(String::new(), f64::to_string));
         }
+        row
     }
 }
 

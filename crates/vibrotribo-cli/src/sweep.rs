@@ -15,7 +15,7 @@ use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_continued
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::limits;
-use crate::output::{numbered, point_cells, point_columns};
+use crate::output::{PointColumns, numbered};
 use crate::progress::{Interrupted, Progress, interrupted};
 
 /// `I/N`: the I-th (0-based) of N interleaved slices of the grid.
@@ -66,6 +66,10 @@ pub struct RunArgs {
     /// Relative tolerance of the period detection.
     #[arg(long, default_value_t = 1e-4)]
     pub period_tolerance: f64,
+    /// Also find the periodic orbit of each point's detected period by shooting and write
+    /// its largest Floquet multiplier modulus (column `max_abs_multiplier`; < 1: stable).
+    #[arg(long)]
+    pub floquet: bool,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -137,6 +141,7 @@ impl RunArgs {
             transient_periods: transient,
             recorded_periods: recorded,
             period_tolerance: self.period_tolerance,
+            floquet: self.floquet,
             ..PointOptions::default()
         };
         Ok(PointRunner::new(base, options, self.mechanics_only))
@@ -221,11 +226,11 @@ pub fn set_threads(threads: Option<usize>) -> Result<()> {
 
 /// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
 /// one row per value) and the manifest `sweep.json`.
-fn sweep_layout(masses: usize) -> Layout {
+fn sweep_layout(masses: usize, floquet: bool) -> Layout {
     let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
     orbit_cols.extend(numbered("x", masses, "_m"));
     let mut summary_cols = vec!["param".to_string()];
-    summary_cols.extend(point_columns(masses - 1));
+    summary_cols.extend(point_columns(masses, floquet).names());
     Layout {
         manifest: "sweep.json",
         files: vec![
@@ -254,11 +259,11 @@ fn write_value(
     out: &mut GridOutput,
     value: f64,
     result: &Result<PointResult, String>,
-    contacts: usize,
+    columns: PointColumns,
 ) -> Result<()> {
     let p = value.to_string();
     if let Ok(r) = result {
-        let n = contacts + 1;
+        let n = columns.contacts + 1;
         for (j, &period) in r.strobe_periods.iter().enumerate() {
             let mut row = vec![p.clone(), period.to_string()];
             row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
@@ -277,8 +282,16 @@ fn write_value(
         }
     }
     let mut row = vec![p];
-    row.extend(point_cells(result, contacts));
+    row.extend(columns.cells(result));
     out.row(2, row)
+}
+
+/// The point columns of a chain of `masses` masses.
+pub fn point_columns(masses: usize, floquet: bool) -> PointColumns {
+    PointColumns {
+        contacts: masses - 1,
+        floquet,
+    }
 }
 
 /// The settings a sweep records in `sweep.json` (everything that determines its output).
@@ -289,7 +302,7 @@ fn settings_json(
     shard: Option<Shard>,
 ) -> serde_json::Value {
     let o = runner.options();
-    json!({
+    let mut settings = json!({
         "command": "sweep",
         "param": args.param,
         "from": args.from,
@@ -307,7 +320,11 @@ fn settings_json(
         "shard": shard.map(|s| json!({"index": s.index, "count": s.count})),
         "settings": runner.base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),
-    })
+    });
+    if o.floquet {
+        settings["floquet"] = json!(true);
+    }
+    settings
 }
 
 /// Checks that a grid's values are distinct: rows are keyed by their value.
@@ -405,7 +422,13 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             } else {
                 order.len()
             };
-            let (o, done) = GridOutput::resume(dir, sweep_layout(masses), settings, &keys, keep)?;
+            let (o, done) = GridOutput::resume(
+                dir,
+                sweep_layout(masses, runner.options().floquet),
+                settings,
+                &keys,
+                keep,
+            )?;
             if let Some((n, s)) = checkpoint.filter(|c| c.0 == done && done > 0) {
                 state = Some(serde_json::from_value(s).map_err(|e| {
                     anyhow!(
@@ -418,11 +441,18 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             }
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, sweep_layout(masses), settings)?), 0),
+        Some(dir) => (
+            Some(GridOutput::create(
+                dir,
+                sweep_layout(masses, runner.options().floquet),
+                settings,
+            )?),
+            0,
+        ),
     };
     let started = Instant::now();
     let mut failed = 0usize;
-    let contacts = masses - 1;
+    let columns = point_columns(masses, runner.options().floquet);
     let key = args.param.as_str();
     let todo = &order[skip..];
     let computed = match args.continuation {
@@ -435,7 +465,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             |point| match (point, out.as_mut()) {
                 (Some((&j, r)), o) => {
                     failed += usize::from(r.is_err());
-                    o.map_or(Ok(()), |o| write_value(o, values[j], r, contacts))
+                    o.map_or(Ok(()), |o| write_value(o, values[j], r, columns))
                 }
                 (None, Some(o)) => o.commit(),
                 (None, None) => Ok(()),
@@ -451,7 +481,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
                 failed += usize::from(r.is_err());
                 written += 1;
                 if let Some(o) = out.as_mut() {
-                    let w = write_value(o, values[j], &r, contacts)
+                    let w = write_value(o, values[j], &r, columns)
                         .and_then(|()| o.checkpoint(skip + written, json!(state)));
                     if let Err(e) = w {
                         failure = Some(e);
@@ -548,10 +578,21 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     } else {
         // orbit.csv: param, period, x1_m, …, xN_m.
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
-        crate::job::merge(&args.shards, &args.out, &sweep_layout(masses), sweep_keys)?;
+        let floquet = floquet_of(first, "sweep.json")?;
+        crate::job::merge(
+            &args.shards,
+            &args.out,
+            &sweep_layout(masses, floquet),
+            sweep_keys,
+        )?;
     }
     println!("merged {} shards into {}", args.shards.len(), args.out.display());
     Ok(())
+}
+
+/// Whether the job in `dir` (manifest `manifest`) has the Floquet column.
+pub fn floquet_of(dir: &Path, manifest: &str) -> Result<bool> {
+    Ok(crate::output::read_json(&dir.join(manifest))?["floquet"].as_bool() == Some(true))
 }
 
 /// The number of columns of the CSV file `path` (from its header).

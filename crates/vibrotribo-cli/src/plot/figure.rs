@@ -119,6 +119,10 @@ pub struct Series<'a> {
     pub x: &'a [f64],
     /// Vertical coordinates (same length as `x`).
     pub y: &'a [f64],
+    /// As a line: dashed instead of solid.
+    pub dashed: bool,
+    /// Colour: an index into the palette; `None` (default) takes the series' position.
+    pub colour: Option<usize>,
 }
 
 impl<'a> Series<'a> {
@@ -128,13 +132,51 @@ impl<'a> Series<'a> {
             label: Some(label),
             x,
             y,
+            dashed: false,
+            colour: None,
         }
     }
 
     /// A series without a legend entry.
     pub fn unlabelled(x: &'a [f64], y: &'a [f64]) -> Self {
-        Series { label: None, x, y }
+        Series {
+            label: None,
+            x,
+            y,
+            dashed: false,
+            colour: None,
+        }
     }
+
+    /// The same series drawn dashed (as a line).
+    pub fn dashed(self) -> Self {
+        Series { dashed: true, ..self }
+    }
+
+    /// The same series in palette colour `index` (0 blue, 1 orange, 2 green, 3 red, …).
+    pub fn colour(self, index: usize) -> Self {
+        Series {
+            colour: Some(index),
+            ..self
+        }
+    }
+}
+
+/// Lines (solid or dashed) with marks of `marker_px` pixels on top, each series in its
+/// colour: e.g. branches of periodic orbits over an orbit diagram.
+pub fn lines_and_points(
+    path: &Path,
+    figure: &Figure,
+    lines: &[Series<'_>],
+    points: &[Series<'_>],
+    marker_px: u32,
+) -> Result<()> {
+    let layers = Layers {
+        lines,
+        points,
+        marker_px,
+    };
+    write(path, figure.size, &xy_chart(figure, layers)?)
 }
 
 /// Lines through each series, one colour per series.

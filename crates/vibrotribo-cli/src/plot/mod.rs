@@ -22,4 +22,7 @@ mod heat;
 mod tests;
 mod xy;
 
-pub use figure::{Figure, HeatMap, Legend, Scale, Series, heat_map, line_plot, phase_portrait, scatter_plot};
+pub use figure::{
+    Figure, HeatMap, Legend, Scale, Series, heat_map, line_plot, lines_and_points, phase_portrait,
+    scatter_plot,
+};

@@ -297,3 +297,18 @@ fn tick_labels_are_compact() {
     assert_eq!(tick_label(2.5e-6), "2.5e-6");
     assert_eq!(tick_label(1.2e6), "1.2e6");
 }
+
+#[test]
+fn dashes_cover_the_line_in_alternating_pieces() {
+    use super::xy::dashes;
+    // A straight line of 100 px: dashes of 9 px with gaps of 6 px, the first from the start.
+    let pieces = dashes(&[(0, 0), (100, 0)], 9.0, 6.0);
+    assert_eq!(pieces.len(), 7, "{pieces:?}");
+    assert_eq!(pieces[0], vec![(0, 0), (9, 0)]);
+    assert_eq!(pieces[1], vec![(15, 0), (24, 0)]);
+    let drawn: i32 = pieces.iter().map(|p| p.last().unwrap().0 - p[0].0).sum();
+    assert_eq!(drawn, 7 * 9);
+    // The pattern runs on across a corner.
+    let corner = dashes(&[(0, 0), (5, 0), (5, 10)], 9.0, 6.0);
+    assert_eq!(corner[0], vec![(0, 0), (5, 0), (5, 4)]);
+}

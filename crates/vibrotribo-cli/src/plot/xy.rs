@@ -311,7 +311,7 @@ where
     let log_y = figure.y_scale == Scale::Log;
     let usable = |x: f64, y: f64| x.is_finite() && y.is_finite() && (!log_y || y > 0.0);
     for (i, s) in layers.lines.iter().enumerate() {
-        let colour = PALETTE[i % PALETTE.len()];
+        let colour = PALETTE[s.colour.unwrap_or(i) % PALETTE.len()];
         // One polyline per run of usable points, in pixels of the plotting area, thinned
         // to points at least 2 px apart (the last point of a run is always kept): dense
         // series draw as clean lines and stay small in SVG, at a visual error under 2 px.
@@ -339,7 +339,13 @@ where
         }
         runs.last_mut().expect("runs is never empty").extend(pending);
         let (w, h) = plot.dim_in_pixel();
-        for run in runs.iter().flat_map(|r| clip_polyline(r, w as i32, h as i32)) {
+        let clipped = runs.iter().flat_map(|r| clip_polyline(r, w as i32, h as i32));
+        let pieces: Vec<Vec<(i32, i32)>> = if s.dashed {
+            clipped.flat_map(|r| dashes(&r, DASH_ON, DASH_OFF)).collect()
+        } else {
+            clipped.collect()
+        };
+        for run in pieces {
             match format {
                 Format::Svg => plot
                     .draw(&PathElement::new(run, colour.stroke_width(2)))
@@ -375,10 +381,10 @@ where
     let mut occupied = vec![false; width * height];
     let half = (layers.marker_px.max(1) as i32 - 1) / 2;
     for (i, s) in layers.points.iter().enumerate() {
-        let colour = if layers.lines.is_empty() {
-            PALETTE[i % PALETTE.len()]
-        } else {
-            BLACK
+        let colour = match s.colour {
+            Some(c) => PALETTE[c % PALETTE.len()],
+            None if layers.lines.is_empty() => PALETTE[i % PALETTE.len()],
+            None => BLACK,
         };
         occupied.iter_mut().for_each(|o| *o = false);
         for (&px, &py) in s.x.iter().zip(s.y) {
@@ -436,6 +442,7 @@ where
 
 /// The visible pieces of a polyline inside the rectangle `[0, w) × [0, h)` (drawing areas
 /// clamp points outside to their edge, which would draw false lines along it).
+/// (See also [`dashes`].)
 pub(super) fn clip_polyline(points: &[(i32, i32)], w: i32, h: i32) -> Vec<Vec<(i32, i32)>> {
     let mut pieces: Vec<Vec<(i32, i32)>> = Vec::new();
     if let [only] = points {
@@ -484,4 +491,55 @@ pub(super) fn clip_segment(a: (i32, i32), b: (i32, i32), w: i32, h: i32) -> Opti
         if t0 > 0.0 { at(t0) } else { a },
         if t1 < 1.0 { at(t1) } else { b },
     ))
+}
+
+/// Dash length of a dashed line, pixels.
+const DASH_ON: f64 = 9.0;
+/// Gap between dashes, pixels.
+const DASH_OFF: f64 = 6.0;
+
+/// The pieces of the polyline `run` (pixels) drawn as dashes `on` long with gaps `off`,
+/// measured along its length.
+pub(super) fn dashes(run: &[(i32, i32)], on: f64, off: f64) -> Vec<Vec<(i32, i32)>> {
+    let mut out = Vec::new();
+    let mut current: Vec<(i32, i32)> = Vec::new();
+    // Position within the dash pattern, pixels, and whether the pen is down.
+    let (mut along, mut down) = (0.0f64, true);
+    if let Some(&first) = run.first() {
+        current.push(first);
+    }
+    for pair in run.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let (dx, dy) = (f64::from(b.0 - a.0), f64::from(b.1 - a.1));
+        let length = dx.hypot(dy);
+        let mut done = 0.0;
+        while length - done > 1e-9 {
+            let left = if down { on } else { off } - along;
+            let step = left.min(length - done);
+            done += step;
+            along += step;
+            let p = (
+                a.0 + (dx * done / length).round() as i32,
+                a.1 + (dy * done / length).round() as i32,
+            );
+            if down {
+                current.push(p);
+            }
+            if along >= if down { on } else { off } - 1e-9 {
+                along = 0.0;
+                if down && current.len() > 1 {
+                    out.push(std::mem::take(&mut current));
+                }
+                current.clear();
+                down = !down;
+                if down {
+                    current.push(p);
+                }
+            }
+        }
+    }
+    if down && current.len() > 1 {
+        out.push(current);
+    }
+    out
 }

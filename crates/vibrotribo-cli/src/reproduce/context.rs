@@ -104,6 +104,7 @@ impl Ctx {
             recorded: Some(self.budget.recorded),
             mechanics_only,
             period_tolerance: 1e-4,
+            floquet: false,
             threads: None,
             quiet: true,
             allow_large: false,

@@ -1,17 +1,19 @@
 //! The run layer: one entry point, [`simulate`], that takes a chain, an optional harvester,
 //! numerical options and observers and returns typed results; and the studies built on it
-//! (a sweep point, [`run_point`]).
+//! (a sweep point, [`run_point`]; the power on a periodic orbit, [`power_on_orbit`]).
 //!
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
 mod observer;
+mod orbit;
 mod point;
 mod replay;
 mod settings;
 mod simulate;
 
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
+pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use settings::{ElectricalFailure, Harvester, RunSettings, RunSpec, Sampling};

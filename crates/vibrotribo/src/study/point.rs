@@ -19,6 +19,7 @@ use crate::dynamics::{Event, EventKind, Observer, StateView};
 use crate::electrical::{ChargeOptions, HarvesterParams};
 use crate::error::SimError;
 use crate::model::{ChainParams, ChainState, SimOptions};
+use crate::orbits::{ShootingOptions, find_periodic_orbit};
 
 /// Settings of [`run_point`].
 #[derive(Debug, Clone, PartialEq)]
@@ -38,6 +39,10 @@ pub struct PointOptions {
     /// electrostatic equilibrium (the circuit forgets its initial charge within a few R·C,
     /// far less than this for all but extreme loads). Default 20.
     pub electrical_warmup_periods: u64,
+    /// Also find the periodic orbit of the detected period by shooting from the final state
+    /// and report its largest Floquet multiplier modulus
+    /// ([`PointResult::max_abs_multiplier`]). Default false.
+    pub floquet: bool,
 }
 
 impl Default for PointOptions {
@@ -48,6 +53,7 @@ impl Default for PointOptions {
             period_tolerance: 1e-4,
             grazing_ratio: 1e-3,
             electrical_warmup_periods: 20,
+            floquet: false,
         }
     }
 }
@@ -106,6 +112,10 @@ pub struct PointResult {
     pub electrical_error: Option<String>,
     /// State at the end of the run (t = (transient + recorded)·T).
     pub final_state: ChainState,
+    /// With [`PointOptions::floquet`] and a detected period: the largest modulus of the
+    /// Floquet multipliers of the periodic orbit of that period found by shooting from the
+    /// final state (`Err` with the reason where shooting failed, e.g. at a grazing point).
+    pub max_abs_multiplier: Option<Result<f64, String>>,
 }
 
 impl PointResult {
@@ -256,6 +266,20 @@ pub fn run_point(
         None
     };
     let stats = &outcome.stats;
+    let period = periodicity.and_then(|p| p.period()).unwrap_or(0);
+    let max_abs_multiplier = (options.floquet && period > 0).then(|| {
+        find_periodic_orbit(
+            params,
+            &outcome.final_state,
+            period as u32,
+            &ShootingOptions {
+                sim: sim_options.clone(),
+                ..ShootingOptions::default()
+            },
+        )
+        .map(|o| o.spectral_radius())
+        .map_err(|e| e.to_string())
+    });
     Ok(PointResult {
         strobe_periods: strobe.indices,
         strobe: strobe.positions,
@@ -268,6 +292,7 @@ pub fn run_point(
         average_power_w,
         electrical_error,
         final_state: outcome.final_state,
+        max_abs_multiplier,
     })
 }
 

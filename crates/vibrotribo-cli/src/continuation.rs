@@ -1,0 +1,532 @@
+//! `vibrotribo continue`: a periodic orbit followed in a parameter by pseudo-arclength
+//! continuation ([`vibrotribo::orbits::continue_orbit`]), with its stability, the
+//! bifurcations located on the way (folds, period doublings followed onto the doubled
+//! branch, Neimark–Sacker, grazing, sticking), and the power along the branches.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use serde_json::json;
+use vibrotribo::config::Config;
+use vibrotribo::orbits::{
+    Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions, ShootingOptions,
+    continue_orbit, periodic_orbit_from_transient,
+};
+use vibrotribo::study::{Harvester, PointOptions, power_on_periodic_state};
+use vibrotribo::sweep::{PointRunner, grid};
+use vibrotribo::{ChainParams, ChainState, Simulator};
+
+use crate::config::ConfigArgs;
+use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
+use crate::plot::{self, Figure, Legend, Series};
+use crate::plots::both;
+
+/// Options of `vibrotribo continue`.
+#[derive(Debug, clap::Args)]
+pub struct ContinueArgs {
+    #[command(flatten)]
+    pub input: ConfigArgs,
+    /// The parameter: any key `sweep --param` accepts (`omega_ratio`, `mass_ratio`,
+    /// `gap_ratio`, `excitation.amplitude`, …).
+    #[arg(long)]
+    pub param: String,
+    /// Start of the branch: the orbit found there.
+    #[arg(long, allow_negative_numbers = true)]
+    pub from: f64,
+    /// The other end of the range.
+    #[arg(long, allow_negative_numbers = true)]
+    pub to: f64,
+    /// Period of the first orbit, in excitation periods (default: detected after the
+    /// transient).
+    #[arg(long)]
+    pub period: Option<u32>,
+    /// Periods simulated at `--from` from the configured initial state before shooting.
+    #[arg(long, default_value_t = 200)]
+    pub transient: u32,
+    /// Period doublings followed onto the doubled branch (a cascade P → 2P → 4P … this deep).
+    #[arg(long, default_value_t = 3)]
+    pub doublings: u32,
+    /// Most points per branch.
+    #[arg(long, default_value_t = 2000)]
+    pub max_points: usize,
+    /// Mechanics only: no power along the branches.
+    #[arg(long)]
+    pub mechanics_only: bool,
+    /// Write branch.csv, bifurcations.csv and continue.json to this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also draw the branches over a brute-force orbit diagram (needs --out).
+    #[arg(long)]
+    pub plot: bool,
+    /// Values of the brute-force orbit diagram drawn under the branches with --plot.
+    #[arg(long, default_value_t = 200)]
+    pub diagram_steps: usize,
+    /// The mass shown in the plot (1-based).
+    #[arg(long, default_value_t = 2)]
+    pub mass: usize,
+}
+
+/// Repetitions of an orbit the charge solver warms up over, and averages over.
+const POWER_WARMUP: u32 = 2;
+const POWER_PERIODS: u32 = 2;
+
+/// Runs `vibrotribo continue`.
+pub fn run(args: &ContinueArgs) -> Result<()> {
+    if args.plot && args.out.is_none() {
+        bail!("--plot needs --out DIR");
+    }
+    if args.period == Some(0) {
+        bail!("--period must be at least 1");
+    }
+    if !(args.from.is_finite() && args.to.is_finite()) || args.from == args.to {
+        bail!("--from and --to must be finite and different");
+    }
+    let config = args.input.load()?;
+    if args.mass == 0 || args.mass > config.chain().len() {
+        bail!("--mass must be between 1 and {}", config.chain().len());
+    }
+    let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
+    let at = |p: f64| -> Result<Config> {
+        crate::config::with(&config, &args.param, p).with_context(|| format!("{} = {p}", args.param))
+    };
+    // Both ends must make valid chains; the family stays between them.
+    let start = at(args.from)?;
+    at(args.to)?;
+    let base_chain = start.chain();
+    let family = |p: f64| -> ChainParams {
+        at(p.clamp(lo, hi)).map_or_else(|_| base_chain.clone(), |c| c.chain().clone())
+    };
+    let shooting = ShootingOptions {
+        sim: config.sim_options().clone(),
+        ..ShootingOptions::default()
+    };
+    let first = periodic_orbit_from_transient(
+        start.chain(),
+        start.initial_state(),
+        args.transient,
+        args.period,
+        &shooting,
+    )
+    .with_context(|| format!("no periodic orbit found at {} = {}", args.param, args.from))?;
+    let options = ContinuationOptions {
+        doubling_depth: args.doublings,
+        max_points: args.max_points,
+        shooting,
+        ..ContinuationOptions::default()
+    };
+    let result = continue_orbit(
+        &args.param,
+        family,
+        args.from,
+        args.to,
+        &first.state,
+        first.period,
+        &options,
+    )?;
+    let power = if args.mechanics_only {
+        None
+    } else {
+        let h = Harvester::new(config.harvester().clone(), config.charge_options().clone());
+        Some(branch_powers(&result, &family, &h, &config)?)
+    };
+    print_continuation(&args.param, &result);
+    if let Some(dir) = &args.out {
+        create_dir(dir)?;
+        write_files(dir, &config, args, &result, power.as_deref())?;
+        if args.plot {
+            plot_branches(dir, &config, args, &result, &family)?;
+        }
+        println!(
+            "  wrote {0}/branch.csv, {0}/bifurcations.csv, {0}/continue.json",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// The average power on every point of every branch (NaN where the charge solver failed).
+fn branch_powers(
+    result: &Continuation,
+    family: &impl Fn(f64) -> ChainParams,
+    harvester: &Harvester,
+    config: &Config,
+) -> Result<Vec<Vec<f64>>> {
+    Ok(result
+        .branches
+        .iter()
+        .map(|b| {
+            b.points
+                .iter()
+                .map(|p| {
+                    power_on_periodic_state(
+                        &family(p.parameter),
+                        &p.state,
+                        b.period,
+                        harvester,
+                        config.sim_options(),
+                        POWER_WARMUP,
+                        POWER_PERIODS,
+                    )
+                    .ok()
+                    .and_then(|e| e.power.map(|s| s.average_power_w))
+                    .unwrap_or(f64::NAN)
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// What a bifurcation is, in words, with its detail.
+fn describe(kind: &BifurcationKind) -> (&'static str, String) {
+    match kind {
+        BifurcationKind::Fold => ("fold", String::new()),
+        BifurcationKind::BranchPoint => ("branch_point", String::new()),
+        BifurcationKind::PeriodDoubling => ("period_doubling", String::new()),
+        BifurcationKind::NeimarkSacker { angle } => ("neimark_sacker", format!("angle {angle} rad")),
+        BifurcationKind::Grazing { contact, appears } => (
+            "grazing",
+            format!(
+                "contact {}: impact {}",
+                contact + 1,
+                if *appears { "appears" } else { "disappears" }
+            ),
+        ),
+        BifurcationKind::Sticking { contact, onset } => (
+            "sticking",
+            format!(
+                "contact {}: sticking {}",
+                contact + 1,
+                if *onset { "begins" } else { "ends" }
+            ),
+        ),
+        BifurcationKind::SequenceChange => ("sequence_change", String::new()),
+        _ => ("other", format!("{kind:?}")),
+    }
+}
+
+fn end_text(end: &BranchEnd) -> String {
+    match end {
+        BranchEnd::RangeEnd { parameter } => format!("range end at {parameter}"),
+        BranchEnd::MaxPoints => "point limit reached".into(),
+        BranchEnd::StepFloor {
+            parameter, reason, ..
+        } => {
+            format!("no continuation past {parameter} (step floor: {reason:?})")
+        }
+        BranchEnd::Grazing {
+            parameter,
+            contact,
+            gap,
+        } => format!(
+            "runs into a grazing of contact {} at {parameter} (gap minimum {gap:.3e} m) it cannot cross",
+            contact + 1
+        ),
+        BranchEnd::CascadeDepth { parameter } => {
+            format!("period doubling at {parameter} beyond the depth followed (--doublings)")
+        }
+        BranchEnd::SwitchFailed { parameter } => {
+            format!("could not switch onto the doubled branch at {parameter}")
+        }
+        BranchEnd::Collapsed { parameter } => format!("fell back onto the half-period orbit at {parameter}"),
+        other => format!("{other:?}"),
+    }
+}
+
+fn print_continuation(param: &str, result: &Continuation) {
+    println!(
+        "vibrotribo continue: {} branch(es) in {param}",
+        result.branches.len()
+    );
+    for (i, b) in result.branches.iter().enumerate() {
+        let stable = b.points.iter().filter(|p| p.stable).count();
+        println!(
+            "  branch {i} (period {}{}): {} points ({stable} stable); {}",
+            b.period,
+            b.parent
+                .map_or(String::new(), |(p, _)| format!(", born on branch {p}")),
+            b.points.len(),
+            end_text(&b.end)
+        );
+        for f in &b.bifurcations {
+            let (kind, detail) = describe(&f.kind);
+            println!(
+                "    {kind} at {param} = {:.10} (±{:.1e}){}",
+                f.parameter,
+                f.precision,
+                if detail.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {detail}")
+                }
+            );
+        }
+    }
+}
+
+fn multipliers_text(p: &BranchPoint) -> String {
+    p.multipliers
+        .iter()
+        .map(|m| format!("{}{:+}i", m.re, m.im))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn write_files(
+    dir: &Path,
+    config: &Config,
+    args: &ContinueArgs,
+    result: &Continuation,
+    power: Option<&[Vec<f64>]>,
+) -> Result<()> {
+    let n = config.chain().len();
+    let mut cols: Vec<String> = [
+        "branch",
+        "period",
+        "param",
+        "stable",
+        "max_abs_multiplier",
+        "unstable_multipliers",
+    ]
+    .map(String::from)
+    .to_vec();
+    cols.extend(numbered("x", n, "_m"));
+    cols.extend(numbered("v", n, "_m_s"));
+    cols.push("impacts_per_period".into());
+    cols.extend(numbered("impacts_per_period_", n - 1, ""));
+    cols.extend(["min_closing_speed_m_s", "sticks", "average_power_w", "arclength"].map(String::from));
+    let mut csv = CsvFile::create(&dir.join("branch.csv"), &cols)?;
+    for (i, b) in result.branches.iter().enumerate() {
+        for (j, p) in b.points.iter().enumerate() {
+            let mut row = vec![
+                i.to_string(),
+                b.period.to_string(),
+                p.parameter.to_string(),
+                p.stable.to_string(),
+                p.spectral_radius().to_string(),
+                p.multipliers
+                    .iter()
+                    .filter(|m| m.norm() > 1.0)
+                    .count()
+                    .to_string(),
+            ];
+            row.extend(p.state.positions.iter().map(f64::to_string));
+            row.extend(p.state.velocities.iter().map(f64::to_string));
+            row.push(p.impacts_per_period.iter().sum::<f64>().to_string());
+            row.extend(p.impacts_per_period.iter().map(f64::to_string));
+            row.push(p.min_closing_speed.map_or(String::new(), |m| m.1.to_string()));
+            row.push(p.sticks.to_string());
+            row.push(
+                power
+                    .and_then(|pw| pw.get(i).and_then(|b| b.get(j)))
+                    .filter(|v| v.is_finite())
+                    .map_or(String::new(), |v| v.to_string()),
+            );
+            row.push(p.arclength.to_string());
+            csv.row(row)?;
+        }
+    }
+    csv.flush()?;
+    let mut bif = CsvFile::create(
+        &dir.join("bifurcations.csv"),
+        &[
+            "branch",
+            "kind",
+            "param",
+            "precision",
+            "contact",
+            "detail",
+            "child_branch",
+            "multipliers",
+        ],
+    )?;
+    let mut listed = Vec::new();
+    for (i, b) in result.branches.iter().enumerate() {
+        for f in &b.bifurcations {
+            let (kind, detail) = describe(&f.kind);
+            let contact = match f.kind {
+                BifurcationKind::Grazing { contact, .. } | BifurcationKind::Sticking { contact, .. } => {
+                    (contact + 1).to_string()
+                }
+                _ => String::new(),
+            };
+            bif.row([
+                i.to_string(),
+                kind.to_string(),
+                f.parameter.to_string(),
+                f.precision.to_string(),
+                contact,
+                csv_text(&detail),
+                f.child.map_or(String::new(), |c| c.to_string()),
+                csv_text(&multipliers_text(&f.point)),
+            ])?;
+            listed.push(bifurcation_json(i, f));
+        }
+    }
+    bif.flush()?;
+    let branches: Vec<serde_json::Value> = result
+        .branches
+        .iter()
+        .map(|b| {
+            json!({
+                "period": b.period,
+                "parent": b.parent.map(|(p, k)| json!({"branch": p, "bifurcation": k})),
+                "points": b.points.len(),
+                "end": end_text(&b.end),
+            })
+        })
+        .collect();
+    write_json(
+        &dir.join("continue.json"),
+        &json!({
+            "command": "continue",
+            "param": args.param,
+            "from": args.from,
+            "to": args.to,
+            "transient_periods": args.transient,
+            "doublings": args.doublings,
+            "max_points": args.max_points,
+            "mechanics_only": args.mechanics_only,
+            "branches": branches,
+            "bifurcations": listed,
+            "settings": config.table(),
+            "vibrotribo_version": env!("CARGO_PKG_VERSION"),
+        }),
+    )
+}
+
+fn bifurcation_json(branch: usize, f: &Bifurcation) -> serde_json::Value {
+    let (kind, detail) = describe(&f.kind);
+    json!({
+        "branch": branch,
+        "kind": kind,
+        "detail": detail,
+        "param": f.parameter,
+        "precision": f.precision,
+        "child_branch": f.child,
+        "multipliers": f.point.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+    })
+}
+
+/// The positions of `mass` at t = kT, k = 0 … period − 1, along the orbit through `state`.
+fn section_positions(
+    chain: &ChainParams,
+    state: &ChainState,
+    period: u32,
+    mass: usize,
+    config: &Config,
+) -> Vec<f64> {
+    let mut out = vec![state.positions[mass]];
+    let Ok(mut sim) = Simulator::new(chain, state, config.sim_options().clone()) else {
+        return out;
+    };
+    for k in 1..period {
+        if sim.run_until(f64::from(k) * chain.period(), &mut ()).is_err() {
+            break;
+        }
+        out.push(sim.state().positions[mass]);
+    }
+    out
+}
+
+/// The branches (stable solid, unstable dashed; every point of a period-P orbit on the
+/// section) over a brute-force orbit diagram, bifurcations marked.
+fn plot_branches(
+    dir: &Path,
+    config: &Config,
+    args: &ContinueArgs,
+    result: &Continuation,
+    family: &impl Fn(f64) -> ChainParams,
+) -> Result<()> {
+    let mass = args.mass - 1;
+    let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
+    // Brute force: every value from rest, a long transient, mechanics only.
+    let options = PointOptions {
+        transient_periods: u64::from(args.transient.max(300)),
+        recorded_periods: 64,
+        ..PointOptions::default()
+    };
+    let runner = PointRunner::new(config.clone(), options, true);
+    let values = grid(lo, hi, args.diagram_steps.max(2));
+    let mut dx = Vec::new();
+    let mut dy = Vec::new();
+    let _ = vibrotribo::sweep::run_grid(
+        &runner,
+        &values,
+        |&v| vec![(args.param.as_str(), v)],
+        64,
+        |d| {
+            if let vibrotribo::sweep::Delivery::Point(&v, Ok(p)) = d {
+                for x in p.position_series(mass) {
+                    dx.push(v);
+                    dy.push(x);
+                }
+            }
+            std::ops::ControlFlow::Continue(())
+        },
+    );
+    // Branch curves: one series per run of equal stability and per section point.
+    let mut curves: Vec<(Vec<f64>, Vec<f64>, bool)> = Vec::new();
+    for b in &result.branches {
+        let sections: Vec<Vec<f64>> = b
+            .points
+            .iter()
+            .map(|p| section_positions(&family(p.parameter), &p.state, b.period, mass, config))
+            .collect();
+        for k in 0..b.period as usize {
+            let mut start = 0;
+            while start < b.points.len() {
+                let stable = b.points[start].stable;
+                let mut end = start;
+                while end + 1 < b.points.len() && b.points[end + 1].stable == stable {
+                    end += 1;
+                }
+                // Runs overlap by one point so that the branch is drawn without holes.
+                let stop = (end + 1).min(b.points.len() - 1);
+                let xs: Vec<f64> = (start..=stop).map(|j| b.points[j].parameter).collect();
+                let ys: Vec<f64> = (start..=stop)
+                    .map(|j| sections[j].get(k).copied().unwrap_or(f64::NAN))
+                    .collect();
+                curves.push((xs, ys, stable));
+                start = end + 1;
+            }
+        }
+    }
+    // Bifurcations: vertical green lines across the data.
+    let (y_lo, y_hi) = dy
+        .iter()
+        .chain(curves.iter().flat_map(|c| c.1.iter()))
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let marks: Vec<([f64; 2], [f64; 2])> = result
+        .branches
+        .iter()
+        .flat_map(|b| b.bifurcations.iter())
+        .map(|f| ([f.parameter; 2], [y_lo, y_hi]))
+        .collect();
+    let mut lines: Vec<Series> = curves
+        .iter()
+        .map(|(x, y, stable)| {
+            let s = Series::unlabelled(x, y);
+            if *stable {
+                s.colour(0)
+            } else {
+                s.colour(3).dashed()
+            }
+        })
+        .collect();
+    lines.extend(marks.iter().map(|(x, y)| Series::unlabelled(x, y).colour(2)));
+    let mut fig = Figure::new(
+        format!(
+            "Branches in {}: stable solid, unstable dashed, bifurcations green",
+            args.param
+        ),
+        args.param.clone(),
+        format!("x{} at t = nT [m]", args.mass),
+    );
+    fig.legend = Legend::Hidden;
+    both(dir, "continuation", |path| {
+        plot::lines_and_points(path, &fig, &lines, &[Series::unlabelled(&dx, &dy).colour(7)], 3)
+    })
+}

@@ -1,0 +1,266 @@
+//! `vibrotribo periodic`: the periodic orbit near a run, found by shooting
+//! ([`vibrotribo::orbits`]), with its Floquet multipliers, its impacts and the power the
+//! harvester delivers on it.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use serde_json::json;
+use vibrotribo::config::Config;
+use vibrotribo::orbits::{
+    PeriodicOrbit, ShootingOptions, find_periodic_orbit, periodic_orbit_from_transient,
+};
+use vibrotribo::study::{ElectricalOutcome, Harvester, power_on_orbit};
+use vibrotribo::{EventKind, UniformSampler};
+
+use crate::config::ConfigArgs;
+use crate::output::{create_dir, numbered, si, write_json};
+use crate::plot::{self, Figure, Legend, Series};
+use crate::plots::both;
+
+/// Options of `vibrotribo periodic`.
+#[derive(Debug, clap::Args)]
+pub struct PeriodicArgs {
+    #[command(flatten)]
+    pub input: ConfigArgs,
+    /// Period P of the orbit, in excitation periods (default: detected from 128 periods after
+    /// the transient).
+    #[arg(long)]
+    pub period: Option<u32>,
+    /// Periods simulated from the configured initial state before shooting; 0 shoots from the
+    /// configured initial state itself (then the period defaults to 1).
+    #[arg(long, default_value_t = 200)]
+    pub transient: u32,
+    /// Mechanics only: no harvester, no power.
+    #[arg(long)]
+    pub mechanics_only: bool,
+    /// Write periodic.json to this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also draw the orbit's phase portraits and its multipliers (needs --out).
+    #[arg(long)]
+    pub plot: bool,
+}
+
+/// Repetitions of the orbit the charge solver warms up over, and averages over.
+const POWER_WARMUP: u32 = 2;
+const POWER_PERIODS: u32 = 4;
+
+/// Runs `vibrotribo periodic`.
+pub fn run(args: &PeriodicArgs) -> Result<()> {
+    if args.plot && args.out.is_none() {
+        bail!("--plot needs --out DIR");
+    }
+    if args.period == Some(0) {
+        bail!("--period must be at least 1");
+    }
+    let config = args.input.load()?;
+    let options = ShootingOptions {
+        sim: config.sim_options().clone(),
+        ..ShootingOptions::default()
+    };
+    let chain = config.chain();
+    let orbit = if args.transient == 0 {
+        find_periodic_orbit(chain, config.initial_state(), args.period.unwrap_or(1), &options)?
+    } else {
+        periodic_orbit_from_transient(
+            chain,
+            config.initial_state(),
+            args.transient,
+            args.period,
+            &options,
+        )?
+    };
+    let power = if args.mechanics_only {
+        None
+    } else {
+        let h = Harvester::new(config.harvester().clone(), config.charge_options().clone());
+        Some(power_on_orbit(
+            &orbit,
+            &h,
+            config.sim_options(),
+            POWER_WARMUP,
+            POWER_PERIODS,
+        )?)
+    };
+    print_orbit(&orbit, power.as_ref());
+    if let Some(dir) = &args.out {
+        create_dir(dir)?;
+        write_json(
+            &dir.join("periodic.json"),
+            &orbit_json(&config, &orbit, power.as_ref()),
+        )?;
+        if args.plot {
+            plot_orbit(dir, &config, &orbit)?;
+        }
+        println!("  wrote {}/periodic.json", dir.display());
+    }
+    Ok(())
+}
+
+fn print_orbit(orbit: &PeriodicOrbit, power: Option<&ElectricalOutcome>) {
+    let n = orbit.params.len();
+    println!(
+        "vibrotribo periodic: period-{} orbit at Ω = {:.6} ({} masses), residual {:.1e} after {} Newton iterations",
+        orbit.period,
+        orbit.params.omega_ratio(),
+        n,
+        orbit.residual,
+        orbit.residuals.len().saturating_sub(1)
+    );
+    println!(
+        "  state at t ≡ 0 (mod T): x = {:?} m, v = {:?} m/s",
+        orbit.state.positions, orbit.state.velocities
+    );
+    let unstable = orbit.unstable_dimension();
+    println!(
+        "  {}: largest |multiplier| {:.6}{}",
+        if orbit.stable { "stable" } else { "unstable" },
+        orbit.spectral_radius(),
+        if unstable > 0 {
+            format!(", {unstable} multiplier(s) outside the unit circle")
+        } else {
+            String::new()
+        }
+    );
+    let ms: Vec<String> = orbit
+        .multipliers
+        .iter()
+        .map(|m| {
+            if m.im == 0.0 {
+                format!("{:.6}", m.re)
+            } else {
+                format!("{:.6}{:+.6}i", m.re, m.im)
+            }
+        })
+        .collect();
+    println!("  Floquet multipliers: {}", ms.join(", "));
+    let per = orbit.impacts_per_period();
+    let contacts: Vec<String> = per
+        .iter()
+        .enumerate()
+        .map(|(k, c)| format!("m{}–m{}: {c}", k + 1, k + 2))
+        .collect();
+    println!(
+        "  impacts per excitation period: {} ({}){}",
+        per.iter().sum::<f64>(),
+        contacts.join(", "),
+        if orbit.sticks() { "; sticks" } else { "" }
+    );
+    if let Some((k, v)) = orbit.min_closing_speed() {
+        println!("  slowest impact: {v:.6} m/s at m{}–m{}", k + 1, k + 2);
+    }
+    if let Some(p) = power.and_then(|p| p.power.as_ref()) {
+        println!(
+            "  harvester on the orbit: average power {}, {} per excitation period",
+            si(p.average_power_w, "W"),
+            si(p.energy_per_period_j, "J")
+        );
+    }
+}
+
+fn orbit_json(
+    config: &Config,
+    orbit: &PeriodicOrbit,
+    power: Option<&ElectricalOutcome>,
+) -> serde_json::Value {
+    let mut state = orbit.state.positions.clone();
+    state.extend(&orbit.state.velocities);
+    let per = orbit.impacts_per_period();
+    let events: Vec<serde_json::Value> = orbit
+        .events
+        .iter()
+        .map(|e| {
+            json!({
+                "time_s": e.time,
+                "kind": e.kind.as_str(),
+                "contact": e.contact + 1,
+                "rel_velocity_m_s": e.velocity_before,
+                "rel_velocity_after_m_s": e.velocity_after,
+            })
+        })
+        .collect();
+    let p = power.and_then(|p| p.power.as_ref());
+    json!({
+        "period": orbit.period,
+        "state": state,
+        "state_names": numbered("x", orbit.params.len(), "_m")
+            .into_iter()
+            .chain(numbered("v", orbit.params.len(), "_m_s"))
+            .collect::<Vec<_>>(),
+        "multipliers": orbit.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "multiplier_moduli": orbit.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>(),
+        "stable": orbit.stable,
+        "unstable_dimension": orbit.unstable_dimension(),
+        "impacts_per_period": per.iter().sum::<f64>(),
+        "impacts_per_period_by_contact": per,
+        "impacts_per_orbit": orbit.events.iter().filter(|e| e.kind == EventKind::Impact).count(),
+        "min_closing_speed_m_s": orbit.min_closing_speed().map(|m| m.1),
+        "min_closing_speed_contact": orbit.min_closing_speed().map(|m| m.0 + 1),
+        "sticks": orbit.sticks(),
+        "average_power_w": p.map(|p| p.average_power_w),
+        "energy_per_period_j": p.map(|p| p.energy_per_period_j),
+        "residual": orbit.residual,
+        "residual_history": orbit.residuals,
+        "events": events,
+        "excitation_period_s": orbit.params.period(),
+        "omega_ratio": orbit.params.omega_ratio(),
+        "parameters": orbit.params,
+        "settings": config.table(),
+    })
+}
+
+/// Phase portraits of every mass over one period of the orbit (section point marked) and the
+/// multipliers in the complex plane with the unit circle.
+fn plot_orbit(dir: &Path, config: &Config, orbit: &PeriodicOrbit) -> Result<()> {
+    let n = orbit.params.len();
+    let samples = 400 * orbit.period as usize;
+    let mut sampler = UniformSampler::new(n, 0.0, orbit.duration() / samples as f64);
+    orbit.replay(config.sim_options(), &mut sampler)?;
+    for i in 0..n {
+        let x: Vec<f64> = sampler.positions.iter().skip(i).step_by(n).copied().collect();
+        let v: Vec<f64> = sampler.velocities.iter().skip(i).step_by(n).copied().collect();
+        let (x0, v0) = ([orbit.state.positions[i]], [orbit.state.velocities[i]]);
+        let mut fig = Figure::new(
+            format!(
+                "Period-{} orbit: mass {} (section t ≡ 0 mod T marked)",
+                orbit.period,
+                i + 1
+            ),
+            format!("x{} [m]", i + 1),
+            format!("v{} [m/s]", i + 1),
+        );
+        fig.legend = Legend::Hidden;
+        both(dir, &format!("orbit_phase_x{}", i + 1), |path| {
+            plot::phase_portrait(
+                path,
+                &fig,
+                &[Series::unlabelled(&x, &v)],
+                Some(Series::unlabelled(&x0, &v0)),
+            )
+        })?;
+    }
+    let circle: Vec<(f64, f64)> = (0..=360)
+        .map(|k| {
+            let a = f64::from(k).to_radians();
+            (a.cos(), a.sin())
+        })
+        .collect();
+    let (cx, cy): (Vec<f64>, Vec<f64>) = circle.into_iter().unzip();
+    let re: Vec<f64> = orbit.multipliers.iter().map(|m| m.re).collect();
+    let im: Vec<f64> = orbit.multipliers.iter().map(|m| m.im).collect();
+    let r = orbit.spectral_radius().max(1.0) * 1.1;
+    let mut fig = Figure::new("Floquet multipliers", "Re λ", "Im λ");
+    fig.size = (800, 800);
+    fig.x_range = Some((-r, r));
+    fig.y_range = Some((-r, r));
+    both(dir, "orbit_multipliers", |path| {
+        plot::lines_and_points(
+            path,
+            &fig,
+            &[Series::new("unit circle", &cx, &cy).dashed().colour(7)],
+            &[Series::new("multipliers", &re, &im).colour(3)],
+            9,
+        )
+    })
+}
