@@ -134,7 +134,14 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         create_dir(dir)?;
         write_files(dir, &config, args, &result, power.as_deref())?;
         if args.plot {
-            plot_branches(dir, &config, args, &result, &family)?;
+            let diagram = Diagram {
+                param: &args.param,
+                range: (args.from.min(args.to), args.from.max(args.to)),
+                mass: args.mass - 1,
+                transient: u64::from(args.transient.max(300)),
+                steps: args.diagram_steps,
+            };
+            plot_branches(dir, "continuation", &config, &diagram, &result, &family)?;
         }
         println!(
             "  wrote {0}/branch.csv, {0}/bifurcations.csv, {0}/continue.json",
@@ -228,6 +235,7 @@ fn end_text(end: &BranchEnd) -> String {
             format!("could not switch onto the doubled branch at {parameter}")
         }
         BranchEnd::Collapsed { parameter } => format!("fell back onto the half-period orbit at {parameter}"),
+        BranchEnd::Closed { parameter } => format!("a closed curve, back at its start at {parameter}"),
         other => format!("{other:?}"),
     }
 }
@@ -428,31 +436,46 @@ fn section_positions(
     out
 }
 
+/// The brute-force orbit diagram under a picture of branches.
+pub struct Diagram<'a> {
+    /// The parameter's key.
+    pub param: &'a str,
+    /// Its range.
+    pub range: (f64, f64),
+    /// The mass shown, 0-based.
+    pub mass: usize,
+    /// Transient periods of each value (from the configured initial state).
+    pub transient: u64,
+    /// Values of the parameter.
+    pub steps: usize,
+}
+
 /// The branches (stable solid, unstable dashed; every point of a period-P orbit on the
-/// section) over a brute-force orbit diagram, bifurcations marked.
-fn plot_branches(
+/// section) over a brute-force orbit diagram, bifurcations marked: `{name}.png`/`.svg`.
+pub fn plot_branches(
     dir: &Path,
+    name: &str,
     config: &Config,
-    args: &ContinueArgs,
+    diagram: &Diagram<'_>,
     result: &Continuation,
     family: &impl Fn(f64) -> ChainParams,
 ) -> Result<()> {
-    let mass = args.mass - 1;
-    let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
-    // Brute force: every value from rest, a long transient, mechanics only.
+    let mass = diagram.mass;
+    let (lo, hi) = diagram.range;
+    // Brute force: every value from the configured initial state, mechanics only.
     let options = PointOptions {
-        transient_periods: u64::from(args.transient.max(300)),
+        transient_periods: diagram.transient,
         recorded_periods: 64,
         ..PointOptions::default()
     };
     let runner = PointRunner::new(config.clone(), options, true);
-    let values = grid(lo, hi, args.diagram_steps.max(2));
+    let values = grid(lo, hi, diagram.steps.max(2));
     let mut dx = Vec::new();
     let mut dy = Vec::new();
     let _ = vibrotribo::sweep::run_grid(
         &runner,
         &values,
-        |&v| vec![(args.param.as_str(), v)],
+        |&v| vec![(diagram.param, v)],
         64,
         |d| {
             if let vibrotribo::sweep::Delivery::Point(&v, Ok(p)) = d {
@@ -520,13 +543,13 @@ fn plot_branches(
     let mut fig = Figure::new(
         format!(
             "Branches in {}: stable solid, unstable dashed, bifurcations green",
-            args.param
+            diagram.param
         ),
-        args.param.clone(),
-        format!("x{} at t = nT [m]", args.mass),
+        diagram.param,
+        format!("x{} at t = nT [m]", mass + 1),
     );
     fig.legend = Legend::Hidden;
-    both(dir, "continuation", |path| {
+    both(dir, name, |path| {
         plot::lines_and_points(path, &fig, &lines, &[Series::unlabelled(&dx, &dy).colour(7)], 3)
     })
 }

@@ -4,7 +4,7 @@
 //! the numbers of this run.
 //!
 //! One file per group of figures (`configurations`, `spacing`, `mass_ratio`, `chatter`,
-//! `extras`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
+//! `orbits`, `extras`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
 //! `report` writes REPORT.md.
 
 mod chatter;
@@ -14,6 +14,7 @@ mod context;
 mod draw;
 mod extras;
 mod mass_ratio;
+mod orbits;
 mod report;
 mod runs;
 mod spacing;

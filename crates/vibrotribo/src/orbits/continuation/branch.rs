@@ -9,7 +9,9 @@ use super::bridge::{bridge, locate_change_in_parameter};
 use super::corrector::{Failure, Problem};
 use super::locate::{Located, Step, StepPoint, classify, locate_change, locate_root};
 use super::phase::{move_section, too_close};
-use super::types::{Bifurcation, BifurcationKind, Branch, BranchEnd, Continuation, ContinuationOptions};
+use super::types::{
+    Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
+};
 use crate::error::ParamError;
 use crate::model::{ChainParams, ChainState};
 use crate::orbits::error::OrbitError;
@@ -438,6 +440,12 @@ fn follow<F: Fn(f64) -> ChainParams>(
             &mut ending,
         );
         branch.points.push(target.described.point.clone());
+        if let Some(k) = closes(&problem, &branch, ds) {
+            branch.end = BranchEnd::Closed {
+                parameter: branch.points[k].parameter,
+            };
+            return (branch, doublings);
+        }
         if seed.depth > 0 && collapsed(&problem, &target) {
             ending.rejoin.get_or_insert(target.described.point.parameter);
         }
@@ -463,6 +471,34 @@ fn follow<F: Fn(f64) -> ChainParams>(
     }
     branch.end = BranchEnd::MaxPoints;
     (branch, doublings)
+}
+
+/// Points a branch must have before it can be found closed.
+const CLOSED_MIN_POINTS: usize = 8;
+
+/// The earlier point the branch's newest point is back at (within a step `ds` in the scaled
+/// units of the state and the parameter), if any: from there on the branch repeats itself.
+/// A smooth solution curve can only come back to its first point (a closed curve); one with
+/// corners (grazings crossed by [`bridge`]) can also run into a loop further on.
+fn closes<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, branch: &Branch, ds: f64) -> Option<usize> {
+    let n = branch.points.len();
+    if n < CLOSED_MIN_POINTS {
+        return None;
+    }
+    let distance = |a: &BranchPoint, b: &BranchPoint| {
+        let za = state_vector(&a.state);
+        let zb = state_vector(&b.state);
+        problem
+            .scale
+            .norm(&(za - zb))
+            .max((a.parameter - b.parameter).abs() / problem.p_scale)
+    };
+    let (last, before) = (&branch.points[n - 1], &branch.points[n - 2]);
+    // Arriving: the newest point is within a step of an old one and nearer it than the one
+    // before (so that a branch that merely moves slowly is not taken for closed).
+    branch.points[..n - CLOSED_MIN_POINTS]
+        .iter()
+        .position(|old| distance(last, old) < ds && distance(last, old) < distance(before, old))
 }
 
 fn step_floor(parameter: f64, f: Failure) -> BranchEnd {

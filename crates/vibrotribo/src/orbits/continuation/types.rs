@@ -231,6 +231,12 @@ pub enum BranchEnd {
         /// Parameter of the point where it happened.
         parameter: f64,
     },
+    /// The branch came back to its first point: it is a closed curve (an isola), followed
+    /// once round.
+    Closed {
+        /// Parameter of the first point.
+        parameter: f64,
+    },
 }
 
 /// One branch of periodic orbits.
