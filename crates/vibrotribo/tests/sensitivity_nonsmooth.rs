@@ -2,7 +2,11 @@
 //! as such, and near grazing Φ stays exact but grows like 1/(closing speed), which finite
 //! differences confirm only with steps below the distance to grazing.
 
+mod common;
+
 use std::f64::consts::PI;
+
+use common::grazing_pair;
 
 use vibrotribo::sensitivity::{
     Horizon, NonSmoothPoint, SensitivityError, SensitivityOptions, flow_map, state_from_vector, state_vector,
@@ -21,31 +25,6 @@ fn map(
         &SimOptions::default(),
         &SensitivityOptions::default(),
     )
-}
-
-/// Two undamped masses with equal k/m: the relative coordinate r = x2 − x1 is exactly
-/// r(t) = R sin(ω_n t) with R = δ(1 + ε). The gap δ − r first closes at asin(1/(1+ε))/ω_n
-/// with closing speed δ ω_n √((1+ε)² − 1): ε = 0 grazes, ε < 0 misses.
-fn grazing_pair(eps: f64) -> (ChainParams, ChainState, f64) {
-    let (m1, m2, k1): (f64, f64, f64) = (0.05, 0.15, 120.0);
-    let wn = (k1 / m1).sqrt();
-    let delta = 0.02;
-    let params = ChainParams {
-        masses: vec![m1, m2],
-        stiffness: vec![k1, k1 * m2 / m1],
-        damping: vec![0.0, 0.0],
-        gaps: vec![delta],
-        restitution: 0.6,
-        excitation: Excitation {
-            amplitude: 0.05,
-            frequency: Frequency::OmegaRatio(0.37),
-        },
-    };
-    let initial = ChainState {
-        positions: vec![0.0, 0.0],
-        velocities: vec![0.0, delta * (1.0 + eps) * wn],
-    };
-    (params, initial, wn)
 }
 
 #[test]

@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::grazing_pair;
+
 use std::f64::consts::PI;
 
 use vibrotribo::{
@@ -22,31 +24,6 @@ fn kinds(log: &EventLog) -> Vec<(EventKind, usize)> {
         .iter()
         .map(|e| (e.event.kind, e.event.contact))
         .collect()
-}
-
-/// Two undamped masses with equal k/m: the base motion cancels in the relative coordinate
-/// r = x2 − x1, which is exactly r(t) = R sin(ω_n t). With R = δ(1 + ε) the gap δ − r first
-/// reaches zero at asin(1/(1+ε))/ω_n, with closing speed δ ω_n √((1+ε)² − 1).
-fn grazing_pair(eps: f64) -> (ChainParams, ChainState, f64) {
-    let (m1, m2, k1): (f64, f64, f64) = (0.05, 0.15, 120.0);
-    let wn = (k1 / m1).sqrt();
-    let delta = 0.02;
-    let params = ChainParams {
-        masses: vec![m1, m2],
-        stiffness: vec![k1, k1 * m2 / m1],
-        damping: vec![0.0, 0.0],
-        gaps: vec![delta],
-        restitution: 0.6,
-        excitation: Excitation {
-            amplitude: 0.05,
-            frequency: Frequency::OmegaRatio(0.37),
-        },
-    };
-    let initial = ChainState {
-        positions: vec![0.0, 0.0],
-        velocities: vec![0.0, delta * (1.0 + eps) * wn],
-    };
-    (params, initial, wn)
 }
 
 #[test]
