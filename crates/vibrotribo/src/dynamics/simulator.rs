@@ -950,29 +950,37 @@ impl Simulator {
                 logged.push(k);
             }
         }
-        for k in 0..ncont {
-            if !quiet
-                && self.scratch_candidate[k]
-                && !self.closure[k].is_closed()
-                && self.v[k] != self.v[k + 1]
-            {
-                self.equalize(k);
-            }
+        if !quiet {
+            self.equalize_touching();
         }
         logged
     }
 
-    /// Gives the two clusters that meet at open contact k their common centre-of-mass
-    /// velocity (a plastic impulse of rounding size: momentum kept, energy never gained).
-    fn equalize(&mut self, k: usize) {
-        let (first, _) = self.cluster_range(k);
-        let (_, last) = self.cluster_range(k + 1);
-        let (mut m, mut p) = (0.0, 0.0);
-        for i in first..=last {
-            m += self.params.masses[i];
-            p += self.params.masses[i] * self.v[i];
+    /// Gives each group of masses joined by touching contacts (closed ones, and open ones with
+    /// a rounding-level relative velocity, the candidates of [`settle`](Self::settle)) that
+    /// contains an open one their common centre-of-mass velocity, if they differ: a plastic
+    /// impulse of rounding size (momentum kept, energy never gained). The whole group at once:
+    /// equalizing one contact after another, or merging a closed cluster in it later, would
+    /// leave a rounding-level relative velocity across the open contact again.
+    fn equalize_touching(&mut self) {
+        let ncont = self.closure.len();
+        let mut first = 0;
+        let mut open = false;
+        for k in 0..=ncont {
+            if k < ncont && (self.closure[k].is_closed() || self.scratch_candidate[k]) {
+                open |= !self.closure[k].is_closed();
+                continue;
+            }
+            let v = &mut self.v[first..=k];
+            if open && v.iter().any(|&vi| vi != v[0]) {
+                let m = &self.params.masses[first..=k];
+                let total: f64 = m.iter().sum();
+                let momentum: f64 = m.iter().zip(v.iter()).map(|(m, v)| m * v).sum();
+                v.fill(momentum / total);
+            }
+            first = k + 1;
+            open = false;
         }
-        self.v[first..=last].fill(p / m);
     }
 
     /// w_k = q_k + (Wλ)_k for the chain's tridiagonal Delassus matrix W.
