@@ -264,6 +264,13 @@ impl Oscillator {
         ((sp + g.h) + g.eh, (vp + g.hd) + g.ehd)
     }
 
+    /// Size of the terms the displacement is summed from, m: static offset, forced amplitude
+    /// and the free amplitude at the start (which only decays). Near resonance or mid-transient
+    /// it can far exceed the displacement itself, and so can the displacement's rounding.
+    pub(crate) fn magnitude(&self) -> f64 {
+        self.mean.abs() + self.pc.hypot(self.ps) + self.h0.hypot(self.h1 / self.wn2.sqrt())
+    }
+
     /// Start time of this flow, s.
     pub fn start_time(&self) -> f64 {
         self.t0

@@ -360,7 +360,12 @@ impl Simulator {
             .fold(0.0, f64::max);
         let xmax = self.x.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let vmax = self.v.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let length = xmax + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
+        let terms = self
+            .clusters
+            .iter()
+            .map(|c| c.oscillator.magnitude())
+            .fold(0.0, f64::max);
+        let length = xmax.max(terms) + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
         let omega = self.forcing.omega;
         let speed = vmax + (p.excitation.amplitude * omega) + wn2_max.sqrt() * length;
         let accel = wn2_max * length + speed * wn2_max.sqrt() + p.excitation.amplitude * omega * omega;
