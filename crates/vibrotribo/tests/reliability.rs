@@ -403,14 +403,7 @@ fn grazing_suite(cases: u64) {
         tally.worst_time,
         tally.worst_speed
     );
-    for f in tally.failures.iter().take(20) {
-        println!("FAIL {f}");
-    }
-    assert!(
-        tally.failures.is_empty(),
-        "{} of {cases} grazing cases failed",
-        tally.failures.len()
-    );
+    assert_none_failed(&tally.failures, cases, "grazing cases");
 }
 
 #[test]
@@ -443,26 +436,21 @@ fn chatter_chain(index: u64) -> (ChainParams, ChainState) {
     let masses: Vec<f64> = (0..n)
         .map(|_| if equal { m0 } else { rng.random_range(0.02..0.3) })
         .collect();
-    let stiffness: Vec<f64> = masses
-        .iter()
-        .map(|m| {
-            if proportional {
-                m * wn2
-            } else {
-                rng.random_range(40.0..300.0)
-            }
-        })
-        .collect();
-    let damping: Vec<f64> = masses
-        .iter()
-        .map(|m| {
-            if proportional {
-                m * two_alpha
-            } else {
-                rng.random_range(0.0..0.08)
-            }
-        })
-        .collect();
+    // k (N/m) or c (N s/m) per mass: proportional to it, or drawn from `range`.
+    let mut per_mass = |ratio: f64, range: std::ops::Range<f64>| -> Vec<f64> {
+        masses
+            .iter()
+            .map(|m| {
+                if proportional {
+                    m * ratio
+                } else {
+                    rng.random_range(range.clone())
+                }
+            })
+            .collect()
+    };
+    let stiffness = per_mass(wn2, 40.0..300.0);
+    let damping = per_mass(two_alpha, 0.0..0.08);
     let gaps: Vec<f64> = (0..n - 1)
         .map(|_| {
             if rng.random_range(0.0..1.0) < 0.15 {
@@ -642,14 +630,7 @@ fn chain_suite(cases: u64) {
         tally.worst_energy,
         tally.worst_overlap
     );
-    for f in tally.failures.iter().take(20) {
-        println!("FAIL {f}");
-    }
-    assert!(
-        tally.failures.is_empty(),
-        "{} of {cases} chains failed",
-        tally.failures.len()
-    );
+    assert_none_failed(&tally.failures, cases, "chains");
 }
 
 #[test]
@@ -661,6 +642,14 @@ fn chatter_prone_chains_keep_their_invariants() {
 #[ignore = "full size (10⁴ chains); run with --ignored"]
 fn chatter_prone_chains_keep_their_invariants_full() {
     chain_suite(10_000);
+}
+
+/// Prints the first 20 failures (each names its case index) and fails if there are any.
+fn assert_none_failed(failures: &[String], cases: u64, what: &str) {
+    for f in failures.iter().take(20) {
+        println!("FAIL {f}");
+    }
+    assert!(failures.is_empty(), "{} of {cases} {what} failed", failures.len());
 }
 
 /// Runs `check` for case indices `0..cases` on all cores and merges the tallies.
