@@ -101,6 +101,8 @@ pub struct Oscillator {
     regime: Regime,
     /// Forcing frequency ω, rad/s.
     omega: f64,
+    /// Size of the terms the displacement is summed from, m (see `magnitude`).
+    magnitude: f64,
 }
 
 /// Mechanical constants of one oscillator (a mass or a stuck cluster).
@@ -183,11 +185,14 @@ impl Oscillator {
             wn2,
             regime,
             omega: w,
+            magnitude: 0.0,
         };
         let ph = forcing.phase(t0);
         let (sp, vp) = osc.forced(ph);
         (osc.h0, osc.e0) = two_sum(s0, -sp);
         (osc.h1, osc.e1) = two_sum(v0, -vp);
+        osc.magnitude =
+            osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs() + osc.h1.abs() / wn2.sqrt();
         Ok(osc)
     }
 
@@ -265,10 +270,11 @@ impl Oscillator {
     }
 
     /// Size of the terms the displacement is summed from, m: static offset, forced amplitude
-    /// and the free amplitude at the start (which only decays). Near resonance or mid-transient
-    /// it can far exceed the displacement itself, and so can the displacement's rounding.
+    /// and free amplitude at the start (which only decays), each bounded by the sum of its
+    /// two components' magnitudes. Near resonance or mid-transient it can far exceed the
+    /// displacement itself, and so can the displacement's rounding.
     pub(crate) fn magnitude(&self) -> f64 {
-        self.mean.abs() + self.pc.hypot(self.ps) + self.h0.hypot(self.h1 / self.wn2.sqrt())
+        self.magnitude
     }
 
     /// Start time of this flow, s.
