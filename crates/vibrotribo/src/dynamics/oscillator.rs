@@ -132,6 +132,7 @@ struct Homogeneous {
 
 impl Oscillator {
     /// The flow through state (`s0`, `v0`) at time `t0`.
+    #[inline]
     pub(crate) fn new(
         k: OscConstants,
         forcing: &Forcing,

@@ -44,7 +44,7 @@
 
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
 use super::oscillator::{Forcing, OscConstants, Oscillator};
-use super::roots::{Found, first_root};
+use super::roots::{Found, Stall, first_root};
 use super::signal::Signal;
 use crate::error::{ParamError, SimError};
 use crate::model::{ChainParams, ChainState, SimOptions};
@@ -150,6 +150,8 @@ pub struct Simulator {
     pos_tol: f64,
     vel_tol: f64,
     acc_tol: f64,
+    /// The largest `Oscillator::magnitude` of the current clusters, m.
+    term_scale: f64,
     // Scratch for per-event work (no allocation per event).
     scratch_first_speed: Vec<f64>,
     scratch_lambda: Vec<f64>,
@@ -211,6 +213,7 @@ impl Simulator {
             pos_tol: 0.0,
             vel_tol: 0.0,
             acc_tol: 0.0,
+            term_scale: 0.0,
             scratch_first_speed: vec![f64::NAN; n - 1],
             scratch_lambda: vec![0.0; n - 1],
             scratch_q: vec![0.0; n - 1],
@@ -360,12 +363,8 @@ impl Simulator {
             .fold(0.0, f64::max);
         let xmax = self.x.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let vmax = self.v.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let terms = self
-            .clusters
-            .iter()
-            .map(|c| c.oscillator.magnitude())
-            .fold(0.0, f64::max);
-        let length = xmax.max(terms) + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
+        let length =
+            xmax.max(self.term_scale) + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
         let omega = self.forcing.omega;
         let speed = vmax + (p.excitation.amplitude * omega) + wn2_max.sqrt() * length;
         let accel = wn2_max * length + speed * wn2_max.sqrt() + p.excitation.amplitude * omega * omega;
@@ -387,6 +386,7 @@ impl Simulator {
         }
         self.clusters.clear();
         self.consts.clear();
+        self.term_scale = 0.0;
         let mut first = 0;
         for i in 0..n {
             let ends = i == n - 1 || !self.closure[i].is_closed();
@@ -430,6 +430,7 @@ impl Simulator {
                 first: first + 1,
                 last: last + 1,
             })?;
+            self.term_scale = self.term_scale.max(osc.magnitude());
             self.clusters.push(ClusterFlow {
                 first,
                 last,
@@ -497,6 +498,7 @@ impl Simulator {
     fn next_event(&self, stop: f64) -> Result<Option<(f64, Pending)>, SimError> {
         let mut best: Option<(f64, Pending)> = None;
         let mut horizon = stop;
+        let w = self.forcing.omega;
         for k in 0..self.closure.len() {
             if let Closure::Chatter { t_acc, .. } = self.closure[k]
                 && t_acc < horizon
@@ -507,52 +509,69 @@ impl Simulator {
             let (sig, start) = match self.closure[k] {
                 Closure::Open => (self.gap_signal(k), self.t.max(self.search_from[k])),
                 Closure::Resting => {
-                    // Part where the force falls to −band; press where it rises to +band.
-                    let band = self.rest_band(k);
-                    let mut part = self.force_signal(k);
-                    part.add_constant(band);
-                    let mut press = part.negated();
-                    press.add_constant(2.0 * band);
-                    for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
-                        if let Some(te) = self.first_zero(&sig, self.t, horizon, k)? {
-                            horizon = te.max(self.t);
-                            best = Some((horizon, what));
-                        }
+                    if let Some(found) = self.resting_event(k, horizon)? {
+                        horizon = found.0;
+                        best = Some(found);
                     }
                     continue;
                 }
                 _ => (self.force_signal(k), self.t),
             };
-            if let Some(te) = self.first_zero(&sig, start, horizon, k)? {
-                horizon = te.max(self.t);
-                let what = match self.closure[k] {
-                    Closure::Open => Pending::Impact {
-                        contact: k,
-                        at_start: te <= start,
-                    },
-                    _ => Pending::Release(k),
-                };
-                best = Some((horizon, what));
+            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
+            match first_root(eval, start, horizon) {
+                Ok(Found::Root(te)) if te < horizon => {
+                    horizon = te.max(self.t);
+                    let what = match self.closure[k] {
+                        Closure::Open => Pending::Impact {
+                            contact: k,
+                            at_start: te <= start,
+                        },
+                        _ => Pending::Release(k),
+                    };
+                    best = Some((horizon, what));
+                }
+                Ok(_) => {}
+                Err(stall) => return Err(self.stalled(k, stall)),
             }
         }
         Ok(best)
     }
 
-    /// The first zero of event function `sig` of contact `k` in `[start, horizon)`, if any.
-    #[inline]
-    fn first_zero(&self, sig: &Signal, start: f64, horizon: f64, k: usize) -> Result<Option<f64>, SimError> {
+    /// The earliest event of resting contact k before `horizon`, if any: its force falls to
+    /// minus its band (it parts) or rises to plus its band (it sticks).
+    #[cold]
+    fn resting_event(&self, k: usize, horizon: f64) -> Result<Option<(f64, Pending)>, SimError> {
+        let band = self.rest_band(k);
+        let mut part = self.force_signal(k);
+        part.add_constant(band);
+        let mut press = part.negated();
+        press.add_constant(2.0 * band);
         let w = self.forcing.omega;
-        let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
-        match first_root(eval, start, horizon) {
-            Ok(Found::Root(te)) if te < horizon => Ok(Some(te)),
-            Ok(_) => Ok(None),
-            Err(stall) => Err(SimError::Stalled {
-                t: stall.t,
-                what: match self.closure[k] {
-                    Closure::Open => format!("the gap of contact {}", k + 1),
-                    _ => format!("the contact force of contact {}", k + 1),
-                },
-            }),
+        let mut best = None;
+        let mut horizon = horizon;
+        for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
+            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
+            match first_root(eval, self.t, horizon) {
+                Ok(Found::Root(te)) if te < horizon => {
+                    horizon = te.max(self.t);
+                    best = Some((horizon, what));
+                }
+                Ok(_) => {}
+                Err(stall) => return Err(self.stalled(k, stall)),
+            }
+        }
+        Ok(best)
+    }
+
+    /// The error for a search of contact k that could not separate a zero from its start.
+    #[cold]
+    fn stalled(&self, k: usize, stall: Stall) -> SimError {
+        SimError::Stalled {
+            t: stall.t,
+            what: match self.closure[k] {
+                Closure::Open => format!("the gap of contact {}", k + 1),
+                _ => format!("the contact force of contact {}", k + 1),
+            },
         }
     }
 
