@@ -67,11 +67,8 @@ pub enum ContactStatus {
 enum Closure {
     Open,
     Stuck,
-    Chatter {
-        t_acc: f64,
-        impacts: u32,
-    },
-    /// Touching with zero force (see the module docs): one cluster, but no event.
+    Chatter { t_acc: f64, impacts: u32 },
+    // Touching with zero force (see the module docs): one cluster, but no event.
     Resting,
 }
 
@@ -352,7 +349,8 @@ impl Simulator {
     }
 
     /// Rounding-level tolerances for positions, velocities and accelerations, from the scale
-    /// of the current state.
+    /// of the current state, or of the terms the clusters' closed forms sum it from where
+    /// those are larger (near resonance, mid-transient), since they set its rounding.
     fn refresh_tolerances(&mut self) {
         let p = &self.params;
         let wn2_max = p
@@ -902,8 +900,8 @@ impl Simulator {
     ///
     /// A touching contact left open has its rounding-level relative velocity removed, the two
     /// sides taking their common centre-of-mass velocity. A `quiet` settle (after a touch that
-    /// changed nothing, see `handle`) changes no state but sticking: no contact starts resting
-    /// and no velocity is adjusted.
+    /// changed nothing, see `handle`) decides sticking and release as always, but starts no
+    /// resting contact and adjusts no velocity.
     fn settle(&mut self, exclude: Option<usize>, quiet: bool) -> Vec<usize> {
         let n = self.x.len();
         let ncont = n - 1;
