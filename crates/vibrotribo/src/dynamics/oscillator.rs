@@ -192,8 +192,7 @@ impl Oscillator {
         let (sp, vp) = osc.forced(ph);
         (osc.h0, osc.e0) = two_sum(s0, -sp);
         (osc.h1, osc.e1) = two_sum(v0, -vp);
-        osc.magnitude =
-            osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs() + osc.h1.abs() / wn2.sqrt();
+        osc.magnitude = osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs();
         Ok(osc)
     }
 
@@ -271,9 +270,9 @@ impl Oscillator {
     }
 
     /// Size of the terms the displacement is summed from, m: static offset, forced amplitude
-    /// and free amplitude at the start (which only decays), each bounded by the sum of its
-    /// two components' magnitudes. Near resonance or mid-transient it can far exceed the
-    /// displacement itself, and so can the displacement's rounding.
+    /// (as |P| + |Q|) and initial free displacement. Near resonance or mid-transient it can far
+    /// exceed the displacement itself (forced and free parts cancel), and so can the
+    /// displacement's rounding.
     pub(crate) fn magnitude(&self) -> f64 {
         self.magnitude
     }
