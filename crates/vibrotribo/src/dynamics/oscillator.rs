@@ -101,6 +101,8 @@ pub struct Oscillator {
     regime: Regime,
     /// Forcing frequency ω, rad/s.
     omega: f64,
+    /// Size of the terms the displacement is summed from, m (see `magnitude`).
+    magnitude: f64,
 }
 
 /// Mechanical constants of one oscillator (a mass or a stuck cluster).
@@ -130,6 +132,7 @@ struct Homogeneous {
 
 impl Oscillator {
     /// The flow through state (`s0`, `v0`) at time `t0`.
+    #[inline]
     pub(crate) fn new(
         k: OscConstants,
         forcing: &Forcing,
@@ -183,11 +186,13 @@ impl Oscillator {
             wn2,
             regime,
             omega: w,
+            magnitude: 0.0,
         };
         let ph = forcing.phase(t0);
         let (sp, vp) = osc.forced(ph);
         (osc.h0, osc.e0) = two_sum(s0, -sp);
         (osc.h1, osc.e1) = two_sum(v0, -vp);
+        osc.magnitude = osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs();
         Ok(osc)
     }
 
@@ -262,6 +267,14 @@ impl Oscillator {
         let (sp, vp) = self.forced(ph);
         let g = self.homogeneous(t);
         ((sp + g.h) + g.eh, (vp + g.hd) + g.ehd)
+    }
+
+    /// Size of the terms the displacement is summed from, m: static offset, forced amplitude
+    /// (as |P| + |Q|) and initial free displacement. Near resonance or mid-transient it can far
+    /// exceed the displacement itself (forced and free parts cancel), and so can the
+    /// displacement's rounding.
+    pub(crate) fn magnitude(&self) -> f64 {
+        self.magnitude
     }
 
     /// Start time of this flow, s.

@@ -65,6 +65,19 @@ impl Signal {
         self.nterms += 1;
     }
 
+    /// The function with the opposite sign (same rounding noise).
+    pub fn negated(&self) -> Signal {
+        let mut s = *self;
+        s.constant = -s.constant;
+        s.fc = -s.fc;
+        s.fs = -s.fs;
+        for term in &mut s.terms[..s.nterms] {
+            term.a = -term.a;
+            term.b = -term.b;
+        }
+        s
+    }
+
     /// Adds a constant.
     pub fn add_constant(&mut self, c: f64) {
         self.constant += c;

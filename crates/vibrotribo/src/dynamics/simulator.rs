@@ -26,6 +26,18 @@
 //!   `N_j = Σ_{i≤j} m_i (a_G − a_i)`, not the paper's eqs. 9–10 (whose factor ½ is exact only
 //!   for equal masses).
 //! - **Release**: a closed contact opens when its force falls to zero.
+//! - **Resting**: a contact at zero gap and zero relative velocity whose LCP force and gap
+//!   acceleration are both zero to within rounding (`|w| ≤` the acceleration tolerance) is
+//!   *resting*: touching with no force, as in a resting stack, Newton's cradle or masses with
+//!   equal k/m that travel together. It is neither a stick nor an impact, so it logs no event;
+//!   its two sides move as one cluster (their relative motion is then zero by construction,
+//!   not by cancellation of two flows), and its force is watched instead of its gap: it
+//!   becomes an ordinary stuck contact (a `Stick`) when the force rises above a band of a few
+//!   times the rounding level, and parts silently when the force falls below minus that band
+//!   (the hysteresis keeps the two decisions apart). An impact passes through resting contacts
+//!   pairwise, as through open touching ones. Any touching contact that stays open has its
+//!   rounding-level relative velocity removed (momentum-conserving), so that the exact flow
+//!   does not carry the rounding of an impact elsewhere into a slow, spurious approach.
 //!
 //! Work is bounded: at most [`SimOptions::max_events_per_period`] events per period, after
 //! which the run ends with [`SimError::EventLimit`].
@@ -34,7 +46,7 @@ use std::ops::ControlFlow;
 
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
 use super::oscillator::{Forcing, OscConstants, Oscillator};
-use super::roots::{Found, first_root};
+use super::roots::{Found, Stall, first_root};
 use super::signal::Signal;
 use crate::error::{ParamError, SimError};
 use crate::model::{ChainParams, ChainState, SimOptions};
@@ -56,7 +68,8 @@ pub enum RunEnd {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum ContactStatus {
-    /// The two sides are apart or merely touching.
+    /// The two sides are apart or merely touching (resting against each other with no
+    /// contact force).
     Open,
     /// The two sides are stuck together (same cluster).
     Stuck,
@@ -70,11 +83,20 @@ enum Closure {
     Open,
     Stuck,
     Chatter { t_acc: f64, impacts: u32 },
+    // Touching with zero force (see the module docs): one cluster, but no event.
+    Resting,
 }
 
 impl Closure {
+    /// Whether the two sides move as one cluster.
     fn is_closed(self) -> bool {
         !matches!(self, Closure::Open)
+    }
+
+    /// Whether the contact carries a compressive force (it entered by a `Stick` and leaves
+    /// by a `Release`).
+    fn presses(self) -> bool {
+        matches!(self, Closure::Stuck | Closure::Chatter { .. })
     }
 }
 
@@ -88,6 +110,10 @@ enum Pending {
     },
     Release(usize),
     ChatterEnd(usize),
+    /// The force of a resting contact rose above its band: it sticks.
+    Press(usize),
+    /// The force of a resting contact fell below minus its band: it parts.
+    Part(usize),
 }
 
 /// Constants of one cluster.
@@ -136,6 +162,8 @@ pub struct Simulator {
     pos_tol: f64,
     vel_tol: f64,
     acc_tol: f64,
+    /// The largest `Oscillator::magnitude` of the current clusters, m.
+    term_scale: f64,
     // Scratch for per-event work (no allocation per event).
     scratch_first_speed: Vec<f64>,
     scratch_lambda: Vec<f64>,
@@ -143,6 +171,7 @@ pub struct Simulator {
     scratch_active: Vec<bool>,
     scratch_candidate: Vec<bool>,
     scratch_events: Vec<Event>,
+    scratch_resting: Vec<bool>,
     /// Per contact: the gap search starts no earlier than this (see `handle`).
     search_from: Vec<f64>,
 }
@@ -159,6 +188,12 @@ const ACC_TOL: f64 = 4096.0 * f64::EPSILON;
 /// search this fraction of a period ahead, so that rounding-level degeneracies (e.g. the
 /// gap of a just-released contact, with all derivatives at rounding level) cannot spin.
 const NUDGE: f64 = 1e-14;
+
+/// The force band of a resting contact, in multiples of the force that corresponds to the
+/// acceleration tolerance: a contact rests while `|w| ≤ acc_tol`, and its force must leave
+/// `±REST_BAND` times that before it sticks or parts, so that the next contact decision sees
+/// it clearly pressing or clearly separating.
+const REST_BAND: f64 = 4.0;
 
 impl Simulator {
     /// A simulator at time 0 in `initial` state. Contacts that start closed with zero relative
@@ -207,17 +242,19 @@ impl Simulator {
             pos_tol: 0.0,
             vel_tol: 0.0,
             acc_tol: 0.0,
-            scratch_first_speed: vec![0.0; n - 1],
+            term_scale: 0.0,
+            scratch_first_speed: vec![f64::NAN; n - 1],
             scratch_lambda: vec![0.0; n - 1],
             scratch_q: vec![0.0; n - 1],
             scratch_active: vec![false; n - 1],
             scratch_candidate: vec![false; n - 1],
             scratch_events: Vec::new(),
+            scratch_resting: vec![false; n - 1],
             search_from: vec![f64::NEG_INFINITY; n - 1],
         };
         sim.refresh_tolerances();
         // Start with closed contacts where the masses touch with equal velocity and press.
-        sim.settle(None);
+        sim.settle(None, false);
         sim.scratch_events.clear();
         sim.rebuild()?;
         Ok(sim)
@@ -262,6 +299,7 @@ impl Simulator {
                 Closure::Open => ContactStatus::Open,
                 Closure::Stuck => ContactStatus::Stuck,
                 Closure::Chatter { .. } => ContactStatus::Chatter,
+                Closure::Resting => ContactStatus::Open,
             })
             .collect()
     }
@@ -366,7 +404,8 @@ impl Simulator {
     }
 
     /// Rounding-level tolerances for positions, velocities and accelerations, from the scale
-    /// of the current state.
+    /// of the current state, or of the terms the clusters' closed forms sum it from where
+    /// those are larger (near resonance, mid-transient), since they set its rounding.
     fn refresh_tolerances(&mut self) {
         let p = &self.params;
         let wn2_max = p
@@ -377,7 +416,8 @@ impl Simulator {
             .fold(0.0, f64::max);
         let xmax = self.x.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let vmax = self.v.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let length = xmax + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
+        let length =
+            xmax.max(self.term_scale) + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
         let omega = self.forcing.omega;
         let speed = vmax + (p.excitation.amplitude * omega) + wn2_max.sqrt() * length;
         let accel = wn2_max * length + speed * wn2_max.sqrt() + p.excitation.amplitude * omega * omega;
@@ -399,6 +439,7 @@ impl Simulator {
         }
         self.clusters.clear();
         self.consts.clear();
+        self.term_scale = 0.0;
         let mut first = 0;
         for i in 0..n {
             let ends = i == n - 1 || !self.closure[i].is_closed();
@@ -442,6 +483,7 @@ impl Simulator {
                 first: first + 1,
                 last: last + 1,
             })?;
+            self.term_scale = self.term_scale.max(osc.magnitude());
             self.clusters.push(ClusterFlow {
                 first,
                 last,
@@ -519,6 +561,13 @@ impl Simulator {
             }
             let (sig, start) = match self.closure[k] {
                 Closure::Open => (self.gap_signal(k), self.t.max(self.search_from[k])),
+                Closure::Resting => {
+                    if let Some(found) = self.resting_event(k, horizon)? {
+                        horizon = found.0;
+                        best = Some(found);
+                    }
+                    continue;
+                }
                 _ => (self.force_signal(k), self.t),
             };
             let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
@@ -535,27 +584,73 @@ impl Simulator {
                     best = Some((horizon, what));
                 }
                 Ok(_) => {}
-                Err(stall) => {
-                    return Err(SimError::Stalled {
-                        t: stall.t,
-                        what: match self.closure[k] {
-                            Closure::Open => format!("the gap of contact {}", k + 1),
-                            _ => format!("the contact force of contact {}", k + 1),
-                        },
-                    });
-                }
+                Err(stall) => return Err(self.stalled(k, stall)),
             }
         }
         Ok(best)
     }
 
+    /// The earliest event of resting contact k before `horizon`, if any: its force falls to
+    /// minus its band (it parts) or rises to plus its band (it sticks).
+    #[cold]
+    fn resting_event(&self, k: usize, horizon: f64) -> Result<Option<(f64, Pending)>, SimError> {
+        let band = self.rest_band(k);
+        let mut part = self.force_signal(k);
+        part.add_constant(band);
+        let mut press = part.negated();
+        press.add_constant(2.0 * band);
+        let w = self.forcing.omega;
+        let mut best = None;
+        let mut horizon = horizon;
+        for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
+            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
+            match first_root(eval, self.t, horizon) {
+                Ok(Found::Root(te)) if te < horizon => {
+                    horizon = te.max(self.t);
+                    best = Some((horizon, what));
+                }
+                Ok(_) => {}
+                Err(stall) => return Err(self.stalled(k, stall)),
+            }
+        }
+        Ok(best)
+    }
+
+    /// The error for a search of contact k that could not separate a zero from its start.
+    #[cold]
+    fn stalled(&self, k: usize, stall: Stall) -> SimError {
+        SimError::Stalled {
+            t: stall.t,
+            what: match self.closure[k] {
+                Closure::Open => format!("the gap of contact {}", k + 1),
+                _ => format!("the contact force of contact {}", k + 1),
+            },
+        }
+    }
+
+    /// The force band of resting contact k, N: [`REST_BAND`] times the acceleration tolerance
+    /// times the reduced mass of the two parts of its cluster (the force that makes their
+    /// relative acceleration equal to the tolerance).
+    fn rest_band(&self, k: usize) -> f64 {
+        let c = &self.clusters[self.cluster_of(k)];
+        let upper: f64 = self.params.masses[c.first..=k].iter().sum();
+        let lower: f64 = self.params.masses[k + 1..=c.last].iter().sum();
+        REST_BAND * self.acc_tol * upper * lower / (upper + lower)
+    }
+
     fn handle(&mut self, what: Pending) -> Result<(), SimError> {
         self.refresh_tolerances();
+        // Contacts struck at this event (none unless it is an impact).
+        self.scratch_first_speed.fill(f64::NAN);
         match what {
             Pending::Impact { contact, at_start } => {
                 let struck = self.resolve_impacts(contact)?;
-                let stuck = self.settle(None);
-                if at_start && !struck && stuck.is_empty() {
+                // A touch at the search start with no closing speed is the rounding of the
+                // event function (as for the gap of a just-released contact), not a new
+                // contact state: only a contact that presses beyond rounding closes there.
+                let quiet = at_start && !struck;
+                let stuck = self.settle(None, quiet);
+                if quiet && stuck.is_empty() {
                     // A rounding-level touch at the search start that changes nothing: not an
                     // event. Search this contact again from a hair later.
                     self.scratch_events.clear();
@@ -568,7 +663,17 @@ impl Simulator {
                 self.sequence[j] = 0;
                 self.last_speed[j] = f64::INFINITY;
                 self.push_event(EventKind::Release, j, 0.0, 0.0, 0);
-                self.settle(Some(j));
+                self.settle(Some(j), false);
+            }
+            Pending::Press(j) => {
+                self.closure[j] = Closure::Stuck;
+                self.sequence[j] = 0;
+                self.last_speed[j] = f64::INFINITY;
+                self.push_event(EventKind::Stick, j, 0.0, 0.0, 0);
+            }
+            Pending::Part(j) => {
+                self.closure[j] = Closure::Open;
+                self.settle(Some(j), false);
             }
             Pending::ChatterEnd(j) => {
                 let impacts = match self.closure[j] {
@@ -578,7 +683,7 @@ impl Simulator {
                 self.push_event(EventKind::Chatter, j, 0.0, 0.0, impacts);
                 // The accumulation point: stick if the contact presses, else release.
                 self.closure[j] = Closure::Stuck;
-                let was_open_before = self.settle(None);
+                let was_open_before = self.settle(None, false);
                 if !was_open_before.contains(&j) {
                     // settle() logged nothing for j: it stays closed, now as a stuck contact.
                     self.push_event(EventKind::Stick, j, 0.0, 0.0, 0);
@@ -670,12 +775,17 @@ impl Simulator {
     /// Applies pairwise cluster impacts until no closed contact approaches, logs one impact
     /// per contact struck (and a grazing touch of speed 0 at `trigger` if it was reached with
     /// no closing speed), then replaces each geometric chatter tail by its accumulation point
-    /// where it is safe to. Returns whether any impulse was applied.
+    /// where it is safe to. Returns whether any impulse was applied. Resting contacts take
+    /// part as the open touching contacts they are (Newton's cradle); they stay resting if
+    /// nothing is struck, and are decided again by [`settle`](Self::settle) otherwise.
     fn resolve_impacts(&mut self, trigger: usize) -> Result<bool, SimError> {
         let mu = self.params.restitution;
         let ncont = self.closure.len();
-        for s in self.scratch_first_speed.iter_mut() {
-            *s = f64::NAN;
+        for (closure, resting) in self.closure.iter_mut().zip(self.scratch_resting.iter_mut()) {
+            *resting = *closure == Closure::Resting;
+            if *resting {
+                *closure = Closure::Open;
+            }
         }
         let mut iterations = 0;
         loop {
@@ -720,6 +830,13 @@ impl Simulator {
             }
         }
         let struck = iterations > 0;
+        if !struck {
+            for (closure, &resting) in self.closure.iter_mut().zip(&self.scratch_resting) {
+                if resting {
+                    *closure = Closure::Resting;
+                }
+            }
+        }
         if self.scratch_first_speed[trigger].is_nan() {
             // Reached with no closing speed: a grazing touch, logged as an impact of speed 0.
             self.scratch_first_speed[trigger] = 0.0;
@@ -830,10 +947,17 @@ impl Simulator {
     }
 
     /// Decides which contacts at zero gap and zero relative velocity are closed, by the
-    /// contact LCP (see module docs). Logs a `Stick` for each open contact that closes and a
-    /// `Release` for each closed one that opens; returns the contacts that were logged.
-    /// `exclude` is a contact that has just released and must not close again at once.
-    fn settle(&mut self, exclude: Option<usize>) -> Vec<usize> {
+    /// contact LCP (see module docs): stuck where the force is compressive, resting where the
+    /// force and the gap acceleration are both zero within rounding, open where the gap
+    /// accelerates apart. Logs a `Stick` for each contact that starts pressing and a `Release`
+    /// for each that stops; returns the contacts that were logged. `exclude` is a contact that
+    /// has just released and must not close again at once.
+    ///
+    /// A touching contact left open has its rounding-level relative velocity removed, the two
+    /// sides taking their common centre-of-mass velocity. A `quiet` settle (after a touch that
+    /// changed nothing, see `handle`) decides sticking and release as always, but starts no
+    /// resting contact and adjusts no velocity.
+    fn settle(&mut self, exclude: Option<usize>, quiet: bool) -> Vec<usize> {
         let n = self.x.len();
         let ncont = n - 1;
         let (y, yd) = self.forcing.base(self.forcing.phase(self.t));
@@ -844,8 +968,11 @@ impl Simulator {
             } else if self.closure[k].is_closed() {
                 true
             } else {
-                let gap = self.gap(k);
-                gap <= self.pos_tol && (self.v[k + 1] - self.v[k]).abs() <= self.vel_tol
+                // A contact struck at this instant touches by the impact's verdict: its gap is
+                // the event time's rounding times the closing speed, which can exceed the
+                // rounding of the positions.
+                let touching = self.gap(k) <= self.pos_tol || !self.scratch_first_speed[k].is_nan();
+                touching && (self.v[k + 1] - self.v[k]).abs() <= self.vel_tol
             };
             self.scratch_candidate[k] = cand;
             any |= cand;
@@ -878,24 +1005,59 @@ impl Simulator {
         }
         let mut logged = Vec::new();
         for k in 0..ncont {
-            let active = self.scratch_active[k];
-            match (self.closure[k].is_closed(), active) {
-                (false, true) => {
-                    self.closure[k] = Closure::Stuck;
-                    self.sequence[k] = 0;
-                    self.last_speed[k] = f64::INFINITY;
-                    self.push_event(EventKind::Stick, k, 0.0, 0.0, 0);
-                    logged.push(k);
-                }
-                (true, false) => {
-                    self.closure[k] = Closure::Open;
-                    self.push_event(EventKind::Release, k, 0.0, 0.0, 0);
-                    logged.push(k);
-                }
-                _ => {}
+            let before = self.closure[k];
+            let after = if self.scratch_active[k] {
+                if before.presses() { before } else { Closure::Stuck }
+            } else if self.scratch_candidate[k]
+                && (!quiet || before == Closure::Resting)
+                && self.gap_accel(k) <= self.acc_tol
+            {
+                Closure::Resting
+            } else {
+                Closure::Open
+            };
+            self.closure[k] = after;
+            if after.presses() && !before.presses() {
+                self.sequence[k] = 0;
+                self.last_speed[k] = f64::INFINITY;
+                self.push_event(EventKind::Stick, k, 0.0, 0.0, 0);
+                logged.push(k);
+            } else if before.presses() && !after.presses() {
+                self.push_event(EventKind::Release, k, 0.0, 0.0, 0);
+                logged.push(k);
             }
         }
+        if !quiet {
+            self.equalize_touching();
+        }
         logged
+    }
+
+    /// Gives each group of masses joined by touching contacts (closed ones, and open ones with
+    /// a rounding-level relative velocity, the candidates of [`settle`](Self::settle)) that
+    /// contains an open one their common centre-of-mass velocity, if they differ: a plastic
+    /// impulse of rounding size (momentum kept, energy never gained). The whole group at once:
+    /// equalizing one contact after another, or merging a closed cluster in it later, would
+    /// leave a rounding-level relative velocity across the open contact again.
+    fn equalize_touching(&mut self) {
+        let ncont = self.closure.len();
+        let mut first = 0;
+        let mut open = false;
+        for k in 0..=ncont {
+            if k < ncont && (self.closure[k].is_closed() || self.scratch_candidate[k]) {
+                open |= !self.closure[k].is_closed();
+                continue;
+            }
+            let v = &mut self.v[first..=k];
+            if open && v.iter().any(|&vi| vi != v[0]) {
+                let m = &self.params.masses[first..=k];
+                let total: f64 = m.iter().sum();
+                let momentum: f64 = m.iter().zip(v.iter()).map(|(m, v)| m * v).sum();
+                v.fill(momentum / total);
+            }
+            first = k + 1;
+            open = false;
+        }
     }
 
     /// w_k = q_k + (Wλ)_k for the chain's tridiagonal Delassus matrix W.
