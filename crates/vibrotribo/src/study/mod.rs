@@ -5,12 +5,14 @@
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
+mod lyapunov;
 mod observer;
 mod point;
 mod replay;
 mod settings;
 mod simulate;
 
+pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
