@@ -6,6 +6,7 @@ mod export_spice;
 mod job;
 mod limits;
 mod load_sweep;
+mod lyapunov;
 mod map;
 mod output;
 mod plot;
@@ -43,6 +44,8 @@ enum Command {
     Map(map::MapArgs),
     /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
     OptimizeMassRatio(map::OptimizeArgs),
+    /// Lyapunov spectrum (all 2N exponents, through impacts and sticking) with its spread.
+    Lyapunov(lyapunov::LyapunovArgs),
     /// Recompute the paper's study (Figs. 5–25) and write REPORT.md comparing its findings.
     Reproduce(reproduce::ReproduceArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
@@ -52,7 +55,7 @@ enum Command {
 /// Options of `vibrotribo plot`.
 #[derive(Debug, clap::Args)]
 struct PlotArgs {
-    /// A directory written by `simulate --out`, `sweep --out` or `map --out`.
+    /// A directory written by `simulate`, `sweep`, `map` or `lyapunov` with `--out`.
     dir: std::path::PathBuf,
     /// PSD of this mass only (1-based; default: every mass).
     #[arg(long)]
@@ -71,6 +74,7 @@ fn run() -> anyhow::Result<()> {
         Command::Merge(args) => sweep::merge(&args),
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),
+        Command::Lyapunov(args) => lyapunov::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
     }

@@ -9,6 +9,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::config::Config;
+use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
 use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_continued, run_grid};
 
@@ -114,6 +115,11 @@ pub struct SweepArgs {
     /// Also draw the diagrams (PNG and SVG) into the output directory.
     #[arg(long)]
     pub plot: bool,
+    /// Also compute the largest Lyapunov exponent over the recorded periods of every value
+    /// (columns `lyapunov_max_1_s` and its batch-means standard error `lyapunov_spread_1_s`
+    /// at the end of summary.csv).
+    #[arg(long)]
+    pub lyapunov: bool,
     #[command(flatten)]
     pub run: RunArgs,
 }
@@ -219,13 +225,20 @@ pub fn set_threads(threads: Option<usize>) -> Result<()> {
     Ok(())
 }
 
+/// The columns `sweep --lyapunov` adds at the end of `summary.csv`.
+const LYAPUNOV_COLUMNS: [&str; 2] = ["lyapunov_max_1_s", "lyapunov_spread_1_s"];
+
 /// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
-/// one row per value) and the manifest `sweep.json`.
-fn sweep_layout(masses: usize) -> Layout {
+/// one row per value; with `lyapunov`, two more columns at its end) and the manifest
+/// `sweep.json`.
+fn sweep_layout(masses: usize, lyapunov: bool) -> Layout {
     let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
     orbit_cols.extend(numbered("x", masses, "_m"));
     let mut summary_cols = vec!["param".to_string()];
     summary_cols.extend(point_columns(masses - 1));
+    if lyapunov {
+        summary_cols.extend(LYAPUNOV_COLUMNS.map(String::from));
+    }
     Layout {
         manifest: "sweep.json",
         files: vec![
@@ -249,12 +262,25 @@ fn sweep_layout(masses: usize) -> Layout {
     }
 }
 
+/// The cells of [`LYAPUNOV_COLUMNS`]: the largest exponent and its spread, 1/s (blank if
+/// the point failed or no period could be averaged).
+fn lyapunov_cells(result: &Result<PointResult, String>) -> [String; 2] {
+    match result {
+        Ok(PointResult {
+            lyapunov: Some(Ok(s)),
+            ..
+        }) => [s.largest().to_string(), s.largest_spread().to_string()],
+        _ => [String::new(), String::new()],
+    }
+}
+
 /// Writes one value's rows: orbit, impacts, then its summary row (last, see [`crate::job`]).
 fn write_value(
     out: &mut GridOutput,
     value: f64,
     result: &Result<PointResult, String>,
     contacts: usize,
+    lyapunov: bool,
 ) -> Result<()> {
     let p = value.to_string();
     if let Ok(r) = result {
@@ -278,6 +304,9 @@ fn write_value(
     }
     let mut row = vec![p];
     row.extend(point_cells(result, contacts));
+    if lyapunov {
+        row.extend(lyapunov_cells(result));
+    }
     out.row(2, row)
 }
 
@@ -289,7 +318,7 @@ fn settings_json(
     shard: Option<Shard>,
 ) -> serde_json::Value {
     let o = runner.options();
-    json!({
+    let mut settings = json!({
         "command": "sweep",
         "param": args.param,
         "from": args.from,
@@ -307,7 +336,12 @@ fn settings_json(
         "shard": shard.map(|s| json!({"index": s.index, "count": s.count})),
         "settings": runner.base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),
-    })
+    });
+    if args.lyapunov {
+        // Only with the option, so that other sweeps' manifests stay as they were.
+        settings["lyapunov"] = json!(true);
+    }
+    settings
 }
 
 /// Checks that a grid's values are distinct: rows are keyed by their value.
@@ -362,7 +396,14 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
-    let runner = args.run.runner(base)?;
+    let mut runner = args.run.runner(base)?;
+    if args.lyapunov {
+        let options = PointOptions {
+            lyapunov: Some(LyapunovOptions::default()),
+            ..runner.options().clone()
+        };
+        runner = PointRunner::new(runner.base().clone(), options, runner.mechanics_only());
+    }
     let masses = runner.masses();
     let values = grid(args.from, args.to, args.steps);
     check_distinct("--from/--to/--steps", &values)?;
@@ -405,7 +446,8 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             } else {
                 order.len()
             };
-            let (o, done) = GridOutput::resume(dir, sweep_layout(masses), settings, &keys, keep)?;
+            let (o, done) =
+                GridOutput::resume(dir, sweep_layout(masses, args.lyapunov), settings, &keys, keep)?;
             if let Some((n, s)) = checkpoint.filter(|c| c.0 == done && done > 0) {
                 state = Some(serde_json::from_value(s).map_err(|e| {
                     anyhow!(
@@ -418,7 +460,14 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             }
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, sweep_layout(masses), settings)?), 0),
+        Some(dir) => (
+            Some(GridOutput::create(
+                dir,
+                sweep_layout(masses, args.lyapunov),
+                settings,
+            )?),
+            0,
+        ),
     };
     let started = Instant::now();
     let mut failed = 0usize;
@@ -435,7 +484,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             |point| match (point, out.as_mut()) {
                 (Some((&j, r)), o) => {
                     failed += usize::from(r.is_err());
-                    o.map_or(Ok(()), |o| write_value(o, values[j], r, contacts))
+                    o.map_or(Ok(()), |o| write_value(o, values[j], r, contacts, args.lyapunov))
                 }
                 (None, Some(o)) => o.commit(),
                 (None, None) => Ok(()),
@@ -451,7 +500,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
                 failed += usize::from(r.is_err());
                 written += 1;
                 if let Some(o) = out.as_mut() {
-                    let w = write_value(o, values[j], &r, contacts)
+                    let w = write_value(o, values[j], &r, contacts, args.lyapunov)
                         .and_then(|()| o.checkpoint(skip + written, json!(state)));
                     if let Err(e) = w {
                         failure = Some(e);
@@ -548,7 +597,13 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     } else {
         // orbit.csv: param, period, x1_m, …, xN_m.
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
-        crate::job::merge(&args.shards, &args.out, &sweep_layout(masses), sweep_keys)?;
+        let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
+        crate::job::merge(
+            &args.shards,
+            &args.out,
+            &sweep_layout(masses, lyapunov),
+            sweep_keys,
+        )?;
     }
     println!("merged {} shards into {}", args.shards.len(), args.out.display());
     Ok(())
