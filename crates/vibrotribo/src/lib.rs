@@ -23,6 +23,8 @@
 //!   Neimark–Sacker points, grazings and the onset of sticking.
 //! - [`lyapunov`] computes all 2N Lyapunov exponents through impacts, sticking and chatter
 //!   from the same state-transition matrix, with a batch-means error bar.
+//! - [`attractors`] finds the attractors that starts end on (by their stroboscopic sets),
+//!   their basin fractions and powers, and follows them across a parameter.
 //!
 //! ```
 //! use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator};
@@ -38,6 +40,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod attractors;
 #[cfg(feature = "config")]
 pub mod config;
 pub mod dynamics;
