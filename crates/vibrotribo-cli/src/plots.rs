@@ -33,13 +33,18 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         plot_sweep(dir)
     } else if dir.join("map.json").exists() {
         plot_map(dir)
+    } else if dir.join("basins.json").exists() {
+        crate::basins::finish(dir)?;
+        crate::basins::plot_basins(dir)
+    } else if dir.join("attractors.json").exists() {
+        crate::attractors::plot_attractors(dir)
     } else if dir.join("lyapunov.json").exists() {
         crate::lyapunov::plot_lyapunov(dir)
     } else if dir.join("summary.json").exists() && dir.join("trajectory.csv").exists() {
         analyze_run(dir, psd_mass)
     } else {
         bail!(
-            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json or lyapunov.json)",
+            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json, basins.json, attractors.json or lyapunov.json)",
             dir.display()
         )
     }

@@ -11,7 +11,7 @@ use vibrotribo::ChainState;
 use vibrotribo::config::Config;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
-use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_continued, run_grid};
+use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_chunks, run_continued};
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
@@ -125,11 +125,19 @@ pub struct SweepArgs {
 }
 
 impl RunArgs {
-    /// The point runner of these settings on `base`.
+    /// The point runner of these settings on `base` (transient and recorded periods by
+    /// default from its `[run]` table).
     pub fn runner(&self, base: Config) -> Result<PointRunner> {
         let settings = base.run();
-        let transient = self.transient.unwrap_or(settings.transient());
-        let recorded = self.recorded.unwrap_or(settings.periods - settings.transient());
+        let defaults = (settings.transient(), settings.periods - settings.transient());
+        self.runner_or(base, defaults)
+    }
+
+    /// The point runner of these settings on `base`, with `(transient, recorded)` periods
+    /// where the options do not give them.
+    pub fn runner_or(&self, base: Config, (transient, recorded): (u64, u64)) -> Result<PointRunner> {
+        let transient = self.transient.unwrap_or(transient);
+        let recorded = self.recorded.unwrap_or(recorded);
         if recorded == 0 {
             bail!("--recorded must be at least 1");
         }
@@ -176,7 +184,7 @@ pub fn run_points<'k, P, W>(
     runner: &PointRunner,
     points: &[P],
     keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
-    (what, before, total): (&str, u64, u64),
+    progress: (&str, u64, u64),
     quiet: bool,
     mut write: W,
 ) -> Result<usize>
@@ -184,13 +192,42 @@ where
     P: Sync,
     W: FnMut(Option<(&P, &Result<PointResult, String>)>) -> Result<()>,
 {
+    run_chunked(
+        points,
+        |p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")),
+        progress,
+        quiet,
+        |d| match d {
+            Some((p, r)) => write(Some((p, &r))),
+            None => write(None),
+        },
+    )
+}
+
+/// Runs `work` on `points` in parallel chunks ([`vibrotribo::sweep::run_chunks`]), calling
+/// `write` with each result in order and with `None` after each chunk, with a progress bar
+/// (label, points done before, points in all) and a stop after the current chunk on
+/// SIGINT/SIGTERM. Returns how many were written.
+pub fn run_chunked<P, R, W, F>(
+    points: &[P],
+    work: W,
+    (what, before, total): (&str, u64, u64),
+    quiet: bool,
+    mut write: F,
+) -> Result<usize>
+where
+    P: Sync,
+    R: Send,
+    W: Fn(&P) -> R + Sync,
+    F: FnMut(Option<(&P, R)>) -> Result<()>,
+{
     let progress = Progress::new(total, what, quiet).starting_at(before);
     let mut failure = None;
-    let done = run_grid(runner, points, keys, rayon::current_num_threads() * 4, |d| {
+    let done = run_chunks(points, rayon::current_num_threads() * 4, work, |d| {
         let (written, checkpoint) = match d {
             Delivery::Point(p, r) => {
                 progress.inc(1);
-                (write(Some((p, &r.map_err(|e| format!("{e:#}"))))), false)
+                (write(Some((p, r))), false)
             }
             Delivery::Chunk(_) => (write(None), true),
         };
@@ -594,6 +631,8 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let first = &args.shards[0];
     if first.join("map.json").exists() {
         crate::map::merge(args)?;
+    } else if first.join("basins.json").exists() {
+        crate::basins::merge(args)?;
     } else {
         // orbit.csv: param, period, x1_m, …, xN_m.
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
