@@ -58,8 +58,13 @@ pub struct AttractorsArgs {
     /// Cell edge of the recurrence grid for non-periodic section clouds (scaled units).
     #[arg(long, default_value_t = 0.02)]
     pub cell: f64,
-    /// Two periodic section sets are one attractor within this scaled distance.
+    /// A start's stroboscopic section (positions and velocities, scaled units) is periodic
+    /// when it repeats within this tolerance (coarser than a sweep's --period-tolerance,
+    /// which does not apply here: a start still ringing down onto an orbit is that orbit).
     #[arg(long, default_value_t = 1e-3)]
+    pub section_tolerance: f64,
+    /// Two periodic section sets are one attractor within this scaled distance.
+    #[arg(long, default_value_t = 3e-3)]
     pub match_tolerance: f64,
     /// An attractor continues one of the previous value within this scaled set distance
     /// (when no seeded run decides).
@@ -96,7 +101,7 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     let options = AttractorOptions {
-        period_tolerance: args.run.period_tolerance,
+        period_tolerance: args.section_tolerance,
         match_tolerance: args.match_tolerance,
         cell: args.cell,
         continuation_distance: args.continuation_distance,

@@ -94,8 +94,13 @@ pub struct BasinsArgs {
     /// units: positions over L = Σδ + A, velocities over L·ω).
     #[arg(long, default_value_t = 0.02)]
     pub cell: f64,
-    /// Two periodic section sets are one attractor within this scaled distance.
+    /// A start's stroboscopic section (positions and velocities, scaled units) is periodic
+    /// when it repeats within this tolerance (coarser than a sweep's --period-tolerance,
+    /// which does not apply here: a start still ringing down onto an orbit is that orbit).
     #[arg(long, default_value_t = 1e-3)]
+    pub section_tolerance: f64,
+    /// Two periodic section sets are one attractor within this scaled distance.
+    #[arg(long, default_value_t = 3e-3)]
     pub match_tolerance: f64,
     #[command(flatten)]
     pub run: RunArgs,
@@ -228,7 +233,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
         bail!("--x and --y are the same key");
     }
     let options = AttractorOptions {
-        period_tolerance: args.run.period_tolerance,
+        period_tolerance: args.section_tolerance,
         match_tolerance: args.match_tolerance,
         cell: args.cell,
         ..AttractorOptions::default()

@@ -92,6 +92,47 @@ fn an_impact_free_chain_has_one_attractor_at_its_forced_response() {
     }
 }
 
+#[test]
+fn the_default_case_is_multistable_and_each_attractor_is_a_stable_orbit_by_shooting() {
+    // Starts from rest settle on the paper's six-impact orbit; random starts mostly find
+    // five-impact orbits, some of them still ringing down (a multiplier near −1) at the
+    // 1e-5 level after 500 periods: each attractor's section point is one Newton solve from
+    // a stable periodic orbit.
+    let runner = starts(Config::default(), 500, 100, true);
+    let (fps, scale) = random_starts(&runner, 24, 2);
+    let cl = classify(&fps, &scale, runner.options());
+    let chain = runner.chain(&[]).unwrap();
+    let impacts: Vec<f64> = cl.attractors.iter().map(|a| a.impacts_per_period).collect();
+    println!(
+        "impacts per period {impacts:?}, starts {:?}",
+        cl.attractors.iter().map(|a| a.starts).collect::<Vec<_>>()
+    );
+    assert!(impacts.contains(&6.0) && impacts.contains(&5.0), "{impacts:?}");
+    for a in &cl.attractors {
+        assert_eq!(a.period, 1);
+        let orbit = vibrotribo::orbits::find_periodic_orbit(
+            &chain,
+            &a.state(),
+            1,
+            &vibrotribo::orbits::ShootingOptions::default(),
+        )
+        .unwrap();
+        assert!(orbit.stable, "{:?}", orbit.multipliers);
+        let z = vibrotribo::sensitivity::state_vector(&orbit.state);
+        for (i, (p, q)) in a.points.iter().zip(z.iter()).enumerate() {
+            let d = scale.scaled(i, p - q).abs();
+            assert!(
+                d < runner.options().period_tolerance,
+                "coordinate {i}: {p} vs {q}"
+            );
+        }
+        println!(
+            "orbit with {} impacts/period: largest multiplier {:.4}",
+            a.impacts_per_period, orbit.multipliers[0]
+        );
+    }
+}
+
 /// Fig. 7's chain (m = 90, 120, 90 g, Ω = 0.70) at spacing ratio `r`.
 fn fig7(r: f64) -> Config {
     config(&[
