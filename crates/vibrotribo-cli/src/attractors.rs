@@ -56,7 +56,7 @@ pub struct AttractorsArgs {
     #[arg(long)]
     pub plot: bool,
     /// Cell edge of the recurrence grid for non-periodic section clouds (scaled units).
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.05)]
     pub cell: f64,
     /// A start's stroboscopic section (positions and velocities, scaled units) is periodic
     /// when it repeats within this tolerance (coarser than a sweep's --period-tolerance,

@@ -92,7 +92,7 @@ pub struct BasinsArgs {
     pub plot: bool,
     /// Cell edge of the recurrence grid that matches non-periodic section clouds (scaled
     /// units: positions over L = Σδ + A, velocities over L·ω).
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.05)]
     pub cell: f64,
     /// A start's stroboscopic section (positions and velocities, scaled units) is periodic
     /// when it repeats within this tolerance (coarser than a sweep's --period-tolerance,

@@ -133,6 +133,25 @@ fn the_default_case_is_multistable_and_each_attractor_is_a_stable_orbit_by_shoot
     }
 }
 
+#[test]
+fn a_hyperchaotic_attractor_is_one_non_periodic_attractor() {
+    // Fig. 14's chain at R_m = 6.54, Ω = 0.72: λ1 = 3.3, λ2 = 1.1 1/s (tests/lyapunov.rs).
+    let c = config(&[
+        ("oscillator.masses", array(&[0.05, 0.327, 0.05])),
+        ("omega_ratio", toml::Value::Float(0.72)),
+    ]);
+    let runner = starts(c, 300, 100, true);
+    let (fps, scale) = random_starts(&runner, 12, 4);
+    let cl = classify(&fps, &scale, runner.options());
+    assert_eq!(
+        cl.attractors.len(),
+        1,
+        "{:?}",
+        cl.attractors.iter().map(|a| a.starts).collect::<Vec<_>>()
+    );
+    assert_eq!((cl.attractors[0].period, cl.attractors[0].starts), (0, 12));
+}
+
 /// Fig. 7's chain (m = 90, 120, 90 g, Ω = 0.70) at spacing ratio `r`.
 fn fig7(r: f64) -> Config {
     config(&[
