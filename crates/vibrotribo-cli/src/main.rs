@@ -1,12 +1,15 @@
 //! The `vibrotribo` command-line program: argument parsing, configuration files, output
 //! files and plots. All physics lives in the `vibrotribo` library.
 
+mod attractors;
+mod basins;
 mod config;
 mod continuation;
 mod export_spice;
 mod job;
 mod limits;
 mod load_sweep;
+mod lyapunov;
 mod map;
 mod output;
 mod periodic;
@@ -43,12 +46,22 @@ enum Command {
     Continue(continuation::ContinueArgs),
     /// Sweep one parameter: orbit diagram, impact velocities, period, power.
     Sweep(sweep::SweepArgs),
-    /// Combine the shards of one sweep (`sweep --shard I/N`) into the unsharded output.
+    /// Combine the shards of one sweep, map or basins job (`--shard I/N`) into the unsharded
+    /// output.
     Merge(sweep::MergeArgs),
     /// Average power, period and impacts per period on a two-parameter grid.
     Map(map::MapArgs),
     /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
     OptimizeMassRatio(map::OptimizeArgs),
+    /// Basins of attraction over two initial conditions: the attractors, their basin
+    /// fractions, periods, impacts and power (starts run 500 transient and 100 recorded
+    /// periods unless --transient/--recorded say).
+    Basins(basins::BasinsArgs),
+    /// Attractors of random starts across a parameter: basin fractions (± standard error),
+    /// power per attractor and the expected power of an unknown start.
+    Attractors(attractors::AttractorsArgs),
+    /// Lyapunov spectrum (all 2N exponents, through impacts and sticking) with its spread.
+    Lyapunov(lyapunov::LyapunovArgs),
     /// Recompute the paper's study (Figs. 5–25) and write REPORT.md comparing its findings.
     Reproduce(reproduce::ReproduceArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
@@ -58,7 +71,8 @@ enum Command {
 /// Options of `vibrotribo plot`.
 #[derive(Debug, clap::Args)]
 struct PlotArgs {
-    /// A directory written by `simulate --out`, `sweep --out` or `map --out`.
+    /// A directory written by `simulate`, `sweep`, `map`, `lyapunov`, `basins` or
+    /// `attractors` with `--out`.
     dir: std::path::PathBuf,
     /// PSD of this mass only (1-based; default: every mass).
     #[arg(long)]
@@ -79,6 +93,9 @@ fn run() -> anyhow::Result<()> {
         Command::Merge(args) => sweep::merge(&args),
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),
+        Command::Lyapunov(args) => lyapunov::run(&args),
+        Command::Basins(args) => basins::run(&args),
+        Command::Attractors(args) => attractors::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
     }

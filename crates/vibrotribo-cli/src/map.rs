@@ -146,7 +146,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
             args.run.allow_large,
         )?;
     }
-    let columns = point_columns(runner.masses(), runner.options().floquet);
+    let columns = point_columns(runner.masses(), runner.options().floquet, false);
     let o = runner.options();
     let mut settings = json!({
         "command": "map",
@@ -231,7 +231,11 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     // map.csv: x, y, then the point columns: 7, one per contact, and the Floquet column.
     let floquet = floquet_of(&args.shards[0], "map.json")?;
     let contacts = header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2 + 7 + usize::from(floquet));
-    let columns = PointColumns { contacts, floquet };
+    let columns = PointColumns {
+        contacts,
+        floquet,
+        lyapunov: false,
+    };
     let keys = |m: &serde_json::Value| -> Result<Vec<String>> {
         let axis = |a: &str| -> Result<Vec<f64>> {
             m[a]["values"]
@@ -421,7 +425,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             index += 1;
             if let Some(csv) = grid_csv.as_mut() {
                 // Of the point's columns: average_power_w, impacts_per_period, period, error.
-                let mut cells = point_columns(contacts + 1, false).cells(res);
+                let mut cells = point_columns(contacts + 1, false, false).cells(res);
                 let error = cells.pop().unwrap_or_default();
                 cells.truncate(3);
                 csv.row(

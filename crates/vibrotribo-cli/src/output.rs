@@ -218,14 +218,21 @@ pub fn si(value: f64, unit: &str) -> String {
 
 /// The columns describing one sweep or map point, after its key columns: `average_power_w`,
 /// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
-/// `impacts_per_period_1..contacts`, `error`, and with `floquet` `max_abs_multiplier`.
+/// `impacts_per_period_1..contacts`, `error`, with `floquet` `max_abs_multiplier`, and with
+/// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointColumns {
     /// Contacts of the chain (N − 1).
     pub contacts: usize,
     /// Whether the largest Floquet multiplier modulus is a column (`--floquet`).
     pub floquet: bool,
+    /// Whether the largest Lyapunov exponent and its spread are columns (`--lyapunov`).
+    pub lyapunov: bool,
 }
+
+/// The columns `--lyapunov` adds at the end: the largest Lyapunov exponent over the recorded
+/// periods and its batch-means standard error, 1/s.
+const LYAPUNOV_COLUMNS: [&str; 2] = ["lyapunov_max_1_s", "lyapunov_spread_1_s"];
 
 impl PointColumns {
     /// The column names.
@@ -244,6 +251,9 @@ impl PointColumns {
         cols.push("error".into());
         if self.floquet {
             cols.push("max_abs_multiplier".into());
+        }
+        if self.lyapunov {
+            cols.extend(LYAPUNOV_COLUMNS.map(String::from));
         }
         cols
     }
@@ -279,6 +289,16 @@ impl PointColumns {
                 .and_then(|p| p.max_abs_multiplier.as_ref())
                 .and_then(|m| m.as_ref().ok());
             row.push(m.map_or(String::new(), f64::to_string));
+        }
+        if self.lyapunov {
+            // Blank if the point failed or no period could be averaged.
+            row.extend(match result {
+                Ok(PointResult {
+                    lyapunov: Some(Ok(s)),
+                    ..
+                }) => [s.largest().to_string(), s.largest_spread().to_string()],
+                _ => [String::new(), String::new()],
+            });
         }
         row
     }

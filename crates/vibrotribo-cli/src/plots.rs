@@ -33,11 +33,18 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         plot_sweep(dir)
     } else if dir.join("map.json").exists() {
         plot_map(dir)
+    } else if dir.join("basins.json").exists() {
+        crate::basins::finish(dir)?;
+        crate::basins::plot_basins(dir)
+    } else if dir.join("attractors.json").exists() {
+        crate::attractors::plot_attractors(dir)
+    } else if dir.join("lyapunov.json").exists() {
+        crate::lyapunov::plot_lyapunov(dir)
     } else if dir.join("summary.json").exists() && dir.join("trajectory.csv").exists() {
         analyze_run(dir, psd_mass)
     } else {
         bail!(
-            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json or map.json)",
+            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json, basins.json, attractors.json or lyapunov.json)",
             dir.display()
         )
     }
@@ -109,6 +116,34 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
         }
         both(dir, "power", |path| {
             plot::line_plot(path, &fig, &[Series::unlabelled(&sp, &power)])
+        })?;
+    }
+    if let Ok(c) = column(&sh, "lyapunov_max_1_s") {
+        let l = numbers(&srows, c);
+        let spread = numbers(&srows, column(&sh, "lyapunov_spread_1_s")?);
+        let (lo, hi): (Vec<f64>, Vec<f64>) = l
+            .iter()
+            .zip(&spread)
+            .map(|(l, s)| (l - 3.0 * s, l + 3.0 * s))
+            .unzip();
+        let zero = vec![0.0; sp.len()];
+        let mut fig = Figure::new(
+            "Largest Lyapunov exponent (± 3 batch-means standard errors)",
+            param.clone(),
+            "λ1 [1/s]",
+        );
+        fig.legend = Legend::UpperLeft;
+        both(dir, "lyapunov", |path| {
+            plot::line_plot(
+                path,
+                &fig,
+                &[
+                    Series::new("λ1", &sp, &l),
+                    Series::new("λ1 − 3σ", &sp, &lo),
+                    Series::new("λ1 + 3σ", &sp, &hi),
+                    Series::unlabelled(&sp, &zero),
+                ],
+            )
         })?;
     }
     let ipp = numbers(&srows, column(&sh, "impacts_per_period")?);

@@ -9,8 +9,9 @@ use anyhow::{Context, Result, anyhow, bail};
 use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::config::Config;
+use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
-use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_continued, run_grid};
+use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_chunks, run_continued};
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
@@ -118,16 +119,29 @@ pub struct SweepArgs {
     /// Also draw the diagrams (PNG and SVG) into the output directory.
     #[arg(long)]
     pub plot: bool,
+    /// Also compute the largest Lyapunov exponent over the recorded periods of every value
+    /// (columns `lyapunov_max_1_s` and its batch-means standard error `lyapunov_spread_1_s`
+    /// at the end of summary.csv).
+    #[arg(long)]
+    pub lyapunov: bool,
     #[command(flatten)]
     pub run: RunArgs,
 }
 
 impl RunArgs {
-    /// The point runner of these settings on `base`.
+    /// The point runner of these settings on `base` (transient and recorded periods by
+    /// default from its `[run]` table).
     pub fn runner(&self, base: Config) -> Result<PointRunner> {
         let settings = base.run();
-        let transient = self.transient.unwrap_or(settings.transient());
-        let recorded = self.recorded.unwrap_or(settings.periods - settings.transient());
+        let defaults = (settings.transient(), settings.periods - settings.transient());
+        self.runner_or(base, defaults)
+    }
+
+    /// The point runner of these settings on `base`, with `(transient, recorded)` periods
+    /// where the options do not give them.
+    pub fn runner_or(&self, base: Config, (transient, recorded): (u64, u64)) -> Result<PointRunner> {
+        let transient = self.transient.unwrap_or(transient);
+        let recorded = self.recorded.unwrap_or(recorded);
         if recorded == 0 {
             bail!("--recorded must be at least 1");
         }
@@ -175,7 +189,7 @@ pub fn run_points<'k, P, W>(
     runner: &PointRunner,
     points: &[P],
     keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
-    (what, before, total): (&str, u64, u64),
+    progress: (&str, u64, u64),
     quiet: bool,
     mut write: W,
 ) -> Result<usize>
@@ -183,13 +197,42 @@ where
     P: Sync,
     W: FnMut(Option<(&P, &Result<PointResult, String>)>) -> Result<()>,
 {
+    run_chunked(
+        points,
+        |p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")),
+        progress,
+        quiet,
+        |d| match d {
+            Some((p, r)) => write(Some((p, &r))),
+            None => write(None),
+        },
+    )
+}
+
+/// Runs `work` on `points` in parallel chunks ([`vibrotribo::sweep::run_chunks`]), calling
+/// `write` with each result in order and with `None` after each chunk, with a progress bar
+/// (label, points done before, points in all) and a stop after the current chunk on
+/// SIGINT/SIGTERM. Returns how many were written.
+pub fn run_chunked<P, R, W, F>(
+    points: &[P],
+    work: W,
+    (what, before, total): (&str, u64, u64),
+    quiet: bool,
+    mut write: F,
+) -> Result<usize>
+where
+    P: Sync,
+    R: Send,
+    W: Fn(&P) -> R + Sync,
+    F: FnMut(Option<(&P, R)>) -> Result<()>,
+{
     let progress = Progress::new(total, what, quiet).starting_at(before);
     let mut failure = None;
-    let done = run_grid(runner, points, keys, rayon::current_num_threads() * 4, |d| {
+    let done = run_chunks(points, rayon::current_num_threads() * 4, work, |d| {
         let (written, checkpoint) = match d {
             Delivery::Point(p, r) => {
                 progress.inc(1);
-                (write(Some((p, &r.map_err(|e| format!("{e:#}"))))), false)
+                (write(Some((p, r))), false)
             }
             Delivery::Chunk(_) => (write(None), true),
         };
@@ -225,12 +268,12 @@ pub fn set_threads(threads: Option<usize>) -> Result<()> {
 }
 
 /// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
-/// one row per value) and the manifest `sweep.json`.
-fn sweep_layout(masses: usize, floquet: bool) -> Layout {
+/// one row per value; its columns are [`PointColumns`]) and the manifest `sweep.json`.
+fn sweep_layout(masses: usize, columns: PointColumns) -> Layout {
     let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
     orbit_cols.extend(numbered("x", masses, "_m"));
     let mut summary_cols = vec!["param".to_string()];
-    summary_cols.extend(point_columns(masses, floquet).names());
+    summary_cols.extend(columns.names());
     Layout {
         manifest: "sweep.json",
         files: vec![
@@ -287,10 +330,11 @@ fn write_value(
 }
 
 /// The point columns of a chain of `masses` masses.
-pub fn point_columns(masses: usize, floquet: bool) -> PointColumns {
+pub fn point_columns(masses: usize, floquet: bool, lyapunov: bool) -> PointColumns {
     PointColumns {
         contacts: masses - 1,
         floquet,
+        lyapunov,
     }
 }
 
@@ -323,6 +367,10 @@ fn settings_json(
     });
     if o.floquet {
         settings["floquet"] = json!(true);
+    }
+    if args.lyapunov {
+        // Only with the option, so that other sweeps' manifests stay as they were.
+        settings["lyapunov"] = json!(true);
     }
     settings
 }
@@ -379,8 +427,16 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
-    let runner = args.run.runner(base)?;
+    let mut runner = args.run.runner(base)?;
+    if args.lyapunov {
+        let options = PointOptions {
+            lyapunov: Some(LyapunovOptions::default()),
+            ..runner.options().clone()
+        };
+        runner = PointRunner::new(runner.base().clone(), options, runner.mechanics_only());
+    }
     let masses = runner.masses();
+    let columns = point_columns(masses, runner.options().floquet, args.lyapunov);
     let values = grid(args.from, args.to, args.steps);
     check_distinct("--from/--to/--steps", &values)?;
     // Fail early on a bad key or on any value of the grid that makes a bad configuration.
@@ -422,13 +478,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             } else {
                 order.len()
             };
-            let (o, done) = GridOutput::resume(
-                dir,
-                sweep_layout(masses, runner.options().floquet),
-                settings,
-                &keys,
-                keep,
-            )?;
+            let (o, done) = GridOutput::resume(dir, sweep_layout(masses, columns), settings, &keys, keep)?;
             if let Some((n, s)) = checkpoint.filter(|c| c.0 == done && done > 0) {
                 state = Some(serde_json::from_value(s).map_err(|e| {
                     anyhow!(
@@ -442,17 +492,12 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             (Some(o), done)
         }
         Some(dir) => (
-            Some(GridOutput::create(
-                dir,
-                sweep_layout(masses, runner.options().floquet),
-                settings,
-            )?),
+            Some(GridOutput::create(dir, sweep_layout(masses, columns), settings)?),
             0,
         ),
     };
     let started = Instant::now();
     let mut failed = 0usize;
-    let columns = point_columns(masses, runner.options().floquet);
     let key = args.param.as_str();
     let todo = &order[skip..];
     let computed = match args.continuation {
@@ -575,14 +620,20 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let first = &args.shards[0];
     if first.join("map.json").exists() {
         crate::map::merge(args)?;
+    } else if first.join("basins.json").exists() {
+        crate::basins::merge(args)?;
     } else {
         // orbit.csv: param, period, x1_m, …, xN_m.
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
-        let floquet = floquet_of(first, "sweep.json")?;
+        let columns = PointColumns {
+            contacts: masses.saturating_sub(1),
+            floquet: floquet_of(first, "sweep.json")?,
+            lyapunov: crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true),
+        };
         crate::job::merge(
             &args.shards,
             &args.out,
-            &sweep_layout(masses, floquet),
+            &sweep_layout(masses, columns),
             sweep_keys,
         )?;
     }

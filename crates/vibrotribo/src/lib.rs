@@ -21,6 +21,10 @@
 //! - [`orbits`] finds periodic orbits by shooting (stable or not), their Floquet multipliers,
 //!   and continues them in a parameter through folds, period doublings (cascades included),
 //!   Neimark–Sacker points, grazings and the onset of sticking.
+//! - [`lyapunov`] computes all 2N Lyapunov exponents through impacts, sticking and chatter
+//!   from the same state-transition matrix, with a batch-means error bar.
+//! - [`attractors`] finds the attractors that starts end on (by their stroboscopic sets),
+//!   their basin fractions and powers, and follows them across a parameter.
 //!
 //! ```
 //! use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator};
@@ -36,13 +40,16 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod attractors;
 #[cfg(feature = "config")]
 pub mod config;
 pub mod dynamics;
 pub mod electrical;
 mod error;
+pub mod lyapunov;
 pub mod model;
 pub mod orbits;
+mod random;
 pub mod sensitivity;
 pub mod study;
 #[cfg(feature = "config")]

@@ -130,7 +130,16 @@ impl PointRunner {
     /// Runs the configuration with `keys` set, from `initial` (if it fits the chain) or the
     /// configured initial state.
     pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult, SweepError> {
-        let config = self.configure(keys)?;
+        self.run_config(&self.configure(keys)?, initial)
+    }
+
+    /// Runs `config` (one of [`configure`](Self::configure)'s) with this runner's point
+    /// options, from `initial` (if it fits the chain) or the configured initial state.
+    pub fn run_config(
+        &self,
+        config: &Config,
+        initial: Option<&ChainState>,
+    ) -> Result<PointResult, SweepError> {
         let params = config.chain();
         let initial = match initial {
             Some(s) if s.positions.len() == params.len() && params.validate_state(s).is_ok() => s,
@@ -147,13 +156,13 @@ impl PointRunner {
     }
 }
 
-/// What [`run_grid`] hands over, in grid order (handed over once, by value: its size does
-/// not matter).
+/// What [`run_grid`] (and [`run_chunks`]) hands over, in grid order (handed over once, by
+/// value: its size does not matter).
 #[derive(Debug)]
 #[allow(clippy::large_enum_variant)]
-pub enum Delivery<'a, P> {
+pub enum Delivery<'a, P, R = Result<PointResult, SweepError>> {
     /// A point and its result.
-    Point(&'a P, Result<PointResult, SweepError>),
+    Point(&'a P, R),
     /// The end of a chunk, with the number of points delivered so far: a checkpoint.
     Chunk(usize),
 }
@@ -167,16 +176,29 @@ pub fn run_grid<'k, P, F>(
     points: &[P],
     keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
     chunk: usize,
-    mut on: F,
+    on: F,
 ) -> usize
 where
     P: Sync,
     F: FnMut(Delivery<'_, P>) -> ControlFlow<()>,
 {
+    run_chunks(points, chunk, |p| runner.run(&keys(p), None), on)
+}
+
+/// Runs `work` on `points` in parallel chunks of `chunk` points on the current rayon pool and
+/// hands each result to `on` in order, then the end of the chunk; `on` may stop the run.
+/// Returns how many points were delivered. What is delivered does not depend on the thread
+/// count. [`run_grid`] is this with a sweep point as the work.
+pub fn run_chunks<P, R, W, F>(points: &[P], chunk: usize, work: W, mut on: F) -> usize
+where
+    P: Sync,
+    R: Send,
+    W: Fn(&P) -> R + Sync,
+    F: FnMut(Delivery<'_, P, R>) -> ControlFlow<()>,
+{
     let mut done = 0;
     for block in points.chunks(chunk.max(1)) {
-        let results: Vec<Result<PointResult, SweepError>> =
-            block.par_iter().map(|p| runner.run(&keys(p), None)).collect();
+        let results: Vec<R> = block.par_iter().map(&work).collect();
         for (p, r) in block.iter().zip(results) {
             done += 1;
             if on(Delivery::Point(p, r)).is_break() {

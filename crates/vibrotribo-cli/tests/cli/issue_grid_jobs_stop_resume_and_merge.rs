@@ -40,27 +40,7 @@ fn run(args: &[String]) -> std::process::Output {
     vibrotribo(&a)
 }
 
-fn files_equal(a: &Path, b: &Path, names: &[&str]) {
-    for name in names {
-        let (x, y) = (read(a, name), read(b, name));
-        if x != y {
-            let line = x.lines().zip(y.lines()).position(|(p, q)| p != q);
-            panic!(
-                "{name} differs between {} and {} (first differing line {line:?}; {} vs {} lines)",
-                a.display(),
-                b.display(),
-                x.lines().count(),
-                y.lines().count()
-            );
-        }
-    }
-}
-
 const SWEEP_FILES: [&str; 4] = ["orbit.csv", "impacts.csv", "summary.csv", "sweep.json"];
-
-fn manifest(dir: &Path, name: &str) -> serde_json::Value {
-    serde_json::from_str(&read(dir, name)).unwrap()
-}
 
 #[test]
 fn merge_accepts_the_shards_of_the_issue_and_equals_the_unsharded_run() {
@@ -188,61 +168,6 @@ fn a_rerun_shard_killed_is_incomplete_and_merge_refuses_it() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("incomplete"), "{}", stderr(&o));
     assert!(!out.exists());
-}
-
-fn set_len(path: &Path, len: u64) {
-    let f = std::fs::OpenOptions::new().write(true).open(path).unwrap();
-    f.set_len(len).unwrap();
-}
-
-/// Cuts a finished job's files as a SIGKILL could leave them, and marks the job unfinished.
-/// The protocol writes a point's index row (in `index`) only once its other rows are on
-/// disk: the index file is cut at `fraction` of its length, and each data file (`data`,
-/// whose first `key_fields` fields name the point) at a place past the rows of the points
-/// whose index rows remain, `beyond` of the way to its end.
-fn cut(
-    dir: &Path,
-    index: &str,
-    data: &[&str],
-    key_fields: usize,
-    manifest_name: &str,
-    fraction: f64,
-    beyond: f64,
-) {
-    let key = |line: &str| line.split(',').take(key_fields).collect::<Vec<_>>().join(",");
-    let path = dir.join(index);
-    let text = std::fs::read_to_string(&path).unwrap();
-    let len = (text.len() as f64 * fraction) as usize;
-    set_len(&path, len as u64);
-    let kept: std::collections::HashSet<String> = text[..len]
-        .split_inclusive('\n')
-        .skip(1)
-        .filter(|l| l.ends_with('\n'))
-        .map(key)
-        .collect();
-    for name in data {
-        let path = dir.join(name);
-        let text = std::fs::read_to_string(&path).unwrap();
-        let mut end = text.find('\n').unwrap() + 1;
-        for line in text[end..].split_inclusive('\n') {
-            if !kept.contains(&key(line)) {
-                break;
-            }
-            end += line.len();
-        }
-        set_len(&path, (end as f64 + (text.len() - end) as f64 * beyond) as u64);
-    }
-    let mut m = manifest(dir, manifest_name);
-    m["complete"] = false.into();
-    std::fs::write(dir.join(manifest_name), m.to_string()).unwrap();
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
-    }
 }
 
 #[test]

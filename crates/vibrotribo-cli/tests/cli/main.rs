@@ -1,8 +1,10 @@
 //! Integration tests of the `vibrotribo` binary: file contracts, and clear errors on bad input.
 //! One test target; each fixed bug has its own module (`issue_*.rs`) opening with what broke.
 
+mod basins;
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_simulate_output_edges;
+mod lyapunov;
 mod periodic_orbits;
 mod util;
 

@@ -155,6 +155,34 @@ impl Sensitivity {
         self.events.clear();
     }
 
+    /// Starts a new product at the end of the latest piece of flow: Φ ← I, so that from
+    /// there on [`stm`](Self::stm) is `∂z(t)/∂z(t₁)` with `t₁` the restart time (products of
+    /// Φ over consecutive intervals, as a Lyapunov spectrum's re-orthonormalisation needs).
+    /// Unlike [`reset`](Self::reset), events reported after the restart are applied as usual.
+    ///
+    /// Refuses (returns false, changes nothing) where Φ over the interval so far cannot be
+    /// split there: right after an event (call it after a piece of flow), while a chatter jump
+    /// is scheduled (its time depends on the state at the impact that started it, which no
+    /// matrix at `t₁` carries; see [`chatter_pending`](Self::chatter_pending)), after a
+    /// non-differentiable point, or before anything was observed.
+    pub fn restart(&mut self) -> bool {
+        if self.failure.is_some() || !self.batch.is_empty() || self.chatter_pending() {
+            return false;
+        }
+        let Some(span) = &mut self.span else {
+            return false;
+        };
+        span.0 = span.1;
+        self.phi.fill_with_identity();
+        true
+    }
+
+    /// Whether a chatter accumulation-point jump started by an observed impact is still to
+    /// come (its time's gradient is held until then).
+    pub fn chatter_pending(&self) -> bool {
+        self.chatter_set.iter().any(|&s| s)
+    }
+
     /// The time interval `(t₀, t)` observed so far, s.
     pub fn span(&self) -> Option<(f64, f64)> {
         self.span

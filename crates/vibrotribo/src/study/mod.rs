@@ -5,6 +5,7 @@
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
+mod lyapunov;
 mod observer;
 mod orbit;
 mod point;
@@ -12,6 +13,7 @@ mod replay;
 mod settings;
 mod simulate;
 
+pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};

@@ -18,6 +18,7 @@ use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, Strobosco
 use crate::dynamics::{Event, EventKind, Observer, StateView};
 use crate::electrical::{ChargeOptions, HarvesterParams};
 use crate::error::SimError;
+use crate::lyapunov::{LyapunovError, LyapunovObserver, LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::orbits::{ShootingOptions, find_periodic_orbit};
 
@@ -43,6 +44,9 @@ pub struct PointOptions {
     /// and report its largest Floquet multiplier modulus
     /// ([`PointResult::max_abs_multiplier`]). Default false.
     pub floquet: bool,
+    /// Also compute the Lyapunov spectrum over the recorded periods (the tangent vectors
+    /// align during the transient; [`PointResult::lyapunov`]). Default `None`.
+    pub lyapunov: Option<LyapunovOptions>,
 }
 
 impl Default for PointOptions {
@@ -54,6 +58,7 @@ impl Default for PointOptions {
             grazing_ratio: 1e-3,
             electrical_warmup_periods: 20,
             floquet: false,
+            lyapunov: None,
         }
     }
 }
@@ -92,6 +97,8 @@ pub struct PointResult {
     pub strobe_periods: Vec<u64>,
     /// Positions at those times, m, flattened (`strobe[j·N + i]`).
     pub strobe: Vec<f64>,
+    /// Velocities at those times, m/s, flattened like [`strobe`](Self::strobe).
+    pub strobe_velocities: Vec<f64>,
     /// Impacts after the transient.
     pub impacts: Vec<ImpactRecord>,
     /// Mean impacts per period after the transient, per contact.
@@ -116,6 +123,9 @@ pub struct PointResult {
     /// Floquet multipliers of the periodic orbit of that period found by shooting from the
     /// final state (`Err` with the reason where shooting failed, e.g. at a grazing point).
     pub max_abs_multiplier: Option<Result<f64, String>>,
+    /// The Lyapunov spectrum over the recorded periods, if [`PointOptions::lyapunov`] asked
+    /// for it.
+    pub lyapunov: Option<Result<LyapunovSpectrum, LyapunovError>>,
 }
 
 impl PointResult {
@@ -235,15 +245,22 @@ pub fn run_point(
         },
     )
     .expect("valid stroboscopic options");
+    let lyapunov = match &options.lyapunov {
+        Some(o) => Some(LyapunovObserver::new(params, transient, o).map_err(StudyError::from)?),
+        None => None,
+    };
     let mut watch = (
         Mechanics::new(strobe),
-        Impacts {
-            after: transient as f64 * period,
-            grazing_speed: options.grazing_ratio * params.excitation.amplitude * params.omega(),
-            last_rebound: vec![0.0; n - 1],
-            records: Vec::new(),
-            grazing: false,
-        },
+        (
+            Mechanics::new(lyapunov),
+            Impacts {
+                after: transient as f64 * period,
+                grazing_speed: options.grazing_ratio * params.excitation.amplitude * params.omega(),
+                last_rebound: vec![0.0; n - 1],
+                records: Vec::new(),
+                grazing: false,
+            },
+        ),
     );
     let outcome = simulate(&spec, &mut watch)?;
     match outcome.ending {
@@ -251,7 +268,7 @@ pub fn run_point(
         Ending::Failed(e) => return Err(PointError::Study(e)),
         Ending::Completed | Ending::Stopped => {}
     }
-    let (strobe, impacts) = (watch.0.inner, watch.1);
+    let (strobe, (lyapunov, impacts)) = (watch.0.inner, (watch.1.0.inner, watch.1.1));
     let (average_power_w, electrical_error) = match &outcome.electrical {
         Some(e) => match &e.power {
             Some(p) if e.solver_error.is_none() => (Some(p.average_power_w), None),
@@ -283,6 +300,7 @@ pub fn run_point(
     Ok(PointResult {
         strobe_periods: strobe.indices,
         strobe: strobe.positions,
+        strobe_velocities: strobe.velocities,
         impacts_per_period: stats.impacts_per_period(total),
         impacts: impacts.records,
         periodicity,
@@ -293,6 +311,7 @@ pub fn run_point(
         electrical_error,
         final_state: outcome.final_state,
         max_abs_multiplier,
+        lyapunov: lyapunov.map(LyapunovObserver::finish),
     })
 }
 

@@ -1,0 +1,413 @@
+//! `vibrotribo attractors`: the attractors of K random starts at each value of a parameter
+//! ([`vibrotribo::attractors::attractors_across`]), followed from value to value, with each
+//! one's basin fraction and power and the expected power of an unknown start.
+
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow, bail};
+use serde_json::json;
+use vibrotribo::attractors::{
+    AcrossDelivery, AttractorOptions, RandomStarts, StartBox, StartRunner, ValueAttractors, attractors_across,
+};
+use vibrotribo::sweep::grid;
+
+use crate::basins::DEFAULT_PERIODS;
+use crate::config::ConfigArgs;
+use crate::output::{CsvFile, create_dir, csv_text, numbered, read_csv, read_json, si, write_json};
+use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
+use crate::progress::{Interrupted, Progress, interrupted};
+use crate::sweep::{RunArgs, check_all, check_distinct, set_threads};
+
+/// Options of `vibrotribo attractors`.
+#[derive(Debug, clap::Args)]
+pub struct AttractorsArgs {
+    #[command(flatten)]
+    pub input: ConfigArgs,
+    /// The parameter (any key `sweep --param` accepts).
+    #[arg(long)]
+    pub param: String,
+    /// First value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub from: f64,
+    /// Last value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub to: f64,
+    /// Number of values.
+    #[arg(long)]
+    pub steps: usize,
+    /// Random starts per value, K.
+    #[arg(long, default_value_t = 100)]
+    pub samples: usize,
+    /// Seed of the random starts (the same starts at every value and for any thread count).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Starts' positions uniform in ±this, m (default: the base amplitude A).
+    #[arg(long)]
+    pub position_range: Option<f64>,
+    /// Starts' velocities uniform in ±this, m/s (default: the base's peak speed A·ω).
+    #[arg(long)]
+    pub velocity_range: Option<f64>,
+    /// Write attractors.csv, expected_power.csv and attractors.json to this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also draw the basin fractions (stacked bands) and the power per attractor.
+    #[arg(long)]
+    pub plot: bool,
+    /// Cell edge of the recurrence grid for non-periodic section clouds (scaled units).
+    #[arg(long, default_value_t = 0.05)]
+    pub cell: f64,
+    /// A start's stroboscopic section (positions and velocities, scaled units) is periodic
+    /// when it repeats within this tolerance (coarser than a sweep's --period-tolerance,
+    /// which does not apply here: a start still ringing down onto an orbit is that orbit).
+    #[arg(long, default_value_t = 1e-3)]
+    pub section_tolerance: f64,
+    /// Two periodic section sets are one attractor within this scaled distance.
+    #[arg(long, default_value_t = 3e-3)]
+    pub match_tolerance: f64,
+    /// An attractor continues one of the previous value within this scaled set distance
+    /// (when no seeded run decides).
+    #[arg(long, default_value_t = 0.25)]
+    pub continuation_distance: f64,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+const ATTRACTOR_COLUMNS: [&str; 9] = [
+    "param",
+    "attractor",
+    "period",
+    "starts",
+    "fraction",
+    "fraction_se",
+    "impacts_per_period",
+    "average_power_w",
+    "power_se_w",
+];
+
+/// Runs `vibrotribo attractors`.
+pub fn run(args: &AttractorsArgs) -> Result<()> {
+    if args.steps == 0 || args.samples == 0 {
+        bail!("--steps and --samples must be at least 1");
+    }
+    if !args.from.is_finite() || !args.to.is_finite() {
+        bail!("--from and --to must be finite numbers");
+    }
+    crate::limits::check_grid("--steps × --samples", args.steps as f64 * args.samples as f64)?;
+    if args.plot && args.out.is_none() {
+        bail!("--plot needs --out DIR");
+    }
+    set_threads(args.run.threads)?;
+    let base = args.input.load()?;
+    let options = AttractorOptions {
+        period_tolerance: args.section_tolerance,
+        match_tolerance: args.match_tolerance,
+        cell: args.cell,
+        continuation_distance: args.continuation_distance,
+    };
+    let starts = StartRunner::new(args.run.runner_or(base, DEFAULT_PERIODS)?, options.clone())
+        .map_err(|e| anyhow!("{e}"))?;
+    let values = grid(args.from, args.to, args.steps);
+    check_distinct("--from/--to/--steps", &values)?;
+    check_all(starts.point_runner(), &values, |&v| {
+        vec![(args.param.as_str(), v)]
+    })?;
+    let chain = starts.point_runner().base().chain();
+    let default_box = StartBox::of(chain);
+    let bounds = match (args.position_range, args.velocity_range) {
+        (None, None) => None,
+        (p, v) => Some(StartBox {
+            positions: p.unwrap_or(default_box.positions),
+            velocities: v.unwrap_or(default_box.velocities),
+        }),
+    };
+    if let Some(b) = &bounds {
+        b.validate()
+            .map_err(|e| anyhow!("--position-range/--velocity-range: {e}"))?;
+    }
+    let sampling = RandomStarts {
+        samples: args.samples,
+        seed: args.seed,
+        bounds,
+    };
+    let masses = chain.len();
+    let o = starts.point_runner().options();
+    let settings = json!({
+        "command": "attractors",
+        "param": args.param,
+        "from": args.from,
+        "to": args.to,
+        "steps": args.steps,
+        "values": values,
+        "samples": args.samples,
+        "seed": args.seed,
+        "start_box": bounds.map(|b| json!({"positions_m": b.positions, "velocities_m_s": b.velocities})),
+        "transient_periods": o.transient_periods,
+        "recorded_periods": o.recorded_periods,
+        "attractor_options": {
+            "period_tolerance": options.period_tolerance,
+            "match_tolerance": options.match_tolerance,
+            "cell": options.cell,
+            "continuation_distance": options.continuation_distance,
+        },
+        "mechanics_only": args.run.mechanics_only,
+        "settings": starts.point_runner().base().table(),
+        "vibrotribo_version": env!("CARGO_PKG_VERSION"),
+    });
+    let mut files = match &args.out {
+        Some(dir) => {
+            create_dir(dir)?;
+            write_json(&dir.join("attractors.json"), &with_progress(&settings, false, 0))?;
+            let mut cols: Vec<String> = ATTRACTOR_COLUMNS.map(String::from).to_vec();
+            cols.extend(numbered("x", masses, "_m"));
+            cols.extend(numbered("v", masses, "_m_s"));
+            Some((
+                CsvFile::create(&dir.join("attractors.csv"), &cols)?,
+                CsvFile::create(
+                    &dir.join("expected_power.csv"),
+                    &[
+                        "param",
+                        "expected_power_w",
+                        "expected_power_se_w",
+                        "attractors",
+                        "starts",
+                        "failed",
+                        "error",
+                    ],
+                )?,
+            ))
+        }
+        None => None,
+    };
+    let progress = Progress::new((values.len() * args.samples) as u64, "starts", args.run.quiet);
+    let started = Instant::now();
+    let mut failure = None;
+    let mut finished = 0;
+    let chunk = rayon::current_num_threads() * 4;
+    let results = attractors_across(&starts, &args.param, &values, &sampling, chunk, |d| match d {
+        AcrossDelivery::Start => {
+            progress.inc(1);
+            ControlFlow::Continue(())
+        }
+        AcrossDelivery::Value(v) => {
+            finished += 1;
+            if let Some((a, e)) = files.as_mut()
+                && let Err(err) = write_value(a, e, v, masses)
+            {
+                failure = Some(err);
+                return ControlFlow::Break(());
+            }
+            ControlFlow::Continue(())
+        }
+        AcrossDelivery::Chunk => {
+            if interrupted() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        }
+    })?;
+    progress.finish();
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let complete = finished == values.len();
+    for v in &results {
+        print_value(v, &args.param);
+    }
+    println!(
+        "{} of {} values of {} with {} starts each in {:.2} s on {} threads",
+        finished,
+        values.len(),
+        args.param,
+        args.samples,
+        started.elapsed().as_secs_f64(),
+        rayon::current_num_threads()
+    );
+    if let (Some((mut a, mut e)), Some(dir)) = (files, &args.out) {
+        a.flush()?;
+        e.flush()?;
+        write_json(
+            &dir.join("attractors.json"),
+            &with_progress(&settings, complete, finished),
+        )?;
+        if complete && args.plot {
+            plot_attractors(dir)?;
+        }
+        println!(
+            "  wrote {0}/attractors.csv, {0}/expected_power.csv, {0}/attractors.json",
+            dir.display()
+        );
+    }
+    if !complete {
+        return Err(Interrupted {
+            what: format!(
+                "after {finished} of {} values; the files hold those, marked incomplete in attractors.json",
+                values.len()
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+fn with_progress(settings: &serde_json::Value, complete: bool, done: usize) -> serde_json::Value {
+    let mut m = settings.clone();
+    m["complete"] = json!(complete);
+    m["done"] = json!(done);
+    m
+}
+
+fn write_value(a: &mut CsvFile, e: &mut CsvFile, v: &ValueAttractors, masses: usize) -> Result<()> {
+    let c = &v.classification;
+    let mut order: Vec<usize> = (0..c.attractors.len()).collect();
+    order.sort_by_key(|&k| v.ids[k]);
+    for k in order {
+        let at = &c.attractors[k];
+        let (f, se) = c.fraction(k);
+        let mut row = vec![
+            v.value.to_string(),
+            (v.ids[k] + 1).to_string(),
+            at.period.to_string(),
+            at.starts.to_string(),
+            f.to_string(),
+            se.to_string(),
+            at.impacts_per_period.to_string(),
+            at.power_w.map_or(String::new(), |p| p.to_string()),
+            at.power_se.map_or(String::new(), |p| p.to_string()),
+        ];
+        row.extend(at.points[..2 * masses].iter().map(f64::to_string));
+        a.row(row)?;
+    }
+    let (p, se) = v.expected_power.map_or((String::new(), String::new()), |(p, s)| {
+        (p.to_string(), s.to_string())
+    });
+    e.row([
+        v.value.to_string(),
+        p,
+        se,
+        c.attractors.iter().filter(|a| a.starts > 0).count().to_string(),
+        c.classified().to_string(),
+        v.failed.to_string(),
+        v.first_error.as_deref().map_or(String::new(), csv_text),
+    ])?;
+    a.flush()?;
+    e.flush()
+}
+
+fn print_value(v: &ValueAttractors, param: &str) {
+    let c = &v.classification;
+    let expected = v.expected_power.map_or(String::new(), |(p, se)| {
+        format!(", expected power {} ± {}", si(p, "W"), si(se, "W"))
+    });
+    println!(
+        "{param} = {}: {} attractors{expected}",
+        v.value,
+        c.attractors.len()
+    );
+    for (k, at) in c.attractors.iter().enumerate() {
+        let (f, se) = c.fraction(k);
+        let kind = if at.is_periodic() {
+            format!("period {}", at.period)
+        } else {
+            "non-periodic".into()
+        };
+        println!(
+            "  A{}: {kind}, {:.2} impacts/T, basin {:.1} ± {:.1} %{}",
+            v.ids[k] + 1,
+            at.impacts_per_period,
+            100.0 * f,
+            100.0 * se,
+            at.power_w.map_or(String::new(), |p| format!(", {}", si(p, "W")))
+        );
+    }
+}
+
+/// Draws the fractions (stacked bands) and powers of an `attractors` directory.
+pub fn plot_attractors(dir: &Path) -> Result<()> {
+    let m = read_json(&dir.join("attractors.json"))?;
+    let param = m["param"].as_str().unwrap_or("parameter").to_string();
+    let values: Vec<f64> = serde_json::from_value(m["values"].clone()).context("attractors.json: values")?;
+    let done = m["done"].as_u64().unwrap_or(values.len() as u64) as usize;
+    let values = &values[..done.min(values.len())];
+    let (h, rows) = read_csv(&dir.join("attractors.csv"))?;
+    let col = |name: &str| crate::output::column(&h, name);
+    let (cp, ca, cf, cw) = (
+        col("param")?,
+        col("attractor")?,
+        col("fraction")?,
+        col("average_power_w")?,
+    );
+    let ids: Vec<usize> = rows
+        .iter()
+        .map(|r| r[ca].parse::<usize>().context("attractors.csv: attractor"))
+        .collect::<Result<_>>()?;
+    let count = ids.iter().copied().max().unwrap_or(0);
+    let index = |x: f64| values.iter().position(|&v| v == x);
+    let mut shares = vec![vec![0.0; values.len()]; count];
+    let mut powers = vec![vec![f64::NAN; values.len()]; count];
+    let mut kinds = vec![String::new(); count];
+    for (r, &id) in rows.iter().zip(&ids) {
+        let Some(i) = r[cp].parse::<f64>().ok().and_then(index) else {
+            continue;
+        };
+        shares[id - 1][i] = r[cf].parse().unwrap_or(0.0);
+        powers[id - 1][i] = 1e6 * r[cw].parse::<f64>().unwrap_or(f64::NAN);
+        if kinds[id - 1].is_empty() {
+            let kind = match r[col("period")?].as_str() {
+                "0" => "non-periodic".into(),
+                p => format!("period {p}"),
+            };
+            let impacts: f64 = r[col("impacts_per_period")?].parse().unwrap_or(f64::NAN);
+            kinds[id - 1] = format!("{kind}, {impacts:.2} impacts/T at {param} = {}", r[cp]);
+        }
+    }
+    let names: Vec<String> = (0..count).map(|k| format!("A{}: {}", k + 1, kinds[k])).collect();
+    let fig = Figure::new(
+        format!(
+            "Basin fractions of the attractors ({} random starts per value)",
+            m["samples"]
+        ),
+        param.clone(),
+        "basin fraction",
+    );
+    crate::plots::both(dir, "attractor_fractions", |path| {
+        plot::stacked_bands(
+            path,
+            &fig,
+            &Bands {
+                x: values,
+                shares: &shares,
+                names: &names,
+            },
+        )
+    })?;
+    let (eh, erows) = read_csv(&dir.join("expected_power.csv"))?;
+    let ep: Vec<f64> = crate::output::numbers(&erows, crate::output::column(&eh, "expected_power_w")?)
+        .iter()
+        .map(|p| 1e6 * p)
+        .collect();
+    if ep.iter().any(|p| p.is_finite()) {
+        let expected = "expected power (fraction-weighted)".to_string();
+        let mut series: Vec<Series<'_>> = names
+            .iter()
+            .zip(&powers)
+            .map(|(n, p)| Series::new(n, values, p))
+            .collect();
+        series.push(Series::new(&expected, values, &ep[..values.len().min(ep.len())]));
+        let mut fig = Figure::new("Average power per attractor", param, "P_a [µW]");
+        fig.legend = Legend::UpperLeft;
+        // A log axis only where the powers span more than a decade (it has no ticks within one).
+        let finite = || powers.iter().flatten().chain(&ep).filter(|p| p.is_finite());
+        let lo = finite().fold(f64::INFINITY, |a, &b| a.min(b));
+        let hi = finite().fold(0.0f64, |a, &b| a.max(b));
+        if lo > 0.0 && hi > 10.0 * lo {
+            fig.y_scale = Scale::Log;
+        }
+        crate::plots::both(dir, "attractor_power", |path| {
+            plot::line_plot(path, &fig, &series)
+        })?;
+    }
+    Ok(())
+}

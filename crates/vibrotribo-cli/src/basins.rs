@@ -1,0 +1,575 @@
+//! `vibrotribo basins`: basins of attraction over two initial-condition keys
+//! ([`vibrotribo::attractors`]): every start of a grid run in parallel and fingerprinted
+//! (`starts.csv`, a grid job that shards, merges and resumes like a map), then, once the
+//! grid is complete, classified in grid order into `basins.csv` and `attractors.csv`, so
+//! the result does not depend on threads or shards.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow, bail};
+use serde_json::{Value, json};
+use vibrotribo::attractors::{
+    AttractorOptions, Classification, Fingerprint, SectionScale, StartRunner, classify,
+};
+use vibrotribo::sweep::grid;
+
+use crate::config::ConfigArgs;
+use crate::job::{CsvSpec, GridOutput, Layout};
+use crate::limits;
+use crate::output::{CsvFile, csv_text, numbered, read_csv, read_json, si};
+use crate::plot::{self, CategoryMap, Figure};
+use crate::progress::Interrupted;
+use crate::sweep::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
+
+/// `NXxNY`: the nodes of a basin grid along x and y.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GridSize {
+    /// Nodes along x.
+    pub nx: usize,
+    /// Nodes along y.
+    pub ny: usize,
+}
+
+impl std::str::FromStr for GridSize {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (a, b) = s
+            .split_once(['x', 'X', '×'])
+            .ok_or_else(|| format!("--grid takes NXxNY (e.g. 200x200), got {s:?}"))?;
+        let parse = |t: &str| {
+            t.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| n >= 1)
+                .ok_or_else(|| format!("--grid {s}: {t:?} is not a positive whole number"))
+        };
+        Ok(GridSize {
+            nx: parse(a)?,
+            ny: parse(b)?,
+        })
+    }
+}
+
+/// Options of `vibrotribo basins`.
+#[derive(Debug, clap::Args)]
+pub struct BasinsArgs {
+    #[command(flatten)]
+    pub input: ConfigArgs,
+    /// Initial condition along x: `run.initial_positions[i]` (m) or
+    /// `run.initial_velocities[i]` (m/s), i 0-based.
+    #[arg(long)]
+    pub x: String,
+    /// First x value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub x_from: f64,
+    /// Last x value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub x_to: f64,
+    /// Initial condition along y.
+    #[arg(long)]
+    pub y: String,
+    /// First y value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub y_from: f64,
+    /// Last y value.
+    #[arg(long, allow_negative_numbers = true)]
+    pub y_to: f64,
+    /// Nodes of the grid, NXxNY (e.g. 200x200).
+    #[arg(long, value_name = "NXxNY")]
+    pub grid: GridSize,
+    /// Write starts.csv, basins.csv, attractors.csv and basins.json to this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Compute only the I-th of N interleaved slices of the grid; combine with `merge`.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<Shard>,
+    /// Continue the interrupted job (or shard) in --out DIR from its finished starts.
+    #[arg(long)]
+    pub resume: bool,
+    /// Also draw the basin picture (PNG and SVG).
+    #[arg(long)]
+    pub plot: bool,
+    /// Cell edge of the recurrence grid that matches non-periodic section clouds (scaled
+    /// units: positions over L = Σδ + A, velocities over L·ω).
+    #[arg(long, default_value_t = 0.05)]
+    pub cell: f64,
+    /// A start's stroboscopic section (positions and velocities, scaled units) is periodic
+    /// when it repeats within this tolerance (coarser than a sweep's --period-tolerance,
+    /// which does not apply here: a start still ringing down onto an orbit is that orbit).
+    #[arg(long, default_value_t = 1e-3)]
+    pub section_tolerance: f64,
+    /// Two periodic section sets are one attractor within this scaled distance.
+    #[arg(long, default_value_t = 3e-3)]
+    pub match_tolerance: f64,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// Transient and recorded periods of a start unless `--transient`/`--recorded` say.
+pub const DEFAULT_PERIODS: (u64, u64) = (500, 100);
+
+/// Checks that `key` is an initial condition of a chain of `masses` masses.
+fn check_key(option: &str, key: &str, masses: usize) -> Result<()> {
+    let index = ["run.initial_positions[", "run.initial_velocities["]
+        .iter()
+        .find_map(|p| key.strip_prefix(p))
+        .and_then(|rest| rest.strip_suffix(']'))
+        .and_then(|i| i.parse::<usize>().ok());
+    match index {
+        Some(i) if i < masses => Ok(()),
+        Some(i) => bail!("{option} {key}: index {i} out of range (the chain has {masses} masses, 0-based)"),
+        None => bail!(
+            "{option} {key}: basins vary initial conditions, run.initial_positions[i] or run.initial_velocities[i] (i 0-based); for parameters use `map` or `attractors`"
+        ),
+    }
+}
+
+/// `starts.csv`: one row per start, the fingerprint of where it ended.
+fn layout() -> Layout {
+    Layout {
+        manifest: "basins.json",
+        files: vec![CsvSpec {
+            name: "starts.csv",
+            columns: [
+                "x",
+                "y",
+                "period",
+                "impacts_per_period",
+                "average_power_w",
+                "points",
+                "cells",
+                "error",
+            ]
+            .map(String::from)
+            .to_vec(),
+        }],
+        index_file: 0,
+        key_fields: 2,
+    }
+}
+
+fn points_of(xs: &[f64], ys: &[f64]) -> Vec<(f64, f64)> {
+    ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect()
+}
+
+fn key_of(&(x, y): &(f64, f64)) -> String {
+    format!("{x},{y}")
+}
+
+fn joined<T: ToString>(v: &[T]) -> String {
+    v.iter().map(ToString::to_string).collect::<Vec<_>>().join(" ")
+}
+
+/// A start's row after its key: the fingerprint (numbers written exactly), or the error.
+fn cells_of(r: &Result<Fingerprint, String>) -> Vec<String> {
+    match r {
+        Ok(f) => vec![
+            f.period.to_string(),
+            f.impacts_per_period.to_string(),
+            f.power_w.map_or(String::new(), |p| p.to_string()),
+            joined(&f.points),
+            joined(&f.cells),
+            String::new(),
+        ],
+        Err(e) => {
+            let mut row = vec![String::new(); 5];
+            row.push(csv_text(e));
+            row
+        }
+    }
+}
+
+/// The fingerprint of a row of `starts.csv` (`None` for a failed start).
+fn parse_row(row: &[String]) -> Result<Option<Fingerprint>> {
+    if row.len() < 8 {
+        bail!("a row of starts.csv has {} fields, expected 8", row.len());
+    }
+    if !row[7].is_empty() || row[2].is_empty() {
+        return Ok(None);
+    }
+    let numbers = |t: &str| -> Result<Vec<f64>> {
+        t.split_whitespace()
+            .map(|x| x.parse().map_err(|_| anyhow!("starts.csv: bad number {x:?}")))
+            .collect()
+    };
+    Ok(Some(Fingerprint {
+        period: row[2].parse().context("starts.csv: period")?,
+        impacts_per_period: row[3].parse().context("starts.csv: impacts_per_period")?,
+        power_w: if row[4].is_empty() {
+            None
+        } else {
+            Some(row[4].parse().context("starts.csv: average_power_w")?)
+        },
+        points: numbers(&row[5])?,
+        cells: row[6]
+            .split_whitespace()
+            .map(|c| c.parse().map_err(|_| anyhow!("starts.csv: bad cell {c:?}")))
+            .collect::<Result<_>>()?,
+    }))
+}
+
+/// Runs `vibrotribo basins`.
+pub fn run(args: &BasinsArgs) -> Result<()> {
+    for (name, a, b) in [("x", args.x_from, args.x_to), ("y", args.y_from, args.y_to)] {
+        if !a.is_finite() || !b.is_finite() {
+            bail!("--{name}-from and --{name}-to must be finite numbers");
+        }
+    }
+    let (nx, ny) = (args.grid.nx, args.grid.ny);
+    limits::check_grid("--grid", nx as f64 * ny as f64)?;
+    if args.plot && args.out.is_none() {
+        bail!("--plot needs --out DIR");
+    }
+    if args.resume && args.out.is_none() {
+        bail!("--resume needs --out DIR (the directory of the job to continue)");
+    }
+    set_threads(args.run.threads)?;
+    let base = args.input.load()?;
+    let masses = base.chain().len();
+    check_key("--x", &args.x, masses)?;
+    check_key("--y", &args.y, masses)?;
+    if args.x == args.y {
+        bail!("--x and --y are the same key");
+    }
+    let options = AttractorOptions {
+        period_tolerance: args.section_tolerance,
+        match_tolerance: args.match_tolerance,
+        cell: args.cell,
+        ..AttractorOptions::default()
+    };
+    let starts = StartRunner::new(args.run.runner_or(base, DEFAULT_PERIODS)?, options.clone())
+        .map_err(|e| anyhow!("{e}"))?;
+    let (xs, ys) = (grid(args.x_from, args.x_to, nx), grid(args.y_from, args.y_to, ny));
+    check_distinct("--x-from/--x-to/--grid", &xs)?;
+    check_distinct("--y-from/--y-to/--grid", &ys)?;
+    let mut points = points_of(&xs, &ys);
+    if let Some(s) = args.shard {
+        points = points
+            .into_iter()
+            .enumerate()
+            .filter(|(j, _)| j % s.count == s.index)
+            .map(|(_, p)| p)
+            .collect();
+    }
+    let (xk, yk) = (args.x.as_str(), args.y.as_str());
+    let scale = SectionScale::of(starts.point_runner().base().chain());
+    let o = starts.point_runner().options();
+    let settings = json!({
+        "command": "basins",
+        "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": nx, "values": xs},
+        "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": ny, "values": ys},
+        "transient_periods": o.transient_periods,
+        "recorded_periods": o.recorded_periods,
+        "max_period_detected": o.period_options().max_period,
+        "attractor_options": {
+            "period_tolerance": options.period_tolerance,
+            "match_tolerance": options.match_tolerance,
+            "cell": options.cell,
+        },
+        "section_scale": {"masses": masses, "length_m": scale.length, "speed_m_s": scale.speed},
+        "mechanics_only": args.run.mechanics_only,
+        "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
+        "settings": starts.point_runner().base().table(),
+        "vibrotribo_version": env!("CARGO_PKG_VERSION"),
+    });
+    let keys: Vec<String> = points.iter().map(key_of).collect();
+    let (mut out, skip) = match &args.out {
+        None => (None, 0),
+        Some(dir) if args.resume => {
+            let (o, done) = GridOutput::resume(dir, layout(), settings, &keys, keys.len())?;
+            (Some(o), done)
+        }
+        Some(dir) => (Some(GridOutput::create(dir, layout(), settings)?), 0),
+    };
+    let started = Instant::now();
+    let mut fingerprints = Vec::new();
+    let computed = run_chunked(
+        &points[skip..],
+        |&(x, y)| {
+            starts
+                .run(&[(xk, x), (yk, y)], None)
+                .map_err(|e| format!("{e:#}"))
+        },
+        ("starts", skip as u64, points.len() as u64),
+        args.run.quiet,
+        |d| {
+            let Some((&(x, y), r)) = d else {
+                return out.as_mut().map_or(Ok(()), GridOutput::commit);
+            };
+            if let Some(out) = out.as_mut() {
+                let mut row = vec![x.to_string(), y.to_string()];
+                row.extend(cells_of(&r));
+                out.row(0, row)?;
+            }
+            fingerprints.push(r.ok());
+            Ok(())
+        },
+    )?;
+    let done = skip + computed;
+    let complete = done == points.len();
+    println!(
+        "basins over {} × {} ({nx} × {ny} starts{}): {computed} computed{} in {:.2} s on {} threads",
+        args.x,
+        args.y,
+        args.shard
+            .map_or(String::new(), |s| format!(", shard {}/{}", s.index, s.count)),
+        if skip > 0 {
+            format!(", {skip} kept from before")
+        } else {
+            String::new()
+        },
+        started.elapsed().as_secs_f64(),
+        rayon::current_num_threads()
+    );
+    match (out, &args.out) {
+        (Some(out), Some(dir)) => {
+            out.finish(complete, done)?;
+            if complete && args.shard.is_none() {
+                let classes = finish(dir)?;
+                print_attractors(&classes);
+                if args.plot {
+                    plot_basins(dir)?;
+                }
+                println!(
+                    "  wrote {0}/basins.csv, {0}/attractors.csv, {0}/starts.csv",
+                    dir.display()
+                );
+            }
+        }
+        _ if complete && args.shard.is_none() => {
+            print_attractors(&classify(&fingerprints, &scale, &options));
+        }
+        _ => {}
+    }
+    if !complete {
+        return Err(Interrupted {
+            what: format!(
+                "starts.csv holds the {done} of {} starts finished, marked incomplete in basins.json; \
+                 the same command with --resume continues",
+                points.len()
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+fn print_attractors(c: &Classification) {
+    println!(
+        "  {} attractors among {} starts that ran:",
+        c.attractors.len(),
+        c.classified()
+    );
+    for (a, name) in names(c).iter().enumerate() {
+        let (f, se) = c.fraction(a);
+        println!("    {name} (basin {:.1} ± {:.1} %)", 100.0 * f, 100.0 * se);
+    }
+}
+
+/// A legend name per attractor: `A1: period 1, 4.00 impacts/T, 12.92 µW`.
+fn names(c: &Classification) -> Vec<String> {
+    c.attractors
+        .iter()
+        .enumerate()
+        .map(|(a, at)| {
+            let kind = if at.is_periodic() {
+                format!("period {}", at.period)
+            } else {
+                "non-periodic".to_string()
+            };
+            let power = at.power_w.map_or(String::new(), |p| format!(", {}", si(p, "W")));
+            format!(
+                "A{}: {kind}, {:.2} impacts/T{power}",
+                a + 1,
+                at.impacts_per_period
+            )
+        })
+        .collect()
+}
+
+/// Reads the fingerprints of a complete basins directory and the settings that classify
+/// them.
+fn read_job(dir: &Path) -> Result<(Value, Vec<Option<Fingerprint>>, SectionScale, AttractorOptions)> {
+    let m = read_json(&dir.join("basins.json"))?;
+    if m["complete"] != json!(true) {
+        bail!(
+            "{} is incomplete: finish it with --resume (or merge its shards) first",
+            dir.display()
+        );
+    }
+    let (_, rows) = read_csv(&dir.join("starts.csv"))?;
+    let fingerprints = rows.iter().map(|r| parse_row(r)).collect::<Result<Vec<_>>>()?;
+    let s = &m["section_scale"];
+    let scale = SectionScale {
+        masses: s["masses"]
+            .as_u64()
+            .context("basins.json: section_scale.masses")? as usize,
+        length: s["length_m"]
+            .as_f64()
+            .context("basins.json: section_scale.length_m")?,
+        speed: s["speed_m_s"]
+            .as_f64()
+            .context("basins.json: section_scale.speed_m_s")?,
+    };
+    let a = &m["attractor_options"];
+    let options = AttractorOptions {
+        period_tolerance: a["period_tolerance"]
+            .as_f64()
+            .context("basins.json: period_tolerance")?,
+        match_tolerance: a["match_tolerance"]
+            .as_f64()
+            .context("basins.json: match_tolerance")?,
+        cell: a["cell"].as_f64().context("basins.json: cell")?,
+        ..AttractorOptions::default()
+    };
+    Ok((m, fingerprints, scale, options))
+}
+
+/// Classifies a complete directory's starts (grid order) and writes `basins.csv` and
+/// `attractors.csv`.
+pub fn finish(dir: &Path) -> Result<Classification> {
+    let (_, fingerprints, scale, options) = read_job(dir)?;
+    let (_, rows) = read_csv(&dir.join("starts.csv"))?;
+    let c = classify(&fingerprints, &scale, &options);
+    let mut basins = CsvFile::create(
+        &dir.join("basins.csv"),
+        &[
+            "x",
+            "y",
+            "attractor",
+            "period",
+            "impacts_per_period",
+            "average_power_w",
+        ],
+    )?;
+    for ((row, label), f) in rows.iter().zip(&c.labels).zip(&fingerprints) {
+        basins.row([
+            row[0].clone(),
+            row[1].clone(),
+            label.map_or(String::new(), |a| (a + 1).to_string()),
+            f.as_ref().map_or(String::new(), |f| f.period.to_string()),
+            f.as_ref()
+                .map_or(String::new(), |f| f.impacts_per_period.to_string()),
+            f.as_ref()
+                .and_then(|f| f.power_w)
+                .map_or(String::new(), |p| p.to_string()),
+        ])?;
+    }
+    basins.flush()?;
+    let n = scale.masses;
+    let mut cols: Vec<String> = [
+        "attractor",
+        "period",
+        "starts",
+        "fraction",
+        "fraction_se",
+        "impacts_per_period",
+        "average_power_w",
+        "power_se_w",
+    ]
+    .map(String::from)
+    .to_vec();
+    cols.extend(numbered("x", n, "_m"));
+    cols.extend(numbered("v", n, "_m_s"));
+    let mut at = CsvFile::create(&dir.join("attractors.csv"), &cols)?;
+    for (a, attractor) in c.attractors.iter().enumerate() {
+        let (f, se) = c.fraction(a);
+        let mut row = vec![
+            (a + 1).to_string(),
+            attractor.period.to_string(),
+            attractor.starts.to_string(),
+            f.to_string(),
+            se.to_string(),
+            attractor.impacts_per_period.to_string(),
+            attractor.power_w.map_or(String::new(), |p| p.to_string()),
+            attractor.power_se.map_or(String::new(), |p| p.to_string()),
+        ];
+        row.extend(attractor.points[..2 * n].iter().map(f64::to_string));
+        at.row(row)?;
+    }
+    at.flush()?;
+    Ok(c)
+}
+
+/// Draws the basin picture of a complete directory (`basins.png`/`.svg`).
+pub fn plot_basins(dir: &Path) -> Result<()> {
+    let (m, fingerprints, scale, options) = read_job(dir)?;
+    let c = classify(&fingerprints, &scale, &options);
+    let axis = |a: &str| -> Result<Vec<f64>> {
+        serde_json::from_value(m[a]["values"].clone()).with_context(|| format!("basins.json: {a} values"))
+    };
+    let (xs, ys) = (axis("x")?, axis("y")?);
+    let mut names = names(&c);
+    for (a, name) in names.iter_mut().enumerate() {
+        let (f, _) = c.fraction(a);
+        name.push_str(&format!(" ({:.1} %)", 100.0 * f));
+    }
+    let map = CategoryMap {
+        x_nodes: (xs[0], xs[xs.len() - 1]),
+        y_nodes: (ys[0], ys[ys.len() - 1]),
+        nx: xs.len(),
+        ny: ys.len(),
+        cells: &c.labels,
+        names: &names,
+        missing: "no run (e.g. overlapping masses)",
+    };
+    let label = |a: &str| m[a]["param"].as_str().unwrap_or(a).to_string();
+    let fig = Figure::new(
+        format!(
+            "Basins of attraction ({} transient periods)",
+            m["transient_periods"]
+        ),
+        label("x"),
+        label("y"),
+    );
+    crate::plots::both(dir, "basins", |path| plot::category_map(path, &fig, &map))
+}
+
+/// Merges the shards of a basins job (`vibrotribo merge`) and classifies the result.
+pub fn merge(args: &MergeArgs) -> Result<()> {
+    let keys = |m: &Value| -> Result<Vec<String>> {
+        let axis = |a: &str| -> Result<Vec<f64>> {
+            serde_json::from_value(m[a]["values"].clone()).with_context(|| format!("basins.json: {a} values"))
+        };
+        Ok(points_of(&axis("x")?, &axis("y")?).iter().map(key_of).collect())
+    };
+    crate::job::merge(&args.shards, &args.out, &layout(), keys)?;
+    let classes = finish(&args.out)?;
+    print_attractors(&classes);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_round_trip_exactly() {
+        let f = Fingerprint {
+            period: 2,
+            points: vec![0.1, -1.0 / 3.0, 2.5e-17, 4.0],
+            cells: vec![],
+            impacts_per_period: 2.5,
+            power_w: Some(1.292e-5),
+        };
+        let mut row = vec!["0.1".to_string(), "-0.2".to_string()];
+        row.extend(cells_of(&Ok(f.clone())));
+        assert_eq!(parse_row(&row).unwrap(), Some(f));
+        let g = Fingerprint {
+            period: 0,
+            points: vec![1.0; 4],
+            cells: vec![-3, 0, 7, 1, 2, 2, 2, 2],
+            impacts_per_period: 7.0,
+            power_w: None,
+        };
+        let mut row = vec!["0".to_string(), "0".to_string()];
+        row.extend(cells_of(&Ok(g.clone())));
+        assert_eq!(parse_row(&row).unwrap(), Some(g));
+        let mut row = vec!["0".to_string(), "0".to_string()];
+        row.extend(cells_of(&Err("overlap, at contact 1".into())));
+        assert_eq!(parse_row(&row).unwrap(), None);
+        assert_eq!("20x30".parse::<GridSize>().unwrap(), GridSize { nx: 20, ny: 30 });
+        assert!("20x0".parse::<GridSize>().is_err());
+    }
+}

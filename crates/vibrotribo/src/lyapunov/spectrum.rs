@@ -1,0 +1,210 @@
+//! The spectrum from the logarithms of the QR factors, period by period, with its
+//! batch-means spread.
+
+use crate::sensitivity::NonSmoothPoint;
+
+/// The logarithms `ln|R_ii|` summed over each averaged period, and its length.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PeriodLogs {
+    dim: usize,
+    logs: Vec<f64>,
+    times: Vec<f64>,
+}
+
+impl PeriodLogs {
+    pub fn new(dim: usize) -> Self {
+        PeriodLogs {
+            dim,
+            logs: Vec::new(),
+            times: Vec::new(),
+        }
+    }
+
+    pub fn push(&mut self, logs: &[f64], time: f64) {
+        debug_assert_eq!(logs.len(), self.dim);
+        self.logs.extend_from_slice(logs);
+        self.times.push(time);
+    }
+
+    pub fn len(&self) -> usize {
+        self.times.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.times.is_empty()
+    }
+
+    /// The exponents (per column of the tangent basis) over periods `range`, 1/s.
+    fn rates(&self, range: std::ops::Range<usize>) -> Vec<f64> {
+        let time: f64 = self.times[range.clone()].iter().sum();
+        (0..self.dim)
+            .map(|i| range.clone().map(|p| self.logs[p * self.dim + i]).sum::<f64>() / time)
+            .collect()
+    }
+}
+
+/// What happened on the way: skipped periods, non-differentiable points, work.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct Diagnostics {
+    pub skipped_periods: u64,
+    pub non_smooth: Vec<NonSmoothPoint>,
+    pub non_smooth_count: u64,
+    pub reorthonormalisations: u64,
+}
+
+/// The Lyapunov spectrum of a run, with its convergence estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LyapunovSpectrum {
+    /// The 2N exponents, 1/s, largest first. The directions a stuck contact (or a chatter
+    /// accumulation) removes are `−∞` ([`collapsed`](Self::collapsed) of them, last).
+    pub exponents: Vec<f64>,
+    /// The convergence estimate of each exponent, 1/s: the standard error of the mean of the
+    /// exponents of [`batches`](Self::batches) consecutive batches of periods (batch means);
+    /// NaN with fewer than two periods, 0 for a `−∞` exponent.
+    pub spread: Vec<f64>,
+    /// Number of `−∞` exponents: 2 per contact stuck at the same time at the worst moment of
+    /// the averaged window (a stuck contact, or a chatter sequence that ends in one,
+    /// maps a neighbourhood of the trajectory onto the sticking surface in finite time).
+    pub collapsed: usize,
+    /// Excitation periods averaged over.
+    pub periods: u64,
+    /// Time averaged over, s.
+    pub time: f64,
+    /// The exponents, 1/s, of each batch of consecutive periods (same order as
+    /// [`exponents`](Self::exponents)), whose spread gives [`spread`](Self::spread).
+    pub batches: Vec<Vec<f64>>,
+    /// The running estimate after each batch: (periods averaged so far, exponents in 1/s).
+    pub running: Vec<(u64, Vec<f64>)>,
+    /// Periods after the transient left out because they met a non-differentiable point
+    /// (grazing, simultaneous impacts), and the period after each such one (its tangent
+    /// vectors are realigned, not averaged).
+    pub skipped_periods: u64,
+    /// The first non-differentiable points met (at most 16).
+    pub non_smooth: Vec<NonSmoothPoint>,
+    /// How many non-differentiable points were met, transient included.
+    pub non_smooth_count: u64,
+    /// QR re-orthonormalisations done, transient included.
+    pub reorthonormalisations: u64,
+}
+
+impl LyapunovSpectrum {
+    /// Builds the spectrum from the period logs: exponents per column of the tangent basis,
+    /// the last `collapsed` set to −∞, sorted largest first.
+    pub(crate) fn from_logs(logs: &PeriodLogs, collapsed: usize, batches: usize, d: Diagnostics) -> Self {
+        let dim = logs.dim;
+        let periods = logs.len();
+        let mut exponents = logs.rates(0..periods);
+        let b = batches.min(periods).max(1);
+        let bounds: Vec<usize> = (0..=b).map(|k| k * periods / b).collect();
+        let mut batch_rates: Vec<Vec<f64>> = bounds.windows(2).map(|w| logs.rates(w[0]..w[1])).collect();
+        let mut running: Vec<(u64, Vec<f64>)> = bounds[1..]
+            .iter()
+            .map(|&end| (end as u64, logs.rates(0..end)))
+            .collect();
+        let mut spread: Vec<f64> = (0..dim)
+            .map(|i| {
+                if b < 2 {
+                    return f64::NAN;
+                }
+                let mean = batch_rates.iter().map(|r| r[i]).sum::<f64>() / b as f64;
+                let var = batch_rates.iter().map(|r| (r[i] - mean).powi(2)).sum::<f64>() / (b - 1) as f64;
+                (var / b as f64).sqrt()
+            })
+            .collect();
+        let collapsed = collapsed.min(dim);
+        for i in dim - collapsed..dim {
+            exponents[i] = f64::NEG_INFINITY;
+            spread[i] = 0.0;
+            for r in batch_rates.iter_mut().chain(running.iter_mut().map(|r| &mut r.1)) {
+                r[i] = f64::NEG_INFINITY;
+            }
+        }
+        // Largest first (the QR ordering already is, up to the scatter of nearly equal
+        // exponents).
+        let mut order: Vec<usize> = (0..dim).collect();
+        order.sort_by(|&a, &b| exponents[b].total_cmp(&exponents[a]));
+        let permute = |v: &[f64]| order.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+        LyapunovSpectrum {
+            exponents: permute(&exponents),
+            spread: permute(&spread),
+            collapsed,
+            periods: periods as u64,
+            time: logs.times.iter().sum(),
+            batches: batch_rates.iter().map(|r| permute(r)).collect(),
+            running: running.iter().map(|(n, r)| (*n, permute(r))).collect(),
+            skipped_periods: d.skipped_periods,
+            non_smooth: d.non_smooth,
+            non_smooth_count: d.non_smooth_count,
+            reorthonormalisations: d.reorthonormalisations,
+        }
+    }
+
+    /// The largest exponent, 1/s.
+    pub fn largest(&self) -> f64 {
+        self.exponents.first().copied().unwrap_or(f64::NAN)
+    }
+
+    /// The spread of the largest exponent, 1/s.
+    pub fn largest_spread(&self) -> f64 {
+        self.spread.first().copied().unwrap_or(f64::NAN)
+    }
+
+    /// The sum of the exponents, 1/s: the mean phase-space contraction rate (−∞ if a
+    /// direction collapsed).
+    pub fn sum(&self) -> f64 {
+        self.exponents.iter().sum()
+    }
+
+    /// The Kaplan–Yorke (Lyapunov) dimension `j + Σ_{i≤j} λ_i / |λ_{j+1}|`, j the largest
+    /// index with a non-negative partial sum (0 if λ₁ < 0; 2N if every partial sum is
+    /// non-negative). Of the stroboscopic map's attractor plus 1 for the time direction, it
+    /// measures how many directions the motion fills.
+    pub fn kaplan_yorke_dimension(&self) -> f64 {
+        let mut sum = 0.0;
+        for (j, &l) in self.exponents.iter().enumerate() {
+            if sum + l < 0.0 {
+                return if j == 0 { 0.0 } else { j as f64 + sum / l.abs() };
+            }
+            sum += l;
+        }
+        self.exponents.len() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Batch means of constant per-period rates: the rates themselves, no spread; of
+    /// alternating rates: the mean and the standard error of the batch values.
+    #[test]
+    fn batch_means() {
+        let mut logs = PeriodLogs::new(2);
+        for p in 0..10 {
+            let x = if p % 2 == 0 { 1.0 } else { 3.0 };
+            logs.push(&[0.5, -x], 0.5);
+        }
+        let s = LyapunovSpectrum::from_logs(&logs, 0, 5, Diagnostics::default());
+        assert_eq!(s.periods, 10);
+        assert!((s.exponents[0] - 1.0).abs() < 1e-15);
+        assert!((s.exponents[1] + 4.0).abs() < 1e-15);
+        assert!(s.spread[0].abs() < 1e-15 && s.spread[1].abs() < 1e-15);
+        let s = LyapunovSpectrum::from_logs(&logs, 0, 10, Diagnostics::default());
+        // Batches of one period: −2 and −6 alternating: sd = √(80/9)/... computed by hand.
+        let sd = (10.0 * 4.0 / 9.0f64).sqrt();
+        assert!((s.spread[1] - sd / 10f64.sqrt()).abs() < 1e-12, "{:?}", s.spread);
+        assert_eq!(s.running.last().unwrap().0, 10);
+        let s = LyapunovSpectrum::from_logs(&logs, 1, 5, Diagnostics::default());
+        assert_eq!(s.exponents[1], f64::NEG_INFINITY);
+        assert_eq!(s.sum(), f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn kaplan_yorke() {
+        let mut s = LyapunovSpectrum::from_logs(&PeriodLogs::new(0), 0, 2, Diagnostics::default());
+        s.exponents = vec![0.5, -0.25, -1.0];
+        assert!((s.kaplan_yorke_dimension() - 2.25).abs() < 1e-15);
+        s.exponents = vec![-0.1, -1.0];
+        assert_eq!(s.kaplan_yorke_dimension(), 0.0);
+    }
+}
