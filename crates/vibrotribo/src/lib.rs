@@ -43,6 +43,8 @@ pub mod electrical;
 mod error;
 pub mod model;
 pub mod orbits;
+#[cfg(feature = "config")]
+pub mod report;
 pub mod sensitivity;
 pub mod study;
 #[cfg(feature = "config")]
