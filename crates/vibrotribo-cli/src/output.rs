@@ -216,24 +216,7 @@ pub fn si(value: f64, unit: &str) -> String {
     format!("{x:.digits$} {prefix}{unit}")
 }
 
-/// The columns describing one sweep or map point, after its key columns: `average_power_w`,
-/// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
-/// `impacts_per_period_1..contacts`, `error`.
-pub fn point_columns(contacts: usize) -> Vec<String> {
-    let mut cols: Vec<String> = [
-        "average_power_w",
-        "impacts_per_period",
-        "period",
-        "chatter",
-        "sticking",
-        "grazing",
-    ]
-    .map(String::from)
-    .to_vec();
-    cols.extend(numbered("impacts_per_period_", contacts, ""));
-    cols.push("error".into());
-    cols
-}
+pub use vibrotribo::sweep::point_columns;
 
 /// The cells of [`point_columns`] for one point: its results, or blanks and the reason it
 /// failed. `error` also holds an electrical failure of a point whose mechanics succeeded.

@@ -10,7 +10,7 @@ use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::config::Config;
 use vibrotribo::study::{PointOptions, PointResult};
-use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_continued, run_grid};
+use vibrotribo::sweep::{Continuation, Delivery, PointRunner, error_text, grid, run_continued, run_grid};
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
@@ -121,10 +121,11 @@ pub struct SweepArgs {
 impl RunArgs {
     /// The point runner of these settings on `base`.
     pub fn runner(&self, base: Config) -> Result<PointRunner> {
-        let settings = base.run();
-        let transient = self.transient.unwrap_or(settings.transient());
-        let recorded = self.recorded.unwrap_or(settings.periods - settings.transient());
-        if recorded == 0 {
+        let options = PointOptions {
+            period_tolerance: self.period_tolerance,
+            ..PointOptions::from_run(base.run(), self.transient, self.recorded)
+        };
+        if options.recorded_periods == 0 {
             bail!("--recorded must be at least 1");
         }
         if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
@@ -133,12 +134,6 @@ impl RunArgs {
                 self.period_tolerance
             );
         }
-        let options = PointOptions {
-            transient_periods: transient,
-            recorded_periods: recorded,
-            period_tolerance: self.period_tolerance,
-            ..PointOptions::default()
-        };
         Ok(PointRunner::new(base, options, self.mechanics_only))
     }
 }
@@ -184,7 +179,7 @@ where
         let (written, checkpoint) = match d {
             Delivery::Point(p, r) => {
                 progress.inc(1);
-                (write(Some((p, &r.map_err(|e| format!("{e:#}"))))), false)
+                (write(Some((p, &r.map_err(|e| error_text(&e))))), false)
             }
             Delivery::Chunk(_) => (write(None), true),
         };
@@ -447,7 +442,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             let mut written = 0usize;
             let mut failure = None;
             let (done, _) = run_continued(&runner, key, &values, todo, state, |j, r, state| {
-                let r = r.map_err(|e| format!("{e:#}"));
+                let r = r.map_err(|e| error_text(&e));
                 failed += usize::from(r.is_err());
                 written += 1;
                 if let Some(o) = out.as_mut() {

@@ -1,8 +1,4 @@
-//! Parameter sweeps over a configuration's keys: the points of a grid, each a
-//! [`run_point`](crate::study::run_point) of the configuration with some keys set, run in
-//! parallel in chunks and delivered in grid order (so results do not depend on the thread
-//! count), or continued from one value to the next. The command line and the Python package
-//! both run their sweeps and maps through here.
+//! The point runner and the grid and continued runners of sweeps and maps.
 
 use std::ops::ControlFlow;
 
@@ -167,17 +163,59 @@ pub fn run_grid<'k, P, F>(
     points: &[P],
     keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
     chunk: usize,
-    mut on: F,
+    on: F,
 ) -> usize
 where
     P: Sync,
     F: FnMut(Delivery<'_, P>) -> ControlFlow<()>,
 {
+    in_chunks(points, chunk, |block| run_block(runner, block, &keys), on)
+}
+
+/// [`run_grid`] on the threads of `pool`, while `on` runs on the calling thread (which can
+/// then be the one that must see an interrupt, such as Python's main thread).
+pub fn run_grid_on<'k, P, F>(
+    pool: &rayon::ThreadPool,
+    runner: &PointRunner,
+    points: &[P],
+    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
+    chunk: usize,
+    on: F,
+) -> usize
+where
+    P: Sync,
+    F: FnMut(Delivery<'_, P>) -> ControlFlow<()>,
+{
+    in_chunks(
+        points,
+        chunk,
+        |block| pool.install(|| run_block(runner, block, &keys)),
+        on,
+    )
+}
+
+/// The points of `block`, run in parallel on the current pool.
+fn run_block<'k, P: Sync>(
+    runner: &PointRunner,
+    block: &[P],
+    keys: &(impl Fn(&P) -> Vec<(&'k str, f64)> + Sync),
+) -> Vec<Result<PointResult, SweepError>> {
+    block.par_iter().map(|p| runner.run(&keys(p), None)).collect()
+}
+
+/// `points` in chunks of `chunk`, each computed by `compute` and delivered to `on` in order.
+fn in_chunks<P, F>(
+    points: &[P],
+    chunk: usize,
+    compute: impl Fn(&[P]) -> Vec<Result<PointResult, SweepError>>,
+    mut on: F,
+) -> usize
+where
+    F: FnMut(Delivery<'_, P>) -> ControlFlow<()>,
+{
     let mut done = 0;
     for block in points.chunks(chunk.max(1)) {
-        let results: Vec<Result<PointResult, SweepError>> =
-            block.par_iter().map(|p| runner.run(&keys(p), None)).collect();
-        for (p, r) in block.iter().zip(results) {
+        for (p, r) in block.iter().zip(compute(block)) {
             done += 1;
             if on(Delivery::Point(p, r)).is_break() {
                 return done;
