@@ -7,12 +7,14 @@
 
 mod observer;
 mod point;
+mod record;
 mod replay;
 mod settings;
 mod simulate;
 
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
+pub use record::{EventColumns, Recording, SampleColumns};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use settings::{ElectricalFailure, Harvester, RunSettings, RunSpec, Sampling};
 pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};
