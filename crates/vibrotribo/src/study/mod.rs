@@ -5,6 +5,7 @@
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
+mod loads;
 mod observer;
 mod point;
 mod record;
@@ -12,6 +13,7 @@ mod replay;
 mod settings;
 mod simulate;
 
+pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 pub use record::{EventColumns, Recording, SampleColumns};
