@@ -1,5 +1,5 @@
 //! The extension module `vibrotribo._vibrotribo`: Python bindings of vibrotribo's run layer
-//! (configurations, runs, sweeps, maps, periodic orbits and their continuation). The Python
+//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation). The Python
 //! package `vibrotribo` (python/vibrotribo/) wraps what this returns into result objects;
 //! nothing here computes: it converts arguments, releases the GIL while the library runs,
 //! watches for Ctrl-C at the library's checkpoints, and converts results to numpy arrays.
@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 mod config;
 mod convert;
 mod interrupt;
+mod loads;
 mod orbits;
 mod simulate;
 mod sweep;
@@ -34,6 +35,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::map, m)?)?;
+    m.add_function(wrap_pyfunction!(loads::load_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::continue_, m)?)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;

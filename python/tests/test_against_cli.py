@@ -180,3 +180,15 @@ def test_thread_count_does_not_change_a_sweep():
     one = vt.sweep(None, "omega_ratio", values, transient=30, recorded=12, threads=1)
     two = vt.sweep(None, "omega_ratio", values, transient=30, recorded=12, threads=2)
     assert one == two
+
+
+def test_load_sweep_equals_the_files(cli, tmp_path):
+    run_cli(cli, "load-sweep", "--steps", "9", "--vq-points", "60", "--set", "run.periods=30",
+            "--set", "run.transient_periods=10", "--out", tmp_path)
+    r = vt.load_sweep(vt.Config(run__periods=30, run__transient_periods=10), steps=9, vq_points=60)
+    compare_tables([r.points, r.vq_cycle], tmp_path, ["load_sweep.csv", "vq_cycle.csv"])
+    expected = read_json(tmp_path / "load_sweep.json")
+    same_json(r.optimum, expected["optimum"], "optimum")
+    for key in ("optimum_at_edge", "configured_load_ohm", "configured_average_power_w",
+                "air_breakdown_last_period", "periods", "transient_periods"):
+        same_json(getattr(r, key), expected[key], key)

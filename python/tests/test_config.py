@@ -129,6 +129,10 @@ def test_bad_toml_file(tmp_path):
         (lambda: vt.periodic(None, guess=([0.0] * 3, [0.0] * 3)), ValueError, "period"),
         (lambda: vt.continue_(None, "omega_ratio", 0.7, -0.1), ValueError, "excitation.omega_ratio"),
         (lambda: vt.continue_(None, "omega_ratoi", 0.7, 0.8), KeyError, "omega_ratoi"),
+        (lambda: vt.load_sweep(None, low=-1.0), ValueError, "low"),
+        (lambda: vt.load_sweep(None, steps=0), ValueError, "steps"),
+        (lambda: vt.load_sweep(None, resistances=[1e5, 0.0]), ValueError, "resistances"),
+        (lambda: vt.load_sweep({"harvester": {"load_resistanse": 1e5}}), KeyError, "harvester.load_resistanse"),
     ],
 )
 def test_bad_run_input(call, exc, named):

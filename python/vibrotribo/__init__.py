@@ -38,6 +38,7 @@ from ._results import (
     Branch,
     Continuation,
     Events,
+    LoadSweep,
     Map,
     Orbit,
     Simulation,
@@ -52,6 +53,7 @@ __all__ = [
     "simulate",
     "sweep",
     "map",
+    "load_sweep",
     "periodic",
     "continue_",
     "grid",
@@ -61,6 +63,7 @@ __all__ = [
     "Events",
     "Sweep",
     "Map",
+    "LoadSweep",
     "Table",
     "Orbit",
     "Branch",
@@ -175,6 +178,32 @@ def map(  # noqa: A001 - the command's name
         period_tolerance=period_tolerance,
     )
     return Map._from(raw)
+
+
+def load_sweep(
+    config: ConfigLike = None,
+    *,
+    resistances: Optional[Iterable[float]] = None,
+    low: float = 1e3,
+    high: float = 1e13,
+    steps: int = 41,
+    vq_points: Optional[int] = 400,
+) -> LoadSweep:
+    """Average power against the load resistance: the configuration's mechanics simulated
+    once (``run.periods``), the charge of its harvester with a resistor of each resistance
+    (Ω; default ``steps`` log-spaced from ``low`` to ``high``, as ``vibrotribo load-sweep``)
+    solved along it, the optimum refined, the power at the configured load, and the V–Q
+    cycles of the last period at the configured and optimal loads (``vq_points`` points;
+    None for none). Returns a :class:`LoadSweep` equal to the command's files."""
+    raw = _vibrotribo.load_sweep(
+        _config(config),
+        resistances=None if resistances is None else _values(resistances, "resistances"),
+        low=low,
+        high=high,
+        steps=steps,
+        vq_points=vq_points,
+    )
+    return LoadSweep._from(raw)
 
 
 def periodic(

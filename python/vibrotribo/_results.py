@@ -16,6 +16,7 @@ __all__ = [
     "SimulationError",
     "Sweep",
     "Map",
+    "LoadSweep",
     "Orbit",
     "Branch",
     "Continuation",
@@ -337,6 +338,45 @@ class Map:
     def to_pandas(self):
         """The map as a pandas DataFrame."""
         return self.summary.to_pandas()
+
+
+@dataclass(frozen=True, eq=False)
+class LoadSweep:
+    """Average power against the load resistance on one mechanical run
+    (:func:`vibrotribo.load_sweep`), as ``vibrotribo load-sweep`` writes it.
+
+    Attributes:
+        points: ``load_sweep.csv``: ``load_resistance_ohm`` (Ω), ``average_power_w`` (W, after
+            the transient), ``energy_per_period_j`` (J).
+        optimum: the best load, refined by golden-section search: ``resistance_ohm``,
+            ``average_power_w``, ``energy_per_period_j``.
+        optimum_at_edge: whether the best grid point is at an end of the range (widen it).
+        configured_load_ohm: the configuration's load resistance, Ω.
+        configured_average_power_w: the average power at it, W.
+        vq_cycle: ``vq_cycle.csv``: ``load_resistance_ohm``, ``time_s``, ``q_c`` (C), ``v_v``
+            (V), ``i_a`` (A) over the last period, at the configured and the optimal load
+            (empty with ``vq_points=None``).
+        air_breakdown_last_period: the worst air-breakdown ratio over the last period at
+            each of those loads.
+    """
+
+    points: Table
+    optimum: Dict[str, float]
+    optimum_at_edge: bool
+    configured_load_ohm: float
+    configured_average_power_w: float
+    vq_cycle: Table
+    air_breakdown_last_period: List[Dict[str, Any]]
+    periods: int
+    transient_periods: int
+
+    @classmethod
+    def _from(cls, raw: Dict[str, Any]) -> "LoadSweep":
+        return cls(**dict(raw, points=Table(raw["points"]), vq_cycle=Table(raw["vq_cycle"])))
+
+    def to_pandas(self):
+        """The points as a pandas DataFrame."""
+        return self.points.to_pandas()
 
 
 @dataclass(frozen=True, eq=False)

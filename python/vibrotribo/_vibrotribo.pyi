@@ -87,6 +87,17 @@ def map(
 ) -> Dict[str, Any]:
     """A map: the columns of map.csv and the settings."""
 
+def load_sweep(
+    config: Any,
+    *,
+    resistances: Optional[List[float]] = None,
+    low: float = 1e3,
+    high: float = 1e13,
+    steps: int = 41,
+    vq_points: Optional[int] = 400,
+) -> Dict[str, Any]:
+    """A load sweep: the columns of load_sweep.csv and vq_cycle.csv, the optimum."""
+
 def periodic(
     config: Any,
     *,
