@@ -13,8 +13,10 @@ import vibrotribo as vt
 
 CHILD = textwrap.dedent(
     """
-    import sys, time
+    import signal, sys, time
     import vibrotribo as vt
+    # Python's own Ctrl-C handler, whatever the disposition inherited (a CI job may ignore SIGINT).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     config = vt.Config(run__periods=10**8)  # about an hour of work
     print("start", flush=True)
     try:
