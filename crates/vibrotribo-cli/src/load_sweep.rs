@@ -5,41 +5,14 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use serde_json::json;
-use vibrotribo::electrical::breakdown::BreakdownMargin;
-use vibrotribo::electrical::{ElectricalSamples, HarvesterParams, Load, load_sweep, log_spaced};
-use vibrotribo::study::{Ending, Harvester, ReplayOptions, record_trajectory, replay};
-use vibrotribo::{ChainParams, Trajectory};
+use vibrotribo::electrical::{HarvesterParams, Load, log_spaced};
+use vibrotribo::study::{LoadStudyOptions, load_study};
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot;
 use crate::plots::both;
 use crate::progress::{Interrupted, Progress, Watch};
-
-/// The V–Q cycle of period `index` at `points + 1` times of `harvester` along `trajectory`
-/// (of `chain`), and the air-breakdown check from that period on.
-pub fn vq_cycle(
-    trajectory: &Trajectory,
-    chain: &ChainParams,
-    harvester: &Harvester,
-    index: u64,
-    points: usize,
-) -> Result<(ElectricalSamples, BreakdownMargin)> {
-    let r = replay(
-        trajectory,
-        chain,
-        harvester,
-        &ReplayOptions {
-            breakdown_from_period: Some(index),
-            vq_cycle: Some((index, points)),
-            ..ReplayOptions::default()
-        },
-    )?;
-    Ok((
-        r.vq_cycle.unwrap_or_default(),
-        r.electrical.breakdown.unwrap_or_default(),
-    ))
-}
 
 /// Options of `vibrotribo load-sweep`.
 #[derive(Debug, clap::Args)]
@@ -86,58 +59,32 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
     }
     let config = args.input.load()?;
     let spec = config.run_spec(false);
-    let chain = &spec.chain;
-    let configured = config
-        .harvester()
-        .load
-        .resistance()
-        .unwrap_or(Load::default().resistance().unwrap_or(1e5));
-    let resistor = |r: f64| Harvester {
-        params: HarvesterParams {
-            load: Load::Resistor { resistance: r },
-            ..config.harvester().clone()
-        },
-        ..Harvester::new(config.harvester().clone(), config.charge_options().clone())
-    };
-    let harvester = resistor(configured).params;
-    let options = config.charge_options().clone();
-    let period = chain.period();
 
-    // The coupling is one-way: simulate the mechanics once and replay it for every load.
+    // The coupling is one-way: the mechanics is simulated once and replayed for every load.
     let mut watch = Watch {
         progress: Progress::new(spec.periods, "mechanics", args.quiet),
     };
-    let (trajectory, ending) = record_trajectory(&spec, 0, &mut watch)?;
+    let options = LoadStudyOptions {
+        resistances: log_spaced(args.from, args.to, args.steps),
+        vq_points: args.out.is_some().then_some(args.vq_points),
+    };
+    let study = load_study(&spec, &options, &mut watch)?;
     watch.progress.finish();
-    if ending != Ending::Completed {
+    let Some(study) = study else {
         return Err(Interrupted {
             what: "during the mechanical run; nothing was written".into(),
         }
         .into());
-    }
-
-    let resistances = log_spaced(args.from, args.to, args.steps);
-    let sweep = load_sweep(
-        &trajectory,
-        &harvester,
-        period,
-        &resistances,
-        spec.transient_periods as usize,
-        &options,
-    )?;
-    let at = |r: f64| -> Result<f64> {
-        let replayed = replay(
-            &trajectory,
-            chain,
-            &resistor(r),
-            &ReplayOptions {
-                transient_periods: spec.transient_periods,
-                ..ReplayOptions::default()
-            },
-        )?;
-        Ok(replayed.electrical.power.map_or(f64::NAN, |s| s.average_power_w))
     };
-    let p_configured = at(configured)?;
+    let sweep = &study.sweep;
+    let configured = study.configured_load_ohm;
+    let p_configured = study.configured_average_power_w;
+    let harvester = HarvesterParams {
+        load: Load::Resistor {
+            resistance: configured,
+        },
+        ..config.harvester().clone()
+    };
     let best = sweep.optimum;
     println!(
         "load sweep over {} loads from {} to {} ({} periods, {} transient)",
@@ -176,36 +123,33 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         }
         csv.flush()?;
         // V–Q cycles over the last simulated period, at the configured and the optimal load.
-        let last = spec.periods - 1;
         let mut vq = CsvFile::create(
             &dir.join("vq_cycle.csv"),
             &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"],
         )?;
         let mut cycles = Vec::new();
         let mut margins = Vec::new();
-        for r in [configured, best.resistance_ohm] {
-            let (c, margin) = vq_cycle(&trajectory, chain, &resistor(r), last, args.vq_points)?;
-            {
-                for j in 0..c.times.len() {
-                    vq.row([r, c.times[j], c.charge_c[j], c.voltage_v[j], c.current_a[j]])?;
-                }
-                println!(
-                    "  at {}: largest |V_gap|/V_breakdown over the last period {:.3}{}",
-                    si(r, "Ω"),
-                    margin.worst_ratio,
-                    if margin.worst_ratio >= 1.0 {
-                        format!(
-                            " ({} across {}): the air would break down",
-                            si(margin.gap_voltage_v, "V"),
-                            si(margin.gap_m, "m")
-                        )
-                    } else {
-                        String::new()
-                    }
-                );
-                margins.push(json!({"load_resistance_ohm": r, "air_breakdown": margin}));
-                cycles.push((r, c.charge_c.clone(), c.voltage_v.clone()));
+        for cycle in &study.vq_cycles {
+            let (r, c, margin) = (cycle.load_resistance_ohm, &cycle.samples, cycle.breakdown);
+            for j in 0..c.times.len() {
+                vq.row([r, c.times[j], c.charge_c[j], c.voltage_v[j], c.current_a[j]])?;
             }
+            println!(
+                "  at {}: largest |V_gap|/V_breakdown over the last period {:.3}{}",
+                si(r, "Ω"),
+                margin.worst_ratio,
+                if margin.worst_ratio >= 1.0 {
+                    format!(
+                        " ({} across {}): the air would break down",
+                        si(margin.gap_voltage_v, "V"),
+                        si(margin.gap_m, "m")
+                    )
+                } else {
+                    String::new()
+                }
+            );
+            margins.push(json!({"load_resistance_ohm": r, "air_breakdown": margin}));
+            cycles.push((r, c.charge_c.clone(), c.voltage_v.clone()));
         }
         vq.flush()?;
         write_json(

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use vibrotribo::study::PointResult;
+use vibrotribo::sweep::point_columns;
 
 /// A CSV file written row by row.
 pub struct CsvFile {
@@ -216,7 +217,7 @@ pub fn si(value: f64, unit: &str) -> String {
     format!("{x:.digits$} {prefix}{unit}")
 }
 
-/// The columns describing one sweep or map point, after its key columns: `average_power_w`,
+/// The columns describing one sweep or map point, after its key columns ([`point_columns`]): `average_power_w`,
 /// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
 /// `impacts_per_period_1..contacts`, `error`, with `floquet` `max_abs_multiplier`, and with
 /// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`.
@@ -237,18 +238,7 @@ const LYAPUNOV_COLUMNS: [&str; 2] = ["lyapunov_max_1_s", "lyapunov_spread_1_s"];
 impl PointColumns {
     /// The column names.
     pub fn names(&self) -> Vec<String> {
-        let mut cols: Vec<String> = [
-            "average_power_w",
-            "impacts_per_period",
-            "period",
-            "chatter",
-            "sticking",
-            "grazing",
-        ]
-        .map(String::from)
-        .to_vec();
-        cols.extend(numbered("impacts_per_period_", self.contacts, ""));
-        cols.push("error".into());
+        let mut cols = point_columns(self.contacts);
         if self.floquet {
             cols.push("max_abs_multiplier".into());
         }

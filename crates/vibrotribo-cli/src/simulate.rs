@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Result;
-use serde_json::json;
 use vibrotribo::config::Config;
 use vibrotribo::electrical::{HarvesterParams, Load, LoadKind, TransducerMode};
 use vibrotribo::study::{Ending, RunObserver, RunOutcome, RunSpec, Sample, simulate};
@@ -172,15 +171,10 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     };
     watch.progress.finish();
     let elapsed = started.elapsed().as_secs_f64();
-    let failure = outcome.failure().map(|e| {
-        anyhow::Error::from(e.clone()).context(format!(
-            "simulation stopped after {} complete periods",
-            outcome.periods
-        ))
-    });
+    let failure = failure_error(&outcome);
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
-        let summary = summary_json(&config, &spec, &outcome, elapsed, failure.as_ref());
+        let summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
             crate::plots::analyze_run(dir, None)?;
@@ -206,6 +200,17 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .into());
     }
     Ok(())
+}
+
+/// The error of a failed run, with how far it got (summary.json holds the same text,
+/// [`vibrotribo::report::failure_text`]).
+fn failure_error(outcome: &RunOutcome) -> Option<anyhow::Error> {
+    outcome.failure().map(|e| {
+        anyhow::Error::from(e.clone()).context(format!(
+            "simulation stopped after {} complete periods",
+            outcome.periods
+        ))
+    })
 }
 
 /// Refuses a run whose per-period statistics or files would be unreasonably large (see
@@ -238,82 +243,6 @@ fn check_size(config: &Config, spec: &RunSpec, args: &SimulateArgs) -> Result<()
         )?;
     }
     Ok(())
-}
-
-fn summary_json(
-    config: &Config,
-    spec: &RunSpec,
-    outcome: &RunOutcome,
-    elapsed: f64,
-    failure: Option<&anyhow::Error>,
-) -> serde_json::Value {
-    let params = &spec.chain;
-    let stats = &outcome.stats;
-    let done = outcome.periods;
-    let per_contact = stats.impacts_per_period(done);
-    let after = stats.impacts_after_transient();
-    let mut out = json!({
-        "periods": done,
-        "periods_requested": spec.periods,
-        "transient_periods": spec.transient_periods,
-        "impacts": after.iter().sum::<u64>(),
-        "impacts_per_period": per_contact.iter().sum::<f64>(),
-        "impacts_per_period_by_contact": per_contact,
-        "impacts_by_contact": after,
-        "impacts_in_each_period": stats.impacts_by_period(done),
-        "sticks": stats.sticks,
-        "releases": stats.releases,
-        "chatter_sequences": stats.chatter_sequences,
-        "max_closing_speed_m_s": stats.max_closing_speed,
-        "events_total": stats.events,
-        "excitation_period_s": params.period(),
-        "omega_rad_s": params.omega(),
-        "omega_ratio": params.omega_ratio(),
-    });
-    let obj = out.as_object_mut().expect("object");
-    if let (Some(e), Some(h)) = (&outcome.electrical, &spec.harvester) {
-        let s = &e.power;
-        obj.insert(
-            "average_power_w".into(),
-            json!(s.as_ref().map(|s| s.average_power_w)),
-        );
-        obj.insert(
-            "energy_per_period_j".into(),
-            json!(s.as_ref().map(|s| s.energy_per_period_j)),
-        );
-        obj.insert(
-            "peak_current_a".into(),
-            json!(s.as_ref().map(|s| s.peak_current_a)),
-        );
-        obj.insert(
-            "peak_voltage_v".into(),
-            json!(s.as_ref().map(|s| s.peak_voltage_v)),
-        );
-        obj.insert("power_curve".into(), json!(e.power_curve()));
-        obj.insert(
-            "energy_in_each_period_j".into(),
-            json!(e.periods.iter().map(|p| p.energy_j).collect::<Vec<_>>()),
-        );
-        if h.params.load.kind() == LoadKind::Rectifier {
-            obj.insert(
-                "storage_voltage_at_period_end_v".into(),
-                json!(e.periods.iter().map(|p| p.storage_voltage_v).collect::<Vec<_>>()),
-            );
-            obj.insert("time_to_target_s".into(), json!(e.time_to_target));
-        }
-        if let Some(margin) = &e.breakdown {
-            obj.insert("air_breakdown".into(), json!(margin));
-        }
-        obj.insert("harvester".into(), json!(h.params));
-        obj.insert("electrical_solver".into(), json!(format!("{:?}", e.solver)));
-    }
-    obj.insert("nondimensional".into(), json!(params.nondimensional()));
-    obj.insert("parameters".into(), json!(params));
-    obj.insert("settings".into(), json!(config.table()));
-    obj.insert("wall_time_s".into(), json!(elapsed));
-    obj.insert("interrupted".into(), json!(outcome.ending == Ending::Stopped));
-    obj.insert("error".into(), json!(failure.map(|e| format!("{e:#}"))));
-    out
 }
 
 fn print_summary(spec: &RunSpec, outcome: &RunOutcome, elapsed: f64, out: Option<&Path>) {
@@ -402,5 +331,22 @@ fn print_summary(spec: &RunSpec, outcome: &RunOutcome, elapsed: f64, out: Option
             "  wrote {0}/events.csv, {0}/trajectory.csv, {0}/summary.json",
             dir.display()
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use vibrotribo::config::Config;
+    use vibrotribo::study::simulate;
+
+    /// summary.json's `error` reads exactly as the error the command reports.
+    #[test]
+    fn summary_error_is_the_reported_error() {
+        let config = Config::default()
+            .with("options.max_events_per_period", 2.into())
+            .unwrap();
+        let outcome = simulate(&config.run_spec(false), &mut ()).unwrap();
+        let reported = format!("{:#}", super::failure_error(&outcome).expect("the run fails"));
+        assert_eq!(Some(reported), vibrotribo::report::failure_text(&outcome));
     }
 }

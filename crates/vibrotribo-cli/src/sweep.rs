@@ -11,7 +11,7 @@ use vibrotribo::ChainState;
 use vibrotribo::config::Config;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
-use vibrotribo::sweep::{Continuation, Delivery, PointRunner, grid, run_chunks, run_continued};
+use vibrotribo::sweep::{Continuation, Delivery, PointRunner, error_text, grid, run_chunks, run_continued};
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
@@ -199,7 +199,7 @@ where
 {
     run_chunked(
         points,
-        |p| runner.run(&keys(p), None).map_err(|e| format!("{e:#}")),
+        |p| runner.run(&keys(p), None).map_err(|e| error_text(&e)),
         progress,
         quiet,
         |d| match d {
@@ -522,7 +522,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             let mut written = 0usize;
             let mut failure = None;
             let (done, _) = run_continued(&runner, key, &values, todo, state, |j, r, state| {
-                let r = r.map_err(|e| format!("{e:#}"));
+                let r = r.map_err(|e| error_text(&e));
                 failed += usize::from(r.is_err());
                 written += 1;
                 if let Some(o) = out.as_mut() {

@@ -50,6 +50,8 @@ pub mod lyapunov;
 pub mod model;
 pub mod orbits;
 mod random;
+#[cfg(feature = "config")]
+pub mod report;
 pub mod sensitivity;
 pub mod study;
 #[cfg(feature = "config")]

@@ -93,6 +93,29 @@ fn unknown_keys_are_named() {
     assert!(e.contains("unknown field `oscilator`"), "{e}");
 }
 
+/// A tree built outside TOML text (a Python dict) with a key the schema lacks: an unknown
+/// key, named as a key.
+#[test]
+fn unknown_keys_of_a_tree_are_named() {
+    for (text, key) in [
+        ("[oscillator]\nmases = [0.1, 0.2]\n", "oscillator.mases"),
+        ("[oscilator]\nmasses = [0.1, 0.2]\n", "oscilator.masses"),
+        ("[run]\nperiods = 10\n[harvester]\nloads = 1\n", "harvester.loads"),
+        ("mass_ratio = 3\n", "mass_ratio"),
+    ] {
+        let table: toml::Table = toml::from_str(text).unwrap();
+        match Config::from_table(table) {
+            Err(ConfigError::UnknownKey { key: k, .. }) => assert_eq!(k, key),
+            other => panic!("{text}: expected the unknown key {key}, got {other:?}"),
+        }
+    }
+    // A known key with a bad type stays a type error.
+    let table: toml::Table = toml::from_str("[run]\nperiods = \"many\"\n").unwrap();
+    let e = Config::from_table(table).unwrap_err();
+    assert!(matches!(e, ConfigError::Type { .. }), "{e:?}");
+    assert!(e.to_string().contains("run.periods"), "{e}");
+}
+
 #[test]
 fn bad_values_are_named_by_their_keys() {
     let cases: &[(&str, &[&str], &str)] = &[

@@ -115,6 +115,10 @@ impl Config {
     /// Reads a configuration from a TOML tree (as parsed, or built from a Python dict).
     pub fn from_table(table: Table) -> Result<Self, ConfigError> {
         let doc: Document = serde_path_to_error::deserialize(Value::Table(table.clone())).map_err(|e| {
+            // A key the schema lacks is named as one (the deserialiser calls it a field).
+            if let Some(key) = keys::unknown_key_in(&table) {
+                return keys::unknown(&key);
+            }
             let path = e.path().to_string();
             ConfigError::Type {
                 origin: if path == "." {

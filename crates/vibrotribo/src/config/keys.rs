@@ -127,7 +127,25 @@ pub fn known_keys() -> Vec<String> {
     keys
 }
 
-fn unknown(key: &str) -> ConfigError {
+/// The first key of `table` (`section.name`, or a top-level name) that the schema lacks.
+pub(super) fn unknown_key_in(table: &Table) -> Option<String> {
+    let known = known_keys();
+    for (section, value) in table {
+        let prefix = format!("{section}.");
+        match value {
+            Value::Table(fields) => {
+                if let Some(name) = fields.keys().find(|n| !known.contains(&format!("{prefix}{n}"))) {
+                    return Some(format!("{prefix}{name}"));
+                }
+            }
+            _ if !known.iter().any(|k| k.starts_with(&prefix)) => return Some(section.clone()),
+            _ => {}
+        }
+    }
+    None
+}
+
+pub(super) fn unknown(key: &str) -> ConfigError {
     let mut known = known_keys();
     known.extend(DERIVED_KEYS.iter().map(|(k, _)| k.to_string()));
     ConfigError::UnknownKey {

@@ -5,18 +5,22 @@
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
+mod loads;
 mod lyapunov;
 mod observer;
 mod orbit;
 mod point;
+mod record;
 mod replay;
 mod settings;
 mod simulate;
 
+pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
+pub use record::{EventColumns, Recording, SampleColumns};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use settings::{ElectricalFailure, Harvester, RunSettings, RunSpec, Sampling};
 pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};

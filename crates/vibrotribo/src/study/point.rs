@@ -12,7 +12,7 @@
 use thiserror::Error;
 
 use super::observer::{Mechanics, RunObserver};
-use super::settings::{ElectricalFailure, Harvester, RunSpec};
+use super::settings::{ElectricalFailure, Harvester, RunSettings, RunSpec};
 use super::simulate::{Ending, StudyError, simulate};
 use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, StroboscopicSection, detect_period};
 use crate::dynamics::{Event, EventKind, Observer, StateView};
@@ -64,6 +64,17 @@ impl Default for PointOptions {
 }
 
 impl PointOptions {
+    /// The options of the sweep points of a configuration whose `[run]` table is `run`:
+    /// `transient` periods before recording (default: `run.transient_periods`) and
+    /// `recorded` periods (default: the rest of `run.periods`), the rest at their defaults.
+    pub fn from_run(run: &RunSettings, transient: Option<u64>, recorded: Option<u64>) -> Self {
+        PointOptions {
+            transient_periods: transient.unwrap_or(run.transient()),
+            recorded_periods: recorded.unwrap_or(run.periods - run.transient()),
+            ..PointOptions::default()
+        }
+    }
+
     /// The period-detection settings for `recorded_periods` samples: periods up to
     /// min(64, recorded/2), each checked over the rest of the window.
     pub fn period_options(&self) -> PeriodOptions {

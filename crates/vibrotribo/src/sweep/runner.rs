@@ -1,8 +1,4 @@
-//! Parameter sweeps over a configuration's keys: the points of a grid, each a
-//! [`run_point`](crate::study::run_point) of the configuration with some keys set, run in
-//! parallel in chunks and delivered in grid order (so results do not depend on the thread
-//! count), or continued from one value to the next. The command line and the Python package
-//! both run their sweeps and maps through here.
+//! The point runner and the grid and continued runners of sweeps and maps.
 
 use std::ops::ControlFlow;
 
@@ -185,21 +181,50 @@ where
     run_chunks(points, chunk, |p| runner.run(&keys(p), None), on)
 }
 
+/// [`run_grid`] on the threads of `pool`, while `on` runs on the calling thread (which can
+/// then be the one that must see an interrupt, such as Python's main thread).
+pub fn run_grid_on<'k, P, F>(
+    pool: &rayon::ThreadPool,
+    runner: &PointRunner,
+    points: &[P],
+    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
+    chunk: usize,
+    on: F,
+) -> usize
+where
+    P: Sync,
+    F: FnMut(Delivery<'_, P>) -> ControlFlow<()>,
+{
+    in_chunks(
+        points,
+        chunk,
+        |block| pool.install(|| block.par_iter().map(|p| runner.run(&keys(p), None)).collect()),
+        on,
+    )
+}
+
 /// Runs `work` on `points` in parallel chunks of `chunk` points on the current rayon pool and
 /// hands each result to `on` in order, then the end of the chunk; `on` may stop the run.
 /// Returns how many points were delivered. What is delivered does not depend on the thread
 /// count. [`run_grid`] is this with a sweep point as the work.
-pub fn run_chunks<P, R, W, F>(points: &[P], chunk: usize, work: W, mut on: F) -> usize
+pub fn run_chunks<P, R, W, F>(points: &[P], chunk: usize, work: W, on: F) -> usize
 where
     P: Sync,
     R: Send,
     W: Fn(&P) -> R + Sync,
     F: FnMut(Delivery<'_, P, R>) -> ControlFlow<()>,
 {
+    in_chunks(points, chunk, |block| block.par_iter().map(&work).collect(), on)
+}
+
+/// `points` in chunks of `chunk`, each computed by `compute` and delivered to `on` in order.
+fn in_chunks<P, R, F>(points: &[P], chunk: usize, compute: impl Fn(&[P]) -> Vec<R>, mut on: F) -> usize
+where
+    F: FnMut(Delivery<'_, P, R>) -> ControlFlow<()>,
+{
     let mut done = 0;
     for block in points.chunks(chunk.max(1)) {
-        let results: Vec<R> = block.par_iter().map(&work).collect();
-        for (p, r) in block.iter().zip(results) {
+        for (p, r) in block.iter().zip(compute(block)) {
             done += 1;
             if on(Delivery::Point(p, r)).is_break() {
                 return done;

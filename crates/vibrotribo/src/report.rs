@@ -1,0 +1,151 @@
+//! What a run reports: the summary of one [`simulate`](crate::study::simulate) run as the
+//! command line writes it to `summary.json` and Python returns it as a dict, built in one
+//! place so that both hold the same keys and the same numbers.
+
+use std::error::Error;
+use std::fmt::Write as _;
+
+use serde_json::json;
+
+use crate::config::Config;
+use crate::electrical::LoadKind;
+use crate::study::{Ending, RunOutcome, RunSpec};
+
+/// Why a run failed, as one line: `simulation stopped after N complete periods: <error>:
+/// <its source>: …` (the error and the chain of its sources, each after `: `).
+pub fn failure_text(outcome: &RunOutcome) -> Option<String> {
+    let e = outcome.failure()?;
+    let mut text = format!("simulation stopped after {} complete periods", outcome.periods);
+    let mut cause: Option<&dyn Error> = Some(e);
+    while let Some(c) = cause {
+        let _ = write!(text, ": {c}");
+        cause = c.source();
+    }
+    Some(text)
+}
+
+/// The summary of a run of `spec` (read from `config`) that ended in `outcome` after
+/// `wall_time_s` seconds: periods, impacts (after the transient, in all, per period and per
+/// contact), sticks, releases, chatter sequences, the largest closing speeds, the excitation;
+/// with a harvester the average power, energy per period, peak current and voltage, the
+/// running power curve, per-period energies (and storage voltages with a rectifier), the
+/// air-breakdown margin and the harvester's parameters; then the nondimensional groups,
+/// the chain's parameters, the configuration's settings, the wall time, whether the run was
+/// interrupted and why it failed ([`failure_text`]). Units are in the key names (`_w`, `_j`,
+/// `_a`, `_v`, `_s`, `_m_s`, `_rad_s`).
+pub fn run_summary(
+    config: &Config,
+    spec: &RunSpec,
+    outcome: &RunOutcome,
+    wall_time_s: f64,
+) -> serde_json::Value {
+    let params = &spec.chain;
+    let stats = &outcome.stats;
+    let done = outcome.periods;
+    let per_contact = stats.impacts_per_period(done);
+    let after = stats.impacts_after_transient();
+    let mut out = json!({
+        "periods": done,
+        "periods_requested": spec.periods,
+        "transient_periods": spec.transient_periods,
+        "impacts": after.iter().sum::<u64>(),
+        "impacts_per_period": per_contact.iter().sum::<f64>(),
+        "impacts_per_period_by_contact": per_contact,
+        "impacts_by_contact": after,
+        "impacts_in_each_period": stats.impacts_by_period(done),
+        "sticks": stats.sticks,
+        "releases": stats.releases,
+        "chatter_sequences": stats.chatter_sequences,
+        "max_closing_speed_m_s": stats.max_closing_speed,
+        "events_total": stats.events,
+        "excitation_period_s": params.period(),
+        "omega_rad_s": params.omega(),
+        "omega_ratio": params.omega_ratio(),
+    });
+    let obj = out.as_object_mut().expect("a JSON object");
+    if let (Some(e), Some(h)) = (&outcome.electrical, &spec.harvester) {
+        let s = &e.power;
+        obj.insert(
+            "average_power_w".into(),
+            json!(s.as_ref().map(|s| s.average_power_w)),
+        );
+        obj.insert(
+            "energy_per_period_j".into(),
+            json!(s.as_ref().map(|s| s.energy_per_period_j)),
+        );
+        obj.insert(
+            "peak_current_a".into(),
+            json!(s.as_ref().map(|s| s.peak_current_a)),
+        );
+        obj.insert(
+            "peak_voltage_v".into(),
+            json!(s.as_ref().map(|s| s.peak_voltage_v)),
+        );
+        obj.insert("power_curve".into(), json!(e.power_curve()));
+        obj.insert(
+            "energy_in_each_period_j".into(),
+            json!(e.periods.iter().map(|p| p.energy_j).collect::<Vec<_>>()),
+        );
+        if h.params.load.kind() == LoadKind::Rectifier {
+            obj.insert(
+                "storage_voltage_at_period_end_v".into(),
+                json!(e.periods.iter().map(|p| p.storage_voltage_v).collect::<Vec<_>>()),
+            );
+            obj.insert("time_to_target_s".into(), json!(e.time_to_target));
+        }
+        if let Some(margin) = &e.breakdown {
+            obj.insert("air_breakdown".into(), json!(margin));
+        }
+        obj.insert("harvester".into(), json!(h.params));
+        obj.insert("electrical_solver".into(), json!(format!("{:?}", e.solver)));
+    }
+    obj.insert("nondimensional".into(), json!(params.nondimensional()));
+    obj.insert("parameters".into(), json!(params));
+    obj.insert("settings".into(), json!(config.table()));
+    obj.insert("wall_time_s".into(), json!(wall_time_s));
+    obj.insert("interrupted".into(), json!(outcome.ending == Ending::Stopped));
+    obj.insert("error".into(), json!(failure_text(outcome)));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study::simulate;
+
+    /// The summary's counts are those of the run's statistics, and a failed run says after
+    /// how many periods and why.
+    #[test]
+    fn summary_counts_and_failure() {
+        let config = Config::default()
+            .with("run.periods", 12.into())
+            .and_then(|c| c.with("run.transient_periods", 4.into()))
+            .unwrap();
+        let spec = config.run_spec(false);
+        let outcome = simulate(&spec, &mut ()).unwrap();
+        let s = run_summary(&config, &spec, &outcome, 0.5);
+        assert_eq!(s["periods"], 12);
+        assert_eq!(
+            s["impacts"],
+            outcome.stats.impacts_after_transient().iter().sum::<u64>()
+        );
+        assert_eq!(s["error"], serde_json::Value::Null);
+        assert_eq!(s["interrupted"], false);
+        assert!(s["average_power_w"].as_f64().unwrap() > 0.0);
+
+        // Two events per period at most: the default case cannot run.
+        let tight = config.with("options.max_events_per_period", 2.into()).unwrap();
+        let spec = tight.run_spec(true);
+        let outcome = simulate(&spec, &mut ()).unwrap();
+        let text = failure_text(&outcome).expect("the run fails");
+        assert!(
+            text.starts_with(&format!(
+                "simulation stopped after {} complete periods: ",
+                outcome.periods
+            )),
+            "{text}"
+        );
+        assert!(text.contains(&outcome.failure().unwrap().to_string()), "{text}");
+        assert_eq!(run_summary(&tight, &spec, &outcome, 0.0)["error"], text.as_str());
+    }
+}

@@ -1,0 +1,14 @@
+//! Parameter sweeps over a configuration's keys: the points of a grid, each a
+//! [`run_point`](crate::study::run_point) of the configuration with some keys set, run in
+//! parallel in chunks and delivered in grid order (so results do not depend on the thread
+//! count), or continued from one value to the next; and their results in columns
+//! ([`SweepColumns`]). The command line and the Python package both run their sweeps and
+//! maps through here.
+
+mod runner;
+mod table;
+
+pub use runner::{
+    Continuation, Delivery, PointRunner, SweepError, grid, run_chunks, run_continued, run_grid, run_grid_on,
+};
+pub use table::{Column, SweepColumns, Table, error_text, point_columns};

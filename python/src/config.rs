@@ -1,0 +1,292 @@
+//! `vibrotribo.Config`: a configuration read by the library ([`vibrotribo::config::Config`])
+//! from a TOML file, a dict shaped like one, and keyword overrides; Python values to TOML
+//! values and back; the library's errors as Python exceptions.
+
+use std::path::PathBuf;
+
+use pyo3::exceptions::{PyFileNotFoundError, PyKeyError, PyOSError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use toml::{Table, Value};
+use vibrotribo::config::{Config, ConfigError, DERIVED_KEYS, known_keys};
+
+/// The exception for a configuration error: `KeyError` for an unknown key, `OSError` for an
+/// unreadable file, `ValueError` for anything else (a bad value, bad TOML). The message
+/// names the key (or the file).
+pub fn config_error(e: ConfigError) -> PyErr {
+    fn innermost(e: &ConfigError) -> &ConfigError {
+        match e {
+            ConfigError::Setting { error, .. } => innermost(error),
+            other => other,
+        }
+    }
+    let message = e.to_string();
+    match innermost(&e) {
+        ConfigError::UnknownKey { .. } => PyKeyError::new_err(message),
+        ConfigError::Io { path, .. } if !std::path::Path::new(path).exists() => {
+            PyFileNotFoundError::new_err(message)
+        }
+        ConfigError::Io { .. } => PyOSError::new_err(message),
+        _ => PyValueError::new_err(message),
+    }
+}
+
+/// A keyword argument's name as a configuration key: `__` stands for `.`
+/// (`excitation__omega_ratio` is `excitation.omega_ratio`); names holding a `.` or `[`
+/// (passed as `**{"oscillator.gaps[1]": 0.03}`) and derived keys (`mass_ratio`) are used as
+/// they are.
+pub fn key_of(name: &str) -> String {
+    name.replace("__", ".")
+}
+
+/// A Python value as a TOML value: bool, int, float, str, a list or tuple (or a numpy array)
+/// of values, a dict of values; numpy scalars as their Python values. `key` names the value
+/// in errors.
+pub fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<Value> {
+    if v.is_none() {
+        return Err(PyValueError::new_err(format!(
+            "`{key}` = None: a configuration value cannot be None (leave the key out for its default)"
+        )));
+    }
+    if v.is_instance_of::<PyBool>() {
+        return Ok(Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        let i: i64 = v
+            .extract()
+            .map_err(|_| PyValueError::new_err(format!("`{key}` = {v}: the integer is too large")))?;
+        return Ok(Value::Integer(i));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(Value::Float(v.extract()?));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(Value::String(v.extract()?));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        return Ok(Value::Table(to_table(d, Some(key))?));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let mut out = Vec::new();
+        for (i, item) in v.try_iter()?.enumerate() {
+            out.push(to_toml(&item?, &format!("{key}[{i}]"))?);
+        }
+        return Ok(Value::Array(out));
+    }
+    // numpy arrays and scalars: their Python equivalent.
+    if v.hasattr("tolist")? {
+        return to_toml(&v.call_method0("tolist")?, key);
+    }
+    Err(PyValueError::new_err(format!(
+        "`{key}`: a {} cannot be a configuration value (use a number, a string, a bool, a list or a dict)",
+        v.get_type().name()?
+    )))
+}
+
+/// A dict shaped like a configuration file (`{"oscillator": {"masses": [...]}}`) as a TOML
+/// table; `prefix` is the key of the dict itself (`None` at the top).
+pub fn to_table(d: &Bound<'_, PyDict>, prefix: Option<&str>) -> PyResult<Table> {
+    let mut table = Table::new();
+    for (k, v) in d.iter() {
+        let name: String = k
+            .extract()
+            .map_err(|_| PyTypeError::new_err(format!("configuration keys must be strings, got {k}")))?;
+        let key = match prefix {
+            Some(p) => format!("{p}.{name}"),
+            None => name.clone(),
+        };
+        table.insert(name, to_toml(&v, &key)?);
+    }
+    Ok(table)
+}
+
+/// A TOML value as a Python value (tables as dicts, arrays as lists, dates as strings).
+pub fn from_toml<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        Value::Boolean(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Integer(i) => i.into_pyobject(py)?.into_any(),
+        Value::Float(x) => PyFloat::new(py, *x).into_any(),
+        Value::String(s) => PyString::new(py, s).into_any(),
+        Value::Datetime(d) => PyString::new(py, &d.to_string()).into_any(),
+        Value::Array(a) => {
+            let items = a.iter().map(|x| from_toml(py, x)).collect::<PyResult<Vec<_>>>()?;
+            PyList::new(py, items)?.into_any()
+        }
+        Value::Table(t) => table_to_dict(py, t)?.into_any(),
+    })
+}
+
+/// A TOML table as a dict.
+pub fn table_to_dict<'py>(py: Python<'py>, t: &Table) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in t {
+        d.set_item(k, from_toml(py, v)?)?;
+    }
+    Ok(d)
+}
+
+/// A configuration: the paper's default case, a TOML file, or a dict shaped like one, with
+/// keys overridden by keyword arguments.
+///
+///     Config()                                          # the paper's default case
+///     Config("configs/chatter.toml")                    # a TOML file (str or path)
+///     Config({"oscillator": {"masses": [0.05, 0.15, 0.05]}, "run": {"periods": 200}})
+///     Config("configs/chatter.toml", excitation__omega_ratio=0.6)
+///     Config(mass_ratio=3, **{"oscillator.gaps[1]": 0.03})
+///
+/// Keys are those of the TOML file, `section.name` (`excitation.omega_ratio`,
+/// `harvester.load_resistance`, one element as `oscillator.gaps[1]`), and the derived keys
+/// (`mass_ratio`, `gap_ratio`, `gap`, `omega_ratio`, `frequency_hz`, `amplitude`,
+/// `restitution`; see `Config.keys()`). As keyword arguments a `.` is written `__`
+/// (`excitation__omega_ratio=0.6`), or the key is passed as it is with `**{...}`. Overrides
+/// are applied in order and the whole is validated once. Units are SI (kg, m, s, N/m, Ω, F).
+///
+/// An unknown key raises `KeyError`, a bad value `ValueError`, a missing file
+/// `FileNotFoundError`; each message names the key or the file. A `Config` is immutable:
+/// `replace(**overrides)` returns a changed copy.
+#[pyclass(module = "vibrotribo", name = "Config", frozen, eq)]
+#[derive(Clone, PartialEq)]
+pub struct PyConfig {
+    /// The library's configuration.
+    pub inner: Config,
+}
+
+impl PyConfig {
+    fn read(source: Option<&Bound<'_, PyAny>>) -> PyResult<Config> {
+        let Some(s) = source.filter(|s| !s.is_none()) else {
+            return Ok(Config::default());
+        };
+        if let Ok(c) = s.cast::<PyConfig>() {
+            return Ok(c.get().inner.clone());
+        }
+        if let Ok(d) = s.cast::<PyDict>() {
+            return Config::from_table(to_table(d, None)?).map_err(config_error);
+        }
+        if let Ok(path) = s.extract::<PathBuf>() {
+            return Config::from_path(&path).map_err(config_error);
+        }
+        Err(PyTypeError::new_err(format!(
+            "Config takes a path to a TOML file, a dict or a Config, not a {}",
+            s.get_type().name()?
+        )))
+    }
+
+    /// `config` with the keyword overrides applied (in order, validated as a whole).
+    pub fn overridden(mut config: Config, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+        let Some(o) = overrides else { return Ok(config) };
+        let mut pairs = Vec::new();
+        for (k, v) in o.iter() {
+            let key = key_of(&k.extract::<String>()?);
+            let value = to_toml(&v, &key)?;
+            pairs.push((key, value));
+        }
+        config
+            .set_all(pairs.iter().map(|(k, v)| (k.as_str(), v.clone())))
+            .map_err(config_error)?;
+        Ok(config)
+    }
+}
+
+/// The configuration `obj` stands for: a `Config`, a dict, a path, or `None` (the defaults).
+pub fn config_of(obj: &Bound<'_, PyAny>) -> PyResult<Config> {
+    PyConfig::read(Some(obj))
+}
+
+#[pymethods]
+impl PyConfig {
+    #[new]
+    #[pyo3(signature = (source=None, /, **overrides))]
+    fn new(source: Option<&Bound<'_, PyAny>>, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        Ok(PyConfig {
+            inner: Self::overridden(Self::read(source)?, overrides)?,
+        })
+    }
+
+    /// A configuration from TOML text.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        Ok(PyConfig {
+            inner: Config::from_toml_str(text).map_err(config_error)?,
+        })
+    }
+
+    /// A copy with the keyword overrides applied (same keys as the constructor).
+    #[pyo3(signature = (**overrides))]
+    fn replace(&self, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        Ok(PyConfig {
+            inner: Self::overridden(self.inner.clone(), overrides)?,
+        })
+    }
+
+    /// The settings as a dict shaped like the TOML file: what was read, with the overrides
+    /// applied (keys left out take their defaults). `Config(c.to_dict()) == c`.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        table_to_dict(py, self.inner.table())
+    }
+
+    /// The settings as TOML text.
+    fn to_toml(&self) -> PyResult<String> {
+        toml::to_string(self.inner.table()).map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// Every key: those of the TOML file (`section.name`), then the derived ones.
+    #[staticmethod]
+    fn keys() -> Vec<String> {
+        let mut k = known_keys();
+        k.extend(DERIVED_KEYS.iter().map(|(name, _)| name.to_string()));
+        k
+    }
+
+    /// Masses m_i, kg (top to bottom).
+    #[getter]
+    fn masses(&self) -> Vec<f64> {
+        self.inner.chain().masses.clone()
+    }
+
+    /// Gaps δ_k at rest, m.
+    #[getter]
+    fn gaps(&self) -> Vec<f64> {
+        self.inner.chain().gaps.clone()
+    }
+
+    /// Excitation period T, s.
+    #[getter]
+    fn period_s(&self) -> f64 {
+        self.inner.chain().period()
+    }
+
+    /// Ω = ω/√(k1/m1).
+    #[getter]
+    fn omega_ratio(&self) -> f64 {
+        self.inner.chain().omega_ratio()
+    }
+
+    /// Excitation periods simulated (`run.periods`).
+    #[getter]
+    fn periods(&self) -> u64 {
+        self.inner.run().periods
+    }
+
+    /// Periods excluded from statistics (`run.transient_periods`).
+    #[getter]
+    fn transient_periods(&self) -> u64 {
+        self.inner.run().transient()
+    }
+
+    fn __repr__(&self) -> String {
+        let text = toml::to_string(self.inner.table()).unwrap_or_default();
+        if text.trim().is_empty() {
+            "Config()  # the paper's default case".into()
+        } else {
+            format!("Config.from_toml('''\n{}''')", text)
+        }
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+        let py = slf.py();
+        Ok((
+            slf.get_type().into_any(),
+            (table_to_dict(py, slf.get().inner.table())?,),
+        ))
+    }
+}

@@ -1,0 +1,355 @@
+//! `vibrotribo.periodic` and `vibrotribo.continue_`: periodic orbits by shooting with their
+//! Floquet multipliers, and their continuation in a configuration key
+//! ([`vibrotribo::orbits`]).
+
+use numpy::{Complex64, PyArray1, PyArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use vibrotribo::config::Config;
+use vibrotribo::nalgebra::Complex;
+use vibrotribo::orbits::{
+    BifurcationKind, Branch, BranchEnd, BranchPoint, ContinuationOptions, OrbitError, PeriodicOrbit,
+    ShootingOptions, continue_orbit, find_periodic_orbit, periodic_orbit_from_transient,
+};
+use vibrotribo::{ChainParams, ChainState};
+
+use crate::config::{config_error, config_of};
+use crate::convert::{array1, array2};
+
+create_exception!(
+    vibrotribo,
+    OrbitNotFound,
+    PyRuntimeError,
+    "No periodic orbit was found (Newton's method did not converge, the motion is not periodic, or the orbit is not differentiable)."
+);
+
+/// `ValueError` for bad options or parameters, [`OrbitNotFound`] otherwise.
+fn orbit_error(e: OrbitError) -> PyErr {
+    match e {
+        OrbitError::Param(p) => PyValueError::new_err(p.to_string()),
+        OrbitError::ZeroPeriod => PyValueError::new_err(e.to_string()),
+        other => OrbitNotFound::new_err(other.to_string()),
+    }
+}
+
+fn complex_array<'py>(py: Python<'py>, m: &[Complex<f64>]) -> Bound<'py, PyAny> {
+    let v: Vec<Complex64> = m.iter().map(|c| Complex64::new(c.re, c.im)).collect();
+    PyArray1::from_vec(py, v).into_any()
+}
+
+/// The orbit as a dict of arrays.
+fn orbit_to_py<'py>(py: Python<'py>, o: &PeriodicOrbit) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("period", o.period)?;
+    d.set_item("x", array1(py, o.state.positions.clone()))?;
+    d.set_item("v", array1(py, o.state.velocities.clone()))?;
+    d.set_item("multipliers", complex_array(py, &o.multipliers))?;
+    d.set_item("stable", o.stable)?;
+    d.set_item("spectral_radius", o.spectral_radius())?;
+    d.set_item("unstable_dimension", o.unstable_dimension())?;
+    d.set_item("impacts_per_period", array1(py, o.impacts_per_period()))?;
+    d.set_item("sticks", o.sticks())?;
+    d.set_item("residual", o.residual)?;
+    d.set_item("residuals", array1(py, o.residuals.clone()))?;
+    d.set_item("duration_s", o.duration())?;
+    d.set_item(
+        "monodromy",
+        array2(
+            py,
+            o.monodromy.transpose().as_slice().to_vec(),
+            o.monodromy.ncols(),
+        )?,
+    )?;
+    let events = PyDict::new(py);
+    events.set_item("t", array1(py, o.events.iter().map(|e| e.time).collect()))?;
+    events.set_item("kind", PyList::new(py, o.events.iter().map(|e| e.kind.as_str()))?)?;
+    let contact: Vec<i64> = o.events.iter().map(|e| e.contact as i64 + 1).collect();
+    events.set_item("contact", PyArray1::from_vec(py, contact))?;
+    events.set_item(
+        "speed_before",
+        array1(py, o.events.iter().map(|e| e.velocity_before).collect()),
+    )?;
+    d.set_item("events", events)?;
+    Ok(d)
+}
+
+/// The shooting options of a configuration (its simulator settings), with a tolerance and
+/// an iteration limit if given.
+fn shooting(config: &Config, tolerance: Option<f64>, max_iterations: Option<usize>) -> ShootingOptions {
+    let d = ShootingOptions::default();
+    ShootingOptions {
+        tolerance: tolerance.unwrap_or(d.tolerance),
+        max_iterations: max_iterations.unwrap_or(d.max_iterations),
+        sim: config.sim_options().clone(),
+        ..d
+    }
+}
+
+/// A state from `(x, v)` for a chain of `n` masses.
+fn state_of(guess: (Vec<f64>, Vec<f64>), n: usize) -> PyResult<ChainState> {
+    let (x, v) = guess;
+    if x.len() != n || v.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "guess: needs {n} positions and {n} velocities, got {} and {}",
+            x.len(),
+            v.len()
+        )));
+    }
+    Ok(ChainState {
+        positions: x,
+        velocities: v,
+    })
+}
+
+/// Finds a periodic orbit (see the Python `vibrotribo.periodic`).
+#[pyfunction]
+#[pyo3(signature = (config, *, period = None, transient = 100, guess = None, tolerance = None, max_iterations = None))]
+pub fn periodic<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    period: Option<u32>,
+    transient: u32,
+    guess: Option<(Vec<f64>, Vec<f64>)>,
+    tolerance: Option<f64>,
+    max_iterations: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = config_of(config)?;
+    let options = shooting(&config, tolerance, max_iterations);
+    let chain = config.chain().clone();
+    let orbit = match guess {
+        Some(g) => {
+            let state = state_of(g, chain.len())?;
+            let period = period.ok_or_else(|| PyValueError::new_err("period: give it with a guess"))?;
+            py.detach(|| find_periodic_orbit(&chain, &state, period, &options))
+        }
+        None => {
+            let initial = config.initial_state().clone();
+            py.detach(|| periodic_orbit_from_transient(&chain, &initial, transient, period, &options))
+        }
+    }
+    .map_err(orbit_error)?;
+    orbit_to_py(py, &orbit)
+}
+
+/// The points of a branch as arrays.
+fn points_to_py<'py>(py: Python<'py>, points: &[BranchPoint], n: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let flat = |f: &dyn Fn(&BranchPoint) -> &[f64]| -> Vec<f64> {
+        points.iter().flat_map(|p| f(p).to_vec()).collect()
+    };
+    d.set_item(
+        "parameter",
+        array1(py, points.iter().map(|p| p.parameter).collect()),
+    )?;
+    d.set_item("x", array2(py, flat(&|p| &p.state.positions), n)?)?;
+    d.set_item("v", array2(py, flat(&|p| &p.state.velocities), n)?)?;
+    let m: Vec<Complex64> = points
+        .iter()
+        .flat_map(|p| p.multipliers.iter().map(|c| Complex64::new(c.re, c.im)))
+        .collect();
+    let rows = points.len();
+    let multipliers = PyArray1::from_vec(py, m).reshape([rows, if rows == 0 { 0 } else { 2 * n }])?;
+    d.set_item("multipliers", multipliers)?;
+    d.set_item(
+        "stable",
+        PyArray1::from_vec(py, points.iter().map(|p| p.stable).collect()),
+    )?;
+    d.set_item(
+        "sticks",
+        PyArray1::from_vec(py, points.iter().map(|p| p.sticks).collect()),
+    )?;
+    d.set_item(
+        "impacts_per_period",
+        array2(py, flat(&|p| &p.impacts_per_period), n - 1)?,
+    )?;
+    d.set_item(
+        "arclength",
+        array1(py, points.iter().map(|p| p.arclength).collect()),
+    )?;
+    d.set_item(
+        "spectral_radius",
+        array1(py, points.iter().map(|p| p.spectral_radius()).collect()),
+    )?;
+    Ok(d)
+}
+
+/// What happens at a bifurcation, as a dict: `kind` and its details (contacts 1-based).
+fn kind_to_py<'py>(py: Python<'py>, kind: &BifurcationKind, d: &Bound<'py, PyDict>) -> PyResult<()> {
+    let name = match kind {
+        BifurcationKind::Fold => "fold",
+        BifurcationKind::BranchPoint => "branch_point",
+        BifurcationKind::PeriodDoubling => "period_doubling",
+        BifurcationKind::NeimarkSacker { angle } => {
+            d.set_item("angle", angle)?;
+            "neimark_sacker"
+        }
+        BifurcationKind::Grazing { contact, appears } => {
+            d.set_item("contact", contact + 1)?;
+            d.set_item("appears", appears)?;
+            "grazing"
+        }
+        BifurcationKind::Sticking { contact, onset } => {
+            d.set_item("contact", contact + 1)?;
+            d.set_item("onset", onset)?;
+            "sticking"
+        }
+        BifurcationKind::SequenceChange => "sequence_change",
+        _ => "other",
+    };
+    let _ = py;
+    d.set_item("kind", name)
+}
+
+/// Why a branch ended, as a dict: `reason` and its details.
+fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let reason = match end {
+        BranchEnd::RangeEnd { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "range_end"
+        }
+        BranchEnd::MaxPoints => "max_points",
+        BranchEnd::StepFloor {
+            parameter,
+            reason,
+            non_smooth,
+            residuals,
+        } => {
+            d.set_item("parameter", parameter)?;
+            d.set_item("why", reason.to_string())?;
+            d.set_item("non_smooth", non_smooth.as_ref().map(|p| p.to_string()))?;
+            d.set_item("residuals", residuals.clone())?;
+            "step_floor"
+        }
+        BranchEnd::Grazing {
+            parameter,
+            contact,
+            gap,
+        } => {
+            d.set_item("parameter", parameter)?;
+            d.set_item("contact", contact + 1)?;
+            d.set_item("gap_m", gap)?;
+            "grazing"
+        }
+        BranchEnd::CascadeDepth { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "cascade_depth"
+        }
+        BranchEnd::SwitchFailed { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "switch_failed"
+        }
+        BranchEnd::Collapsed { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "collapsed"
+        }
+        _ => "other",
+    };
+    d.set_item("reason", reason)?;
+    Ok(d)
+}
+
+fn branch_to_py<'py>(py: Python<'py>, b: &Branch, n: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("period", b.period)?;
+    d.set_item("parent", b.parent)?;
+    d.set_item("points", points_to_py(py, &b.points, n)?)?;
+    let bifurcations = PyList::empty(py);
+    for bif in &b.bifurcations {
+        let e = PyDict::new(py);
+        kind_to_py(py, &bif.kind, &e)?;
+        e.set_item("parameter", bif.parameter)?;
+        e.set_item("precision", bif.precision)?;
+        e.set_item("x", array1(py, bif.point.state.positions.clone()))?;
+        e.set_item("v", array1(py, bif.point.state.velocities.clone()))?;
+        e.set_item("multipliers", complex_array(py, &bif.point.multipliers))?;
+        e.set_item("child", bif.child)?;
+        bifurcations.append(e)?;
+    }
+    d.set_item("bifurcations", bifurcations)?;
+    d.set_item("end", end_to_py(py, &b.end)?)?;
+    Ok(d)
+}
+
+/// Continues a periodic orbit in a configuration key (see the Python `vibrotribo.continue_`).
+#[pyfunction]
+#[pyo3(signature = (config, param, start, stop, *, period = None, transient = 100, guess = None, max_points = None, doubling_depth = None, initial_step = None, max_step = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn continue_<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    param: String,
+    start: f64,
+    stop: f64,
+    period: Option<u32>,
+    transient: u32,
+    guess: Option<(Vec<f64>, Vec<f64>)>,
+    max_points: Option<usize>,
+    doubling_depth: Option<u32>,
+    initial_step: Option<f64>,
+    max_step: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let base = config_of(config)?;
+    for v in [start, stop] {
+        base.with(&param, toml::Value::Float(v)).map_err(config_error)?;
+    }
+    let at_start = base
+        .with(&param, toml::Value::Float(start))
+        .map_err(config_error)?;
+    let d = ContinuationOptions::default();
+    let options = ContinuationOptions {
+        max_points: max_points.unwrap_or(d.max_points),
+        doubling_depth: doubling_depth.unwrap_or(d.doubling_depth),
+        initial_step: initial_step.unwrap_or(d.initial_step),
+        max_step: max_step.unwrap_or(d.max_step),
+        shooting: shooting(&base, None, None),
+        ..d
+    };
+    let n = base.chain().len();
+    // A value inside the range that makes an invalid chain gives a chain that fails its
+    // validation, so the corrector fails there and the branch ends.
+    let invalid = || ChainParams {
+        masses: vec![f64::NAN; n],
+        ..base.chain().clone()
+    };
+    let family = |v: f64| {
+        base.with(&param, toml::Value::Float(v))
+            .map_or_else(|_| invalid(), |c| c.chain().clone())
+    };
+    let chain = at_start.chain().clone();
+    let guess = match guess {
+        Some(g) => Some((
+            state_of(g, n)?,
+            period.ok_or_else(|| PyValueError::new_err("period: give it with a guess"))?,
+        )),
+        None => None,
+    };
+    let c = py
+        .detach(|| {
+            let (state, period) = match guess {
+                Some(g) => g,
+                None => {
+                    let o = periodic_orbit_from_transient(
+                        &chain,
+                        at_start.initial_state(),
+                        transient,
+                        period,
+                        &options.shooting,
+                    )?;
+                    (o.state, o.period)
+                }
+            };
+            continue_orbit(&param, family, start, stop, &state, period, &options)
+        })
+        .map_err(orbit_error)?;
+    let out = PyDict::new(py);
+    out.set_item("parameter", &c.parameter)?;
+    let branches = PyList::empty(py);
+    for b in &c.branches {
+        branches.append(branch_to_py(py, b, n)?)?;
+    }
+    out.set_item("branches", branches)?;
+    Ok(out)
+}

@@ -1,0 +1,76 @@
+//! `vibrotribo.simulate`: one run through the library's run layer
+//! ([`vibrotribo::study::simulate`]), its samples and events as numpy arrays and its summary
+//! as `summary.json` holds it ([`vibrotribo::report::run_summary`]).
+
+use std::time::Instant;
+
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use vibrotribo::electrical::LoadKind;
+use vibrotribo::report::{failure_text, run_summary};
+use vibrotribo::study::{Recording, simulate as run};
+
+use crate::config::config_of;
+use crate::convert::{array1, array2, json_to_py};
+use crate::interrupt::Signals;
+
+/// Runs the configuration (see the Python `vibrotribo.simulate`) and returns a dict of
+/// arrays, the events and the summary.
+#[pyfunction]
+#[pyo3(signature = (config, *, mechanics_only = false, samples = true))]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    mechanics_only: bool,
+    samples: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let config = config_of(config)?;
+    let mut spec = config.sampled_run_spec(mechanics_only);
+    spec.breakdown_check = true;
+    let (outcome, recording, elapsed, signals) = py.detach(|| {
+        let mut recording = Recording::new(samples);
+        let mut signals = Signals::new();
+        let started = Instant::now();
+        let outcome = run(&spec, &mut (&mut recording, &mut signals));
+        (outcome, recording, started.elapsed().as_secs_f64(), signals)
+    });
+    signals.result()?;
+    let outcome = outcome.map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let n = spec.chain.len();
+    let out = PyDict::new(py);
+    let s = recording.samples;
+    out.set_item("t", array1(py, s.time))?;
+    out.set_item("x", array2(py, s.positions, n)?)?;
+    out.set_item("v", array2(py, s.velocities, n)?)?;
+    out.set_item("y", array1(py, s.base))?;
+    out.set_item("d", array2(py, s.gaps, n - 1)?)?;
+    if let Some(h) = &spec.harvester {
+        out.set_item("q", array1(py, s.charge_c))?;
+        out.set_item("i", array1(py, s.current_a))?;
+        out.set_item("v_load", array1(py, s.voltage_v))?;
+        out.set_item("c", array1(py, s.capacitance_f))?;
+        out.set_item("voc", array1(py, s.voc_v))?;
+        if h.params.load.kind() == LoadKind::Rectifier {
+            out.set_item("vs", array1(py, s.storage_voltage_v))?;
+        }
+    }
+    let e = recording.events;
+    let events = PyDict::new(py);
+    events.set_item("t", array1(py, e.time))?;
+    events.set_item("kind", PyList::new(py, e.kind.iter().map(|k| k.as_str()))?)?;
+    let contact: Vec<i64> = e.contact.iter().map(|&k| k as i64 + 1).collect();
+    events.set_item("contact", PyArray1::from_vec(py, contact))?;
+    events.set_item("speed_before", array1(py, e.velocity_before))?;
+    events.set_item("speed_after", array1(py, e.velocity_after))?;
+    let seq: Vec<i64> = e.sequence_impacts.iter().map(|&s| i64::from(s)).collect();
+    events.set_item("sequence_impacts", PyArray1::from_vec(py, seq))?;
+    events.set_item("x", array2(py, e.positions, n)?)?;
+    events.set_item("v", array2(py, e.velocities, n)?)?;
+    out.set_item("events", events)?;
+    let summary = run_summary(&config, &spec, &outcome, elapsed);
+    out.set_item("summary", json_to_py(py, &summary)?)?;
+    out.set_item("error", failure_text(&outcome))?;
+    Ok(out)
+}

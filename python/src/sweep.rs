@@ -1,0 +1,226 @@
+//! `vibrotribo.sweep` and `vibrotribo.map`: points of a configuration with keys set, run by
+//! the library's sweep runners ([`vibrotribo::sweep`]) and collected in the columns of the
+//! command line's files ([`SweepColumns`]).
+
+use std::ops::ControlFlow;
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibrotribo::config::Config;
+use vibrotribo::study::PointOptions;
+use vibrotribo::sweep::{Continuation, Delivery, PointRunner, SweepColumns, run_continued, run_grid_on};
+
+use crate::config::{config_error, config_of, table_to_dict};
+use crate::convert::table_to_py;
+use crate::interrupt::Signals;
+
+/// Settings shared by sweeps and maps.
+pub struct PointSettings {
+    pub transient: Option<u64>,
+    pub recorded: Option<u64>,
+    pub mechanics_only: bool,
+    pub threads: Option<usize>,
+    pub period_tolerance: f64,
+}
+
+impl PointSettings {
+    /// The point runner on `base`, the options checked.
+    fn runner(&self, base: Config) -> PyResult<PointRunner> {
+        let options = PointOptions {
+            period_tolerance: self.period_tolerance,
+            ..PointOptions::from_run(base.run(), self.transient, self.recorded)
+        };
+        if options.recorded_periods == 0 {
+            return Err(PyValueError::new_err("recorded must be at least 1"));
+        }
+        if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
+            return Err(PyValueError::new_err(format!(
+                "period_tolerance must lie in (0, 1), got {}",
+                self.period_tolerance
+            )));
+        }
+        Ok(PointRunner::new(base, options, self.mechanics_only))
+    }
+
+    /// A thread pool of `threads` threads (all cores by default).
+    fn pool(&self) -> PyResult<rayon::ThreadPool> {
+        if self.threads == Some(0) {
+            return Err(PyValueError::new_err("threads must be at least 1"));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads.unwrap_or(0))
+            .build()
+            .map_err(|e| PyValueError::new_err(format!("cannot start the threads: {e}")))
+    }
+}
+
+/// Checks that every point's configuration is valid, naming the first bad one.
+fn check_points(runner: &PointRunner, points: &[Vec<(&str, f64)>]) -> PyResult<()> {
+    for keys in points {
+        runner.configure(keys).map_err(config_error)?;
+    }
+    Ok(())
+}
+
+/// The settings of a sweep or a map as a dict (what `sweep.json`/`map.json` record).
+fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'py, PyDict>> {
+    let o = runner.options();
+    let d = PyDict::new(py);
+    d.set_item("transient_periods", o.transient_periods)?;
+    d.set_item("recorded_periods", o.recorded_periods)?;
+    d.set_item("period_tolerance", o.period_tolerance)?;
+    d.set_item("max_period_detected", o.period_options().max_period)?;
+    d.set_item("grazing_ratio", o.grazing_ratio)?;
+    d.set_item("electrical_warmup_periods", o.electrical_warmup_periods)?;
+    d.set_item("mechanics_only", runner.mechanics_only())?;
+    d.set_item("settings", table_to_dict(py, runner.base().table())?)?;
+    Ok(d)
+}
+
+/// Runs `points` on the pool, collecting them into `table` in grid order; stops at a chunk's
+/// end if a signal handler raised.
+fn run_points(
+    pool: &rayon::ThreadPool,
+    runner: &PointRunner,
+    points: &[Vec<(&str, f64)>],
+    table: &mut SweepColumns,
+) -> PyResult<()> {
+    let mut signals = Signals::new();
+    let chunk = pool.current_num_threads() * 4;
+    run_grid_on(
+        pool,
+        runner,
+        points,
+        |keys| keys.clone(),
+        chunk,
+        |d| match d {
+            Delivery::Point(keys, r) => {
+                let values: Vec<f64> = keys.iter().map(|&(_, v)| v).collect();
+                table.push(&values, &r);
+                ControlFlow::Continue(())
+            }
+            Delivery::Chunk(_) => {
+                if signals.check() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            }
+        },
+    );
+    signals.result()
+}
+
+/// Runs a one-parameter sweep (see the Python `vibrotribo.sweep`).
+#[pyfunction]
+#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4))]
+#[allow(clippy::too_many_arguments)]
+pub fn sweep<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    param: String,
+    values: Vec<f64>,
+    continuation: String,
+    transient: Option<u64>,
+    recorded: Option<u64>,
+    mechanics_only: bool,
+    threads: Option<usize>,
+    period_tolerance: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let continuation: Continuation = continuation.parse().map_err(PyValueError::new_err)?;
+    let settings_of = PointSettings {
+        transient,
+        recorded,
+        mechanics_only,
+        threads,
+        period_tolerance,
+    };
+    let runner = settings_of.runner(config_of(config)?)?;
+    let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
+    check_points(&runner, &points)?;
+    let mut table = SweepColumns::new(&["param"], runner.masses(), true);
+    match continuation {
+        Continuation::None => {
+            let pool = settings_of.pool()?;
+            py.detach(|| run_points(&pool, &runner, &points, &mut table))?;
+        }
+        Continuation::Up | Continuation::Down => {
+            let mut order: Vec<usize> = (0..values.len()).collect();
+            if continuation == Continuation::Down {
+                order.reverse();
+            }
+            py.detach(|| {
+                let mut signals = Signals::new();
+                run_continued(&runner, &param, &values, &order, None, |j, r, _| {
+                    table.push(&[values[j]], &r);
+                    Ok(if signals.check() {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    })
+                })
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                signals.result()
+            })?;
+        }
+    }
+    let out = PyDict::new(py);
+    out.set_item("summary", table_to_py(py, &table.summary())?)?;
+    out.set_item("orbit", table_to_py(py, &table.orbit())?)?;
+    out.set_item("impacts", table_to_py(py, &table.impacts())?)?;
+    let s = settings(py, &runner)?;
+    s.set_item("command", "sweep")?;
+    s.set_item("param", param)?;
+    s.set_item("values", values)?;
+    s.set_item("continuation", continuation.as_str())?;
+    out.set_item("settings", s)?;
+    Ok(out)
+}
+
+/// Runs a two-parameter map (see the Python `vibrotribo.map`).
+#[pyfunction]
+#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4))]
+#[allow(clippy::too_many_arguments)]
+pub fn map<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    x: String,
+    x_values: Vec<f64>,
+    y: String,
+    y_values: Vec<f64>,
+    transient: Option<u64>,
+    recorded: Option<u64>,
+    mechanics_only: bool,
+    threads: Option<usize>,
+    period_tolerance: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let settings_of = PointSettings {
+        transient,
+        recorded,
+        mechanics_only,
+        threads,
+        period_tolerance,
+    };
+    let runner = settings_of.runner(config_of(config)?)?;
+    // Grid order as map.csv: y outer, x inner.
+    let (xk, yk) = (x.as_str(), y.as_str());
+    let points: Vec<Vec<(&str, f64)>> = y_values
+        .iter()
+        .flat_map(|&yv| x_values.iter().map(move |&xv| vec![(xk, xv), (yk, yv)]))
+        .collect();
+    check_points(&runner, &points)?;
+    let mut table = SweepColumns::new(&["x", "y"], runner.masses(), false);
+    let pool = settings_of.pool()?;
+    py.detach(|| run_points(&pool, &runner, &points, &mut table))?;
+    let out = PyDict::new(py);
+    out.set_item("summary", table_to_py(py, &table.summary())?)?;
+    let s = settings(py, &runner)?;
+    s.set_item("command", "map")?;
+    s.set_item("x", x)?;
+    s.set_item("x_values", x_values)?;
+    s.set_item("y", y)?;
+    s.set_item("y_values", y_values)?;
+    out.set_item("settings", s)?;
+    Ok(out)
+}

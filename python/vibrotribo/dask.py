@@ -1,0 +1,111 @@
+"""Sweeps spread over a Dask cluster: ``vibrotribo.dask.sweep(client, config, param,
+values, ...)`` splits the values into chunks, runs each chunk as one task calling the
+serial :func:`vibrotribo.sweep` on a worker, and joins the chunks in order, so that it
+returns exactly what the serial ``vibrotribo.sweep`` returns for the same arguments (every
+point of a sweep without continuation is independent of the others and of the thread
+count).
+
+Needs ``dask[distributed]`` (and, on Slurm, ``dask-jobqueue``); nothing from dask is
+imported until a sweep is submitted::
+
+    from dask.distributed import Client
+    from dask_jobqueue import SLURMCluster
+    import vibrotribo as vt, vibrotribo.dask
+
+    cluster = SLURMCluster(cores=4, memory="8GB", walltime="01:00:00")
+    cluster.scale(jobs=16)
+    client = Client(cluster)
+    result = vibrotribo.dask.sweep(client, "configs/chatter.toml", "omega_ratio",
+                                   vt.grid(0.3, 1.0, 20000), transient=300, recorded=100)
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Iterable, List, Optional
+
+import numpy as np
+
+from . import Config, Sweep, Table, _config, _values
+from . import sweep as _serial_sweep
+
+__all__ = ["sweep"]
+
+
+def _run_chunk(config: Config, param: str, values: List[float], kwargs: dict) -> Sweep:
+    """One task: the serial sweep of ``values``."""
+    return _serial_sweep(config, param, values, **kwargs)
+
+
+def sweep(
+    client: Any,
+    config: Any,
+    param: str,
+    values: Iterable[float],
+    *,
+    continuation: str = "none",
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    threads: Optional[int] = 1,
+    period_tolerance: float = 1e-4,
+    chunk_size: Optional[int] = None,
+) -> Sweep:
+    """:func:`vibrotribo.sweep` with its values spread over the workers of the Dask
+    ``client``: chunks of ``chunk_size`` values (default: about four chunks per worker
+    thread) each run as one task with ``threads`` threads (default 1: one value at a time per
+    Dask worker thread; the GIL is released while it computes). Returns exactly what the
+    serial sweep returns for the same arguments.
+
+    ``continuation`` must be ``"none"``: a continued sweep is one chain of values, each
+    starting from the previous one's final state, and cannot be split. Bad input (an unknown
+    key, a bad value) raises here, before anything is submitted.
+    """
+    if continuation != "none":
+        raise ValueError(
+            f"vibrotribo.dask.sweep: continuation={continuation!r} cannot be spread over a "
+            "cluster (each value starts from the previous one's final state, one chain); "
+            "use vibrotribo.sweep for continued sweeps, or continuation='none'"
+        )
+    cfg = _config(config)
+    vals = _values(values, "values")
+    kwargs = dict(
+        transient=transient,
+        recorded=recorded,
+        mechanics_only=mechanics_only,
+        threads=threads,
+        period_tolerance=period_tolerance,
+    )
+    if not vals:
+        return _serial_sweep(cfg, param, vals, **kwargs)
+    # Fail early and here, not on a worker, on a bad key or value (as the serial sweep does).
+    _check(cfg, param, vals)
+    if chunk_size is None:
+        workers = sum(client.nthreads().values()) or 1
+        chunk_size = max(1, math.ceil(len(vals) / (4 * workers)))
+    if chunk_size < 1:
+        raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
+    chunks = [vals[j : j + chunk_size] for j in range(0, len(vals), chunk_size)]
+    futures = client.map(
+        _run_chunk,
+        [cfg] * len(chunks),
+        [param] * len(chunks),
+        chunks,
+        [kwargs] * len(chunks),
+        pure=False,
+    )
+    parts: List[Sweep] = client.gather(futures)
+    settings = dict(parts[0].settings)
+    settings["values"] = vals
+    return Sweep(
+        summary=Table.concat([p.summary for p in parts]),
+        orbit=Table.concat([p.orbit for p in parts]),
+        impacts=Table.concat([p.impacts for p in parts]),
+        settings=settings,
+    )
+
+
+def _check(config: Config, param: str, values: List[float]) -> None:
+    """Raises the serial sweep's KeyError/ValueError for a bad key or value."""
+    for v in values:
+        config.replace(**{param: v})
