@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use super::chatter::figs_20_25;
 use super::configurations::figs_5_6;
 use super::context::{Budget, Ctx};
+use super::dynamics::dynamics;
 use super::extras::extras;
 use super::mass_ratio::{fig_13, fig_17, figs_14_16, figs_18_19};
 use super::orbits::periodic_orbits;
@@ -69,7 +70,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         failures: std::sync::Mutex::new(Vec::new()),
     };
     let started = Instant::now();
-    let steps: [(&str, Step); 10] = [
+    let steps: [(&str, Step); 11] = [
         ("Figs. 5–6: mass configurations", figs_5_6),
         ("Figs. 7–11: asymmetric spacing R_δ", figs_7_11),
         ("Fig. 12: symmetric spacing δ", fig_12),
@@ -79,6 +80,10 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         ("Figs. 18–19: Ω = 0.30", figs_18_19),
         ("Figs. 20–25: chatter", figs_20_25),
         ("periodic orbits behind Figs. 7, 9, 14–15, 18–19", periodic_orbits),
+        (
+            "what the non-periodic motions are: exponents, error bars, basins, expected power",
+            dynamics,
+        ),
         ("beyond the paper: loads and V_oc model", extras),
     ];
     for (what, step) in steps {

@@ -4,7 +4,7 @@
 //! the numbers of this run.
 //!
 //! One file per group of figures (`configurations`, `spacing`, `mass_ratio`, `chatter`,
-//! `orbits`, `extras`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
+//! `orbits`, `dynamics`, `extras`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
 //! `report` writes REPORT.md.
 
 mod chatter;
@@ -12,6 +12,7 @@ mod command;
 mod configurations;
 mod context;
 mod draw;
+mod dynamics;
 mod extras;
 mod mass_ratio;
 mod orbits;
