@@ -41,6 +41,7 @@
 
 pub mod breakdown;
 mod diode;
+mod energy;
 mod params;
 mod radau;
 mod solver;
@@ -52,6 +53,7 @@ mod transducer;
 mod waveform;
 
 pub use diode::{BridgeCurrents, Diode};
+pub use energy::{Electrostatics, NoFieldEnergy};
 pub use params::{
     BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, Load, LoadKind, Rectifier, TransducerMode, VocModel,
 };
