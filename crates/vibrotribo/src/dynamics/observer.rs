@@ -80,6 +80,9 @@ pub struct ClusterFlow {
     pub last: usize,
     /// Closed-form motion of the cluster's top mass.
     pub oscillator: Oscillator,
+    /// The rigid stop the cluster is stuck to, if any (its motion is then the stop's,
+    /// [`Oscillator::is_prescribed`]).
+    pub stop: Option<crate::model::StopSide>,
 }
 
 /// The exact motion of the whole chain on `[t_start, t_end]`, between two events.

@@ -153,6 +153,8 @@ impl Simulator {
             "must be finite and not negative",
         )?;
         let n = params.len();
+        // Contacts: N − 1 between masses, and the two stops' if the chain has any.
+        let nc = params.contact_count();
         let mut offsets = vec![0.0; n];
         for i in 1..n {
             offsets[i] = offsets[i - 1] + params.gaps[i - 1];
@@ -167,23 +169,23 @@ impl Simulator {
             events_in_period: 0,
             clusters: Vec::with_capacity(n),
             consts: Vec::with_capacity(n),
-            closure: vec![Closure::Open; n - 1],
+            closure: vec![Closure::Open; nc],
             x: initial.positions.clone(),
             v: initial.velocities.clone(),
-            last_speed: vec![f64::INFINITY; n - 1],
-            sequence: vec![0; n - 1],
+            last_speed: vec![f64::INFINITY; nc],
+            sequence: vec![0; nc],
             pos_tol: 0.0,
             vel_tol: 0.0,
             acc_tol: 0.0,
             term_scale: 0.0,
-            scratch_first_speed: vec![f64::NAN; n - 1],
-            scratch_lambda: vec![0.0; n - 1],
-            scratch_q: vec![0.0; n - 1],
-            scratch_active: vec![false; n - 1],
-            scratch_candidate: vec![false; n - 1],
+            scratch_first_speed: vec![f64::NAN; nc],
+            scratch_lambda: vec![0.0; nc],
+            scratch_q: vec![0.0; nc],
+            scratch_active: vec![false; nc],
+            scratch_candidate: vec![false; nc],
             scratch_events: Vec::new(),
-            scratch_resting: vec![false; n - 1],
-            search_from: vec![f64::NEG_INFINITY; n - 1],
+            scratch_resting: vec![false; nc],
+            search_from: vec![f64::NEG_INFINITY; nc],
         };
         sim.refresh_tolerances();
         // Start with closed contacts where the masses touch with equal velocity and press.
@@ -371,6 +373,18 @@ impl Simulator {
                 momentum += m * self.v[j];
                 moment += m * (self.x[j] - o);
             }
+            if let Some((osc, stop)) = self.anchored_flow(first, last) {
+                self.term_scale = self.term_scale.max(osc.magnitude());
+                self.clusters.push(ClusterFlow {
+                    first,
+                    last,
+                    oscillator: osc,
+                    stop: Some(stop),
+                });
+                self.consts.push(k);
+                first = i + 1;
+                continue;
+            }
             let s = moment / k.mass;
             let vs = momentum / k.mass;
             for j in first..=last {
@@ -398,6 +412,7 @@ impl Simulator {
                 first,
                 last,
                 oscillator: osc,
+                stop: None,
             });
             self.consts.push(k);
             first = i + 1;
@@ -417,6 +432,9 @@ impl Simulator {
         let mut horizon = stop;
         let w = self.forcing.omega;
         for k in 0..self.closure.len() {
+            if self.absent(k) {
+                continue;
+            }
             if let Closure::Chatter { t_acc, .. } = self.closure[k]
                 && t_acc < horizon
             {
@@ -486,8 +504,8 @@ impl Simulator {
         SimError::Stalled {
             t: stall.t,
             what: match self.closure[k] {
-                Closure::Open => format!("the gap of contact {}", k + 1),
-                _ => format!("the contact force of contact {}", k + 1),
+                Closure::Open => format!("the gap of {}", self.contact_name(k)),
+                _ => format!("the contact force of {}", self.contact_name(k)),
             },
         }
     }

@@ -121,6 +121,7 @@ mod field;
 mod flow_map;
 mod saltation;
 mod stm;
+mod stops;
 
 pub use error::{NonSmoothPoint, SensitivityError};
 pub(crate) use flow_map::EventRecorder;

@@ -69,7 +69,11 @@ impl Simulator {
     /// Current gap at contact k, m (negative: overlap).
     #[inline]
     pub(in crate::dynamics) fn gap(&self, k: usize) -> f64 {
-        self.params.gaps[k] - (self.x[k + 1] - self.x[k])
+        if k + 1 < self.x.len() {
+            self.params.gaps[k] - (self.x[k + 1] - self.x[k])
+        } else {
+            self.stop_gap(k)
+        }
     }
 
     /// Total mass and range of the cluster containing mass `i`, following the current
@@ -123,6 +127,10 @@ impl Simulator {
                     continue;
                 }
                 debug_assert!(gap > -1e6 * self.pos_tol, "overlap {gap:e} at contact {k}");
+                if self.project_stop(k, gap) {
+                    moved = true;
+                    continue;
+                }
                 let up = self.cluster_range(k);
                 let low = self.cluster_range(k + 1);
                 let (mu, ml) = (self.range_mass(up), self.range_mass(low));

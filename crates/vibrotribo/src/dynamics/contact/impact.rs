@@ -14,7 +14,6 @@ impl Simulator {
     /// part as the open touching contacts they are (Newton's cradle); they stay resting if
     /// nothing is struck, and are decided again by [`settle`](Self::settle) otherwise.
     pub(in crate::dynamics) fn resolve_impacts(&mut self, trigger: usize) -> Result<bool, SimError> {
-        let mu = self.params.restitution;
         let ncont = self.closure.len();
         for (closure, resting) in self.closure.iter_mut().zip(self.scratch_resting.iter_mut()) {
             *resting = *closure == Closure::Resting;
@@ -34,7 +33,7 @@ impl Simulator {
                 if gap > self.pos_tol && k != trigger {
                     continue;
                 }
-                let vc = self.v[k + 1] - self.v[k];
+                let vc = self.closing_speed(k);
                 if vc > self.vel_tol {
                     if self.scratch_first_speed[k].is_nan() {
                         self.scratch_first_speed[k] = vc;
@@ -51,6 +50,10 @@ impl Simulator {
                     t: self.t,
                     iterations,
                 });
+            }
+            let mu = self.params.contact_restitution(k);
+            if self.stop_impulse(k, vc, mu) {
+                continue;
             }
             let up = self.cluster_range(k);
             let low = self.cluster_range(k + 1);
@@ -81,7 +84,7 @@ impl Simulator {
             if before.is_nan() {
                 continue;
             }
-            let after = -(self.v[k + 1] - self.v[k]);
+            let after = -self.closing_speed(k);
             if before > 0.0 {
                 if before < self.last_speed[k] {
                     self.sequence[k] += 1;
@@ -92,8 +95,8 @@ impl Simulator {
             }
             self.push_event(EventKind::Impact, k, before, after, 0);
         }
-        if mu < 1.0 {
-            for k in 0..ncont {
+        for k in 0..ncont {
+            if self.params.contact_restitution(k) < 1.0 {
                 let before = self.scratch_first_speed[k];
                 if before > 0.0 && !self.closure[k].is_closed() {
                     self.try_chatter_jump(k);
@@ -128,15 +131,18 @@ impl Simulator {
     /// constant-acceleration limit is accurate to the tolerance, merge the two sides and
     /// schedule the accumulation point.
     fn try_chatter_jump(&mut self, k: usize) {
-        let mu = self.params.restitution;
-        let u = -(self.v[k + 1] - self.v[k]);
+        let mu = self.params.contact_restitution(k);
+        let u = -self.closing_speed(k);
         if u <= self.vel_tol {
             return; // zero rebound: settle() decides.
         }
-        let up = self.cluster_range(k);
-        let low = self.cluster_range(k + 1);
-        let (au, ju) = self.cluster_accel(up);
-        let (al, jl) = self.cluster_accel(low);
+        let (up, low) = self.side_ranges(k);
+        let (au, ju) = self
+            .prescribed_side_accel(k, true)
+            .unwrap_or_else(|| self.cluster_accel(up.expect("a free cluster above")));
+        let (al, jl) = self
+            .prescribed_side_accel(k, false)
+            .unwrap_or_else(|| self.cluster_accel(low.expect("a free cluster below")));
         // d'' = a_U − a_L; closing acceleration a = −d''.
         let a = al - au;
         let jerk = (ju - jl).abs();
@@ -159,8 +165,13 @@ impl Simulator {
                 t_acc: self.t + remaining,
                 impacts: self.sequence[k],
             };
-            // Merge now (momentum-conserving) so that later checks see the new cluster.
-            self.merge_range(self.cluster_range(k));
+            // Merge now (momentum-conserving; into a stop: at its velocity) so that later
+            // checks see the new cluster.
+            if self.stop_at(k).is_some() || self.range_anchor(self.cluster_range(k)).is_some() {
+                self.merge_into_stop(k);
+            } else {
+                self.merge_range(self.cluster_range(k));
+            }
         }
     }
 }

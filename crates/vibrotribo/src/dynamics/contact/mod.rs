@@ -35,11 +35,13 @@
 //!
 //! The rooms: [`closure`] (the state of each contact, the clusters it makes, tolerances and
 //! overlap removal), [`impact`] (Newton impacts and chatter jumps), [`sticking`] (the contact
-//! LCP: stick, release, rest) and [`surfaces`] (the event functions the simulator searches).
+//! LCP: stick, release, rest), [`stops`] (rigid stops: contacts with a body of infinite mass
+//! and prescribed motion) and [`surfaces`] (the event functions the simulator searches).
 
 mod closure;
 mod impact;
 mod sticking;
+mod stops;
 mod surfaces;
 
 pub(super) use closure::Closure;

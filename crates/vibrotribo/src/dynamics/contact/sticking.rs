@@ -17,8 +17,7 @@ impl Simulator {
     /// changed nothing, see `handle`) decides sticking and release as always, but starts no
     /// resting contact and adjusts no velocity.
     pub(in crate::dynamics) fn settle(&mut self, exclude: Option<usize>, quiet: bool) -> Vec<usize> {
-        let n = self.x.len();
-        let ncont = n - 1;
+        let ncont = self.closure.len();
         let (y, yd) = self.forcing.base(self.forcing.phase(self.t));
         let mut any = false;
         for k in 0..ncont {
@@ -31,7 +30,7 @@ impl Simulator {
                 // the event time's rounding times the closing speed, which can exceed the
                 // rounding of the positions.
                 let touching = self.gap(k) <= self.pos_tol || !self.scratch_first_speed[k].is_nan();
-                touching && (self.v[k + 1] - self.v[k]).abs() <= self.vel_tol
+                touching && self.closing_speed(k).abs() <= self.vel_tol
             };
             self.scratch_candidate[k] = cand;
             any |= cand;
@@ -44,7 +43,12 @@ impl Simulator {
         let free =
             |i: usize| (-p.damping[i] * (self.v[i] - yd) - p.stiffness[i] * (self.x[i] - y)) / p.masses[i];
         for k in 0..ncont {
-            self.scratch_q[k] = free(k) - free(k + 1);
+            let q = if self.stop_at(k).is_some() {
+                self.stop_free_gap_accel(k, free)
+            } else {
+                free(k) - free(k + 1)
+            };
+            self.scratch_q[k] = q;
             self.scratch_lambda[k] = 0.0;
             self.scratch_active[k] = false;
         }
@@ -68,6 +72,7 @@ impl Simulator {
             let after = if self.scratch_active[k] {
                 if before.presses() { before } else { Closure::Stuck }
             } else if self.scratch_candidate[k]
+                && self.may_rest(k)
                 && (!quiet || before == Closure::Resting)
                 && self.gap_accel(k) <= self.acc_tol
             {
@@ -88,6 +93,9 @@ impl Simulator {
         }
         if !quiet {
             self.equalize_touching();
+            if !self.params.stops.is_empty() {
+                self.equalize_stops();
+            }
         }
         logged
     }
@@ -99,7 +107,8 @@ impl Simulator {
     /// equalizing one contact after another, or merging a closed cluster in it later, would
     /// leave a rounding-level relative velocity across the open contact again.
     fn equalize_touching(&mut self) {
-        let ncont = self.closure.len();
+        // The contacts between masses (the stops' are seen to by `equalize_stops`).
+        let ncont = self.x.len() - 1;
         let mut first = 0;
         let mut open = false;
         for k in 0..=ncont {
@@ -121,6 +130,9 @@ impl Simulator {
 
     /// w_k = q_k + (Wλ)_k for the chain's tridiagonal Delassus matrix W.
     fn gap_accel(&self, k: usize) -> f64 {
+        if !self.params.stops.is_empty() {
+            return self.gap_accel_with_stops(k);
+        }
         let m = &self.params.masses;
         let lam = &self.scratch_lambda;
         let mut w = self.scratch_q[k] + lam[k] * (1.0 / m[k] + 1.0 / m[k + 1]);
@@ -135,6 +147,9 @@ impl Simulator {
 
     /// Solves `W_AA λ_A = −q_A` on each run of consecutive active contacts (Thomas algorithm).
     fn solve_active_forces(&mut self) {
+        if !self.params.stops.is_empty() {
+            return self.solve_active_forces_with_stops();
+        }
         let m = &self.params.masses;
         let ncont = self.scratch_q.len();
         let mut k = 0;

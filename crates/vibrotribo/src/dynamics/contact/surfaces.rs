@@ -13,6 +13,9 @@ const REST_BAND: f64 = 4.0;
 impl Simulator {
     /// Gap of open contact k as a [`Signal`]: d_k = δ_k + o_k^U + s_U − s_L.
     pub(in crate::dynamics) fn gap_signal(&self, k: usize) -> Signal {
+        if self.stop_at(k).is_some() {
+            return self.stop_gap_signal(k);
+        }
         let u = self.cluster_of(k);
         let l = u + 1;
         debug_assert_eq!(self.clusters[l].first, k + 1);
@@ -29,6 +32,9 @@ impl Simulator {
     /// `N_j = Σ_{i∈G, i≤j} m_i (a_G − a_i)`, written as
     /// `e₀ + e₁ (s − y) + e₂ (s' − y')` for the cluster coordinate s.
     pub(in crate::dynamics) fn force_signal(&self, j: usize) -> Signal {
+        if let Some(sig) = self.anchored_force_signal(j) {
+            return sig;
+        }
         let g = self.cluster_of(j);
         let c = &self.clusters[g];
         let kc = &self.consts[g];
