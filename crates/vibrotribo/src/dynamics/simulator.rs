@@ -144,7 +144,7 @@ impl Simulator {
         options: SimOptions,
     ) -> Result<Self, SimError> {
         params.validate()?;
-        params.validate_state(initial)?;
+        params.validate_state_at(initial, t0)?;
         options.validate()?;
         crate::error::check(
             "start time",

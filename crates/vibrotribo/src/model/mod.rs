@@ -221,8 +221,15 @@ impl ChainParams {
         }
     }
 
-    /// Checks an initial state against the chain: lengths, finiteness, no interpenetration.
+    /// Checks an initial state against the chain: lengths, finiteness, no interpenetration
+    /// (and no mass beyond a stop, with the base at its position of time 0).
     pub fn validate_state(&self, state: &ChainState) -> Result<(), ParamError> {
+        self.validate_state_at(state, 0.0)
+    }
+
+    /// [`validate_state`](Self::validate_state) for a state at time `t`, s (where a stop
+    /// that moves with the base stands).
+    pub fn validate_state_at(&self, state: &ChainState, t: f64) -> Result<(), ParamError> {
         let n = self.len();
         check_len("positions", &state.positions, n)?;
         check_len("velocities", &state.velocities, n)?;
@@ -243,7 +250,7 @@ impl ChainParams {
         if self.stops.is_empty() {
             Ok(())
         } else {
-            self.validate_state_stops(&state.positions, 0.0)
+            self.validate_state_stops(&state.positions, t)
         }
     }
 }
