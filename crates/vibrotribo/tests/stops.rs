@@ -55,6 +55,10 @@ fn single(omega_ratio: f64, gap: f64) -> ChainParams {
 }
 
 fn textbook(omega_ratio: f64, gap: f64) -> ImpactOscillator {
+    textbook_in(omega_ratio, gap, false)
+}
+
+fn textbook_in(omega_ratio: f64, gap: f64, moving: bool) -> ImpactOscillator {
     ImpactOscillator {
         m: M,
         k: K,
@@ -63,6 +67,7 @@ fn textbook(omega_ratio: f64, gap: f64) -> ImpactOscillator {
         omega: omega_ratio * wn(),
         gap,
         r: R,
+        moving,
     }
 }
 
@@ -82,9 +87,12 @@ fn section_state(io: &ImpactOscillator, o: &OneOne) -> ChainState {
     let (h0, h1) = (io.gap - p, -io.r * o.speed - pd);
     let f = io.propagator(io.period() - o.t0);
     let (xp, vp) = io.xp(io.period());
+    // With a moving stop the closed form is relative to the base, which is at y = 0,
+    // y' = Aω at the section.
+    let base_speed = if io.moving { io.amplitude * io.omega } else { 0.0 };
     ChainState {
         positions: vec![xp + f[0][0] * h0 + f[0][1] * h1],
-        velocities: vec![vp + f[1][0] * h0 + f[1][1] * h1],
+        velocities: vec![vp + f[1][0] * h0 + f[1][1] * h1 + base_speed],
     }
 }
 
@@ -163,6 +171,62 @@ fn shooting_reproduces_the_closed_form_one_one_orbits() {
         );
         assert_eq!(orbit.stable, stable, "Ω = {omega}");
     }
+}
+
+/// The same with the stop moving with the base (relative coordinates): impact phase, speed
+/// and multipliers of the (1,1) orbit.
+#[test]
+fn shooting_reproduces_the_one_one_orbits_against_a_moving_stop() {
+    let mut found = 0;
+    for omega in [0.8, 1.6, 2.5, 2.8] {
+        let io = textbook_in(omega, 0.002, true);
+        let Some(o) = (0..64).find_map(|j| io.one_one((io.period() * f64::from(j) / 64.0, 0.2))) else {
+            continue;
+        };
+        if !admissible(&io, &o) {
+            continue;
+        }
+        found += 1;
+        let mut params = single(omega, 0.002);
+        params.stops.upper.as_mut().unwrap().frame = StopFrame::Base;
+        let mut guess = section_state(&io, &o);
+        guess.velocities[0] *= 1.01;
+        let orbit = find_periodic_orbit(&params, &guess, 1, &ShootingOptions::default()).unwrap();
+        let impacts: Vec<_> = orbit
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::Impact)
+            .collect();
+        assert_eq!(impacts.len(), 1, "Ω = {omega}: {:?}", orbit.events);
+        let t = impacts[0].time.rem_euclid(io.period());
+        let speed = impacts[0].velocity_before;
+        let got = sorted(orbit.multipliers.iter().map(|c| (c.re, c.im)).collect());
+        let want = sorted(o.multipliers.to_vec());
+        println!(
+            "moving stop, Ω = {omega}: phase {:.12} ({:.12}), speed {speed:.12} ({:.12}), multipliers \
+             {got:?} ({want:?})",
+            t / io.period(),
+            o.t0 / io.period(),
+            o.speed
+        );
+        assert!(
+            (t - o.t0).abs() < 1e-10 * io.period(),
+            "Ω = {omega}: impact time {t} vs {}",
+            o.t0
+        );
+        assert!(
+            (speed - o.speed).abs() < 1e-9 * o.speed,
+            "Ω = {omega}: speed {speed} vs {}",
+            o.speed
+        );
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g.0 - w.0).abs() < 1e-8 && (g.1.abs() - w.1.abs()).abs() < 1e-8,
+                "Ω = {omega}: multipliers {got:?} vs {want:?}"
+            );
+        }
+    }
+    assert!(found >= 2, "only {found} admissible textbook orbits");
 }
 
 /// The closed-form period-doubling point: where a multiplier of the (1,1) orbit is −1

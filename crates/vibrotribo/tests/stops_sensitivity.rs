@@ -92,7 +92,11 @@ fn random_chain_with_stops(rng: &mut Lcg, s: usize) -> (ChainParams, ChainState)
     params.excitation.amplitude = rng.range(0.005, 0.03);
     let stop = |rng: &mut Lcg| Stop {
         gap: rng.range(0.0, 0.01),
-        restitution: if s.is_multiple_of(5) { 0.0 } else { rng.range(0.3, 0.9) },
+        restitution: if s.is_multiple_of(5) {
+            0.0
+        } else {
+            rng.range(0.3, 0.9)
+        },
         frame: if rng.next() < 0.5 {
             StopFrame::Fixed
         } else {

@@ -12,6 +12,9 @@
 //! over one period and S the saltation matrix of the impact,
 //! `S = [[−r, 0], [(a⁺ + r a⁻)/v, −r]]`, a∓ the accelerations just before and after; so
 //! `det = r² e^{−2ζω_nT}`.
+//!
+//! With the stop moving with the base (`moving`), the same holds for the relative coordinate
+//! `z = x − y`: `m z'' + c z' + k z = m ω² A sin ωt` below `z = g`, `z'⁺ = −r z'⁻`.
 
 #![allow(dead_code)]
 
@@ -25,6 +28,8 @@ pub struct ImpactOscillator {
     pub omega: f64,
     pub gap: f64,
     pub r: f64,
+    /// The stop moves with the base (the coordinate is then z = x − y).
+    pub moving: bool,
 }
 
 /// A (1,1) orbit: impact time in [0, T), s, impact speed, m/s, and multipliers (re, im).
@@ -44,6 +49,11 @@ impl ImpactOscillator {
         let (m, k, c, a, w) = (self.m, self.k, self.c, self.amplitude, self.omega);
         let d = k - m * w * w;
         let det = d * d + c * w * c * w;
+        if self.moving {
+            // [d, cw; −cw, d][P; Q] = [0; mω²A].
+            let f = m * w * w * a;
+            return (-c * w * f / det, d * f / det);
+        }
         // Cramer on [d, cw; −cw, d][P; Q] = [caw; ka].
         let p = (c * a * w * d - c * w * k * a) / det;
         let q = (d * k * a + c * w * c * a * w) / det;
@@ -116,7 +126,13 @@ impl ImpactOscillator {
             self.amplitude * (self.omega * t0).sin(),
             self.amplitude * self.omega * (self.omega * t0).cos(),
         );
-        let accel = |vel: f64| (-self.c * (vel - yd) - self.k * (self.gap - y)) / self.m;
+        let accel = |vel: f64| {
+            if self.moving {
+                (-self.c * vel - self.k * self.gap + self.m * self.omega * self.omega * y) / self.m
+            } else {
+                (-self.c * (vel - yd) - self.k * (self.gap - y)) / self.m
+            }
+        };
         let (am, ap) = (accel(v), accel(-self.r * v));
         let s = [[-self.r, 0.0], [(ap + self.r * am) / v, -self.r]];
         let f = self.propagator(self.period());
