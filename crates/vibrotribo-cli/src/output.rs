@@ -221,7 +221,7 @@ pub fn si(value: f64, unit: &str) -> String {
 /// `impacts_per_period_1..contacts`, `error`, and with `floquet` `max_abs_multiplier`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointColumns {
-    /// Contacts of the chain (N − 1).
+    /// Contacts of the chain (N − 1, or N + 1 with stops).
     pub contacts: usize,
     /// Whether the largest Floquet multiplier modulus is a column (`--floquet`).
     pub floquet: bool,

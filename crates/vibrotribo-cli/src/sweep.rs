@@ -226,11 +226,11 @@ pub fn set_threads(threads: Option<usize>) -> Result<()> {
 
 /// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
 /// one row per value) and the manifest `sweep.json`.
-fn sweep_layout(masses: usize, floquet: bool) -> Layout {
+fn sweep_layout(masses: usize, contacts: usize, floquet: bool) -> Layout {
     let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
     orbit_cols.extend(numbered("x", masses, "_m"));
     let mut summary_cols = vec!["param".to_string()];
-    summary_cols.extend(point_columns(masses, floquet).names());
+    summary_cols.extend(point_columns(contacts, floquet).names());
     Layout {
         manifest: "sweep.json",
         files: vec![
@@ -263,7 +263,8 @@ fn write_value(
 ) -> Result<()> {
     let p = value.to_string();
     if let Ok(r) = result {
-        let n = columns.contacts + 1;
+        // Masses per stroboscopic sample.
+        let n = r.strobe.len() / r.strobe_periods.len().max(1);
         for (j, &period) in r.strobe_periods.iter().enumerate() {
             let mut row = vec![p.clone(), period.to_string()];
             row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
@@ -286,12 +287,10 @@ fn write_value(
     out.row(2, row)
 }
 
-/// The point columns of a chain of `masses` masses.
-pub fn point_columns(masses: usize, floquet: bool) -> PointColumns {
-    PointColumns {
-        contacts: masses - 1,
-        floquet,
-    }
+/// The point columns of a chain with `contacts` contacts
+/// ([`ChainParams::contact_count`](vibrotribo::ChainParams::contact_count)).
+pub fn point_columns(contacts: usize, floquet: bool) -> PointColumns {
+    PointColumns { contacts, floquet }
 }
 
 /// The settings a sweep records in `sweep.json` (everything that determines its output).
@@ -424,7 +423,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             };
             let (o, done) = GridOutput::resume(
                 dir,
-                sweep_layout(masses, runner.options().floquet),
+                sweep_layout(masses, runner.contacts(), runner.options().floquet),
                 settings,
                 &keys,
                 keep,
@@ -444,7 +443,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         Some(dir) => (
             Some(GridOutput::create(
                 dir,
-                sweep_layout(masses, runner.options().floquet),
+                sweep_layout(masses, runner.contacts(), runner.options().floquet),
                 settings,
             )?),
             0,
@@ -452,7 +451,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     };
     let started = Instant::now();
     let mut failed = 0usize;
-    let columns = point_columns(masses, runner.options().floquet);
+    let columns = point_columns(runner.contacts(), runner.options().floquet);
     let key = args.param.as_str();
     let todo = &order[skip..];
     let computed = match args.continuation {
@@ -579,10 +578,12 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
         // orbit.csv: param, period, x1_m, …, xN_m.
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
         let floquet = floquet_of(first, "sweep.json")?;
+        // summary.csv: param and the point columns (7 + contacts, and the Floquet column).
+        let contacts = header_len(&first.join("summary.csv"))?.saturating_sub(1 + 7 + usize::from(floquet));
         crate::job::merge(
             &args.shards,
             &args.out,
-            &sweep_layout(masses, floquet),
+            &sweep_layout(masses, contacts, floquet),
             sweep_keys,
         )?;
     }

@@ -162,6 +162,16 @@ impl ChainParams {
         k + 1
     }
 
+    /// A short name of contact `k` for messages, with 1-based masses: `m1–m2`,
+    /// `m1–upper stop`, `m3–lower stop`.
+    pub fn contact_name(&self, k: usize) -> String {
+        match self.contact(k) {
+            Contact::Masses(j) => format!("m{}–m{}", j + 1, j + 2),
+            Contact::Stop(StopSide::Upper) => "m1–upper stop".to_string(),
+            Contact::Stop(StopSide::Lower) => format!("m{}–lower stop", self.len()),
+        }
+    }
+
     /// Whether contact `k` is a stop that exists.
     pub fn is_stop(&self, k: usize) -> bool {
         match self.contact(k) {
