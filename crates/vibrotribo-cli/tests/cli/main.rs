@@ -4,6 +4,7 @@
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_simulate_output_edges;
 mod periodic_orbits;
+mod stops;
 mod util;
 
 use std::path::Path;

@@ -11,6 +11,9 @@
 //!
 //! Gap `k` (between mass `k` and `k+1`, seed eq. 2): `d_k = δ_k − (x_{k+1} − x_k) ≥ 0`.
 //!
+//! Optional rigid stops above the top mass and below the bottom one ([`Stops`], in
+//! `stops.rs`: geometry and contact numbering) make a chain of a single mass possible.
+//!
 //! Physical inputs live in [`ChainParams`]; numerical settings in
 //! [`SimOptions`]. Validate once with [`ChainParams::validate`].
 
