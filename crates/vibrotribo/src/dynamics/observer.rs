@@ -48,7 +48,8 @@ pub struct Event {
     /// What happened.
     pub kind: EventKind,
     /// Contact index k, 0-based: contact k is the gap between mass k and mass k+1 (so the
-    /// paper's contact "m1–m2" is 0 here and 1 in files).
+    /// paper's contact "m1–m2" is 0 here and 1 in files); with rigid stops, N − 1 is the lower
+    /// stop and N the upper one ([`ChainParams::contact`](crate::ChainParams::contact)).
     pub contact: usize,
     /// For an impact, the closing speed just before it (≥ 0), m/s; 0 otherwise.
     pub velocity_before: f64,

@@ -226,7 +226,8 @@ impl Simulator {
         }
     }
 
-    /// Status of each contact (index k: between mass k and k+1, 0-based).
+    /// Status of each contact (index k: between mass k and k+1, 0-based; with stops, N − 1 is
+    /// the lower stop and N the upper one, see [`ChainParams::contact_count`]).
     pub fn contact_status(&self) -> Vec<ContactStatus> {
         self.closure
             .iter()

@@ -70,7 +70,7 @@ pub enum StopFrame {
     Base,
 }
 
-/// A rigid stop of infinite mass (see the [module docs](self) for its geometry).
+/// A rigid stop of infinite mass (see [`Stops`] for its geometry).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
@@ -87,6 +87,41 @@ pub struct Stop {
 }
 
 /// The stops of a chain: none by default.
+///
+/// Rigid stops: obstacles of infinite mass above the top mass or below the bottom mass of the
+/// chain, fixed in space or moving with the base, each with its own gap and restitution.
+///
+/// # Geometry
+///
+/// A stop's `gap` is its distance from the adjacent mass's static position (x = 0) with the
+/// base at rest (y = 0). With `Y(t) = 0` for a stop fixed in space and `Y(t) = y(t) = A sin ωt`
+/// for one moving with the base, the upper stop stands at `x₁ = gap + Y(t)` and the lower one
+/// at `x_N = −gap + Y(t)`, and their gap functions are
+///
+/// ```text
+/// d_upper = gap − (x₁ − Y(t)) ≥ 0,        d_lower = gap − (Y(t) − x_N) ≥ 0,
+/// ```
+///
+/// the same form as the gap between two masses, `d_k = δ_k − (x_{k+1} − x_k)`, with the stop
+/// as a body of infinite mass at position `Y(t)`. A single mass with a stop is the
+/// harmonically forced impact oscillator of the textbooks (Shaw & Holmes 1983; di Bernardo et
+/// al. 2008, ch. 1 and 6): with the stop fixed in space the mass obeys
+/// `m x'' + c x' + k x = c y' + k y` below `x = gap`; with the stop moving with the base, in
+/// the relative coordinate `z = x − y`, `m z'' + c z' + k z = −m y''` below `z = gap`.
+///
+/// # Contacts
+///
+/// Contact k (0-based) is the gap below mass k: contacts `0 … N−2` lie between neighbouring
+/// masses. A chain with a stop has two more: contact `N − 1` is the lower stop (the gap below
+/// the bottom mass, mass N − 1) and contact `N` the upper stop (above mass 0). A chain with
+/// only one stop still numbers both ([`ChainParams::contact_count`] is N + 1); the absent one
+/// never sees an event. In files and messages contacts are 1-based, `k + 1`
+/// ([`ChainParams::contact_label`]): the masses' contacts `1 … N−1` as without stops (so no
+/// existing column or number changes), the lower stop `N`, the upper stop `N + 1`.
+///
+/// In the chain's spatial order the contacts read upper stop, 0, 1, …, N − 2, lower stop;
+/// a stop is a neighbour of infinite mass, so it adds nothing to the Delassus matrix of the
+/// sticking problem on its own side.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
@@ -114,7 +149,7 @@ impl Stops {
     }
 }
 
-/// What a contact index of a chain designates (see the [module docs](self)).
+/// What a contact index of a chain designates (see [`Stops`] for the numbering).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Contact {
     /// The gap between mass `k` and mass `k + 1` (0-based).
