@@ -9,7 +9,7 @@ mod impact_oscillator;
 
 use impact_oscillator::{ImpactOscillator, OneOne};
 use vibrotribo::orbits::{
-    BifurcationKind, ContinuationOptions, ShootingOptions, continue_orbit, find_periodic_orbit,
+    BifurcationKind, BranchEnd, ContinuationOptions, ShootingOptions, continue_orbit, find_periodic_orbit,
 };
 use vibrotribo::{
     ChainParams, ChainState, ContactStatus, EventKind, EventLog, Excitation, Frequency, SimOptions,
@@ -452,5 +452,76 @@ fn chatter_against_a_stop_never_penetrates() {
         );
         let gap = -e.positions[0];
         assert!(gap > -1e-12, "beyond the stop by {gap:e} at {}", e.event.time);
+    }
+}
+
+/// Continuation of the orbit that never reaches the stop, towards lower Ω, meets the stop where
+/// the steady amplitude `A √(k² + c²ω²) / √((k − mω²)² + c²ω²)` equals the gap: a grazing of
+/// the stop's contact, located where the closed form puts it.
+#[test]
+fn continuation_meets_the_stop_at_the_closed_form_grazing() {
+    let gap = 0.002;
+    let steady = |w: f64| {
+        let (c, om) = (damping(), w * wn());
+        A * (K * K + c * c * om * om).sqrt() / ((K - M * om * om).powi(2) + c * c * om * om).sqrt()
+    };
+    let (mut lo, mut hi) = (2.3, 3.0);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if steady(mid) > gap { lo = mid } else { hi = mid }
+    }
+    let grazing = 0.5 * (lo + hi);
+    let io = textbook(3.0, gap);
+    let (x, v) = io.xp(0.0);
+    let start = ChainState {
+        positions: vec![x],
+        velocities: vec![v],
+    };
+    let options = ContinuationOptions {
+        doubling_depth: 0,
+        ..ContinuationOptions::default()
+    };
+    let result = continue_orbit("omega_ratio", |w| single(w, gap), 3.0, 2.3, &start, 1, &options).unwrap();
+    let main = &result.branches[0];
+    let located: Vec<f64> = main
+        .bifurcations
+        .iter()
+        .filter(|b| matches!(b.kind, BifurcationKind::Grazing { contact: 1, .. }))
+        .map(|b| b.parameter)
+        .chain(match main.end {
+            BranchEnd::Grazing {
+                parameter,
+                contact: 1,
+                ..
+            } => Some(parameter),
+            _ => None,
+        })
+        .collect();
+    println!(
+        "closed-form grazing at Ω = {grazing:.12}; continuation: {located:?}, bifurcations {:?}, end {:?}",
+        main.bifurcations
+            .iter()
+            .map(|b| (b.kind, b.parameter))
+            .collect::<Vec<_>>(),
+        main.end
+    );
+    assert!(!located.is_empty(), "no grazing of the stop found");
+    assert!(
+        (located[0] - grazing).abs() < 1e-6,
+        "grazing at {} vs {grazing}",
+        located[0]
+    );
+    // A branch that ends at the grazing stops just short of it: its last gap minimum is the
+    // closed-form distance of the steady motion from the stop there.
+    if let BranchEnd::Grazing {
+        parameter, gap: left, ..
+    } = main.end
+    {
+        let want = gap - steady(parameter);
+        println!("gap minimum at the end {left:e} m, closed form {want:e} m");
+        assert!(
+            (left - want).abs() < 1e-12,
+            "gap minimum {left:e} vs closed form {want:e}"
+        );
     }
 }
