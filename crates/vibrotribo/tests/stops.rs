@@ -525,3 +525,70 @@ fn continuation_meets_the_stop_at_the_closed_form_grazing() {
         );
     }
 }
+
+/// Two masses between two fixed stops, all impacts elastic (r = μ = 1), no damping and no
+/// forcing: ½Σm v² + ½Σk x² is conserved through hundreds of impacts between the masses and
+/// against both stops, and no mass ever passes a stop or its neighbour.
+#[test]
+fn elastic_chain_between_two_stops_conserves_energy() {
+    let stop = |gap| {
+        Some(Stop {
+            gap,
+            restitution: 1.0,
+            frame: StopFrame::Fixed,
+        })
+    };
+    let params = ChainParams {
+        masses: vec![0.05, 0.08],
+        stiffness: vec![120.0, 90.0],
+        damping: vec![0.0, 0.0],
+        gaps: vec![0.004],
+        restitution: 1.0,
+        excitation: Excitation {
+            amplitude: 0.0,
+            frequency: Frequency::OmegaRatio(0.7),
+        },
+        stops: Stops {
+            upper: stop(0.003),
+            lower: stop(0.005),
+        },
+    };
+    let state = ChainState {
+        positions: vec![0.0, 0.0],
+        velocities: vec![0.4, -0.3],
+    };
+    let energy = |x: &[f64], v: &[f64]| {
+        (0..2)
+            .map(|i| 0.5 * params.masses[i] * v[i] * v[i] + 0.5 * params.stiffness[i] * x[i] * x[i])
+            .sum::<f64>()
+    };
+    let e0 = energy(&state.positions, &state.velocities);
+    let mut sim = Simulator::new(&params, &state, SimOptions::default()).unwrap();
+    let mut log = EventLog::default();
+    sim.run_until(3.0, &mut log).unwrap();
+    let at = |k: usize| log.events.iter().filter(|e| e.event.contact == k).count();
+    println!(
+        "impacts: masses {}, lower stop {}, upper stop {}",
+        at(0),
+        at(1),
+        at(2)
+    );
+    assert!(
+        at(0) > 20 && at(1) > 20 && at(2) > 20,
+        "{} {} {}",
+        at(0),
+        at(1),
+        at(2)
+    );
+    for e in &log.events {
+        assert_eq!(e.event.kind, EventKind::Impact);
+        let (x, v) = (&e.positions, &e.velocities);
+        assert!(
+            (energy(x, v) - e0).abs() < 1e-12 * e0,
+            "energy {} vs {e0}",
+            energy(x, v)
+        );
+        let tol = 1e-15;
+        assert!(x[0] <= 0.003 + tol && x[1] >= -0.005 - tol && x[1] - x[0] <= 0.004 + tol);
+    }
+}
