@@ -139,7 +139,7 @@ pub fn sweep<'py>(
     let runner = settings_of.runner(config_of(config)?)?;
     let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
     check_points(&runner, &points)?;
-    let mut table = SweepColumns::new(&["param"], runner.masses(), true);
+    let mut table = SweepColumns::new(&["param"], runner.masses(), runner.contacts(), true);
     match continuation {
         Continuation::None => {
             let pool = settings_of.pool()?;
@@ -210,7 +210,7 @@ pub fn map<'py>(
         .flat_map(|&yv| x_values.iter().map(move |&xv| vec![(xk, xv), (yk, yv)]))
         .collect();
     check_points(&runner, &points)?;
-    let mut table = SweepColumns::new(&["x", "y"], runner.masses(), false);
+    let mut table = SweepColumns::new(&["x", "y"], runner.masses(), runner.contacts(), false);
     let pool = settings_of.pool()?;
     py.detach(|| run_points(&pool, &runner, &points, &mut table))?;
     let out = PyDict::new(py);

@@ -61,9 +61,9 @@ pub struct ContinueArgs {
     /// Values of the brute-force orbit diagram drawn under the branches with --plot.
     #[arg(long, default_value_t = 200)]
     pub diagram_steps: usize,
-    /// The mass shown in the plot (1-based).
-    #[arg(long, default_value_t = 2)]
-    pub mass: usize,
+    /// The mass shown in the plot (1-based; default 2, or 1 for a single mass).
+    #[arg(long)]
+    pub mass: Option<usize>,
 }
 
 /// Repetitions of an orbit the charge solver warms up over, and averages over.
@@ -82,7 +82,8 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         bail!("--from and --to must be finite and different");
     }
     let config = args.input.load()?;
-    if args.mass == 0 || args.mass > config.chain().len() {
+    let mass = args.mass.unwrap_or(if config.chain().len() > 1 { 2 } else { 1 });
+    if mass == 0 || mass > config.chain().len() {
         bail!("--mass must be between 1 and {}", config.chain().len());
     }
     let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
@@ -137,7 +138,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             let diagram = Diagram {
                 param: &args.param,
                 range: (args.from.min(args.to), args.from.max(args.to)),
-                mass: args.mass - 1,
+                mass: mass - 1,
                 transient: u64::from(args.transient.max(300)),
                 steps: args.diagram_steps,
             };
@@ -300,7 +301,11 @@ fn write_files(
     cols.extend(numbered("x", n, "_m"));
     cols.extend(numbered("v", n, "_m_s"));
     cols.push("impacts_per_period".into());
-    cols.extend(numbered("impacts_per_period_", n - 1, ""));
+    cols.extend(numbered(
+        "impacts_per_period_",
+        config.chain().contact_count(),
+        "",
+    ));
     cols.extend(["min_closing_speed_m_s", "sticks", "average_power_w", "arclength"].map(String::from));
     let mut csv = CsvFile::create(&dir.join("branch.csv"), &cols)?;
     for (i, b) in result.branches.iter().enumerate() {

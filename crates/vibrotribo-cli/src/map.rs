@@ -146,7 +146,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
             args.run.allow_large,
         )?;
     }
-    let columns = point_columns(runner.masses(), runner.options().floquet, false);
+    let columns = point_columns(runner.contacts(), runner.options().floquet, false);
     let o = runner.options();
     let mut settings = json!({
         "command": "map",
@@ -377,7 +377,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     let runner = args.run.runner(base)?;
-    let contacts = runner.masses() - 1;
+    let contacts = runner.contacts();
     let (omegas, ratios) = (
         grid(args.omega_from, args.omega_to, args.omega_steps),
         grid(args.rm_from, args.rm_to, args.rm_steps),
@@ -425,7 +425,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             index += 1;
             if let Some(csv) = grid_csv.as_mut() {
                 // Of the point's columns: average_power_w, impacts_per_period, period, error.
-                let mut cells = point_columns(contacts + 1, false, false).cells(res);
+                let mut cells = point_columns(contacts, false, false).cells(res);
                 let error = cells.pop().unwrap_or_default();
                 cells.truncate(3);
                 csv.row(

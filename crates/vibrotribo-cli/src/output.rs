@@ -223,7 +223,7 @@ pub fn si(value: f64, unit: &str) -> String {
 /// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointColumns {
-    /// Contacts of the chain (N − 1).
+    /// Contacts of the chain (N − 1, or N + 1 with stops).
     pub contacts: usize,
     /// Whether the largest Floquet multiplier modulus is a column (`--floquet`).
     pub floquet: bool,

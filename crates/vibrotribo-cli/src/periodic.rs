@@ -71,7 +71,8 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
             &options,
         )?
     };
-    let power = if args.mechanics_only {
+    // A single mass (against a stop) has no gap between masses to harvest from.
+    let power = if args.mechanics_only || config.chain().len() < 2 {
         None
     } else {
         let h = Harvester::new(config.harvester().clone(), config.charge_options().clone());
@@ -139,7 +140,8 @@ fn print_orbit(orbit: &PeriodicOrbit, power: Option<&ElectricalOutcome>) {
     let contacts: Vec<String> = per
         .iter()
         .enumerate()
-        .map(|(k, c)| format!("m{}–m{}: {c}", k + 1, k + 2))
+        .filter(|&(k, _)| k + 1 < orbit.params.len() || orbit.params.is_stop(k))
+        .map(|(k, c)| format!("{}: {c}", orbit.params.contact_name(k)))
         .collect();
     println!(
         "  impacts per excitation period: {} ({}){}",
@@ -148,7 +150,7 @@ fn print_orbit(orbit: &PeriodicOrbit, power: Option<&ElectricalOutcome>) {
         if orbit.sticks() { "; sticks" } else { "" }
     );
     if let Some((k, v)) = orbit.min_closing_speed() {
-        println!("  slowest impact: {v:.6} m/s at m{}–m{}", k + 1, k + 2);
+        println!("  slowest impact: {v:.6} m/s at {}", orbit.params.contact_name(k));
     }
     if let Some(p) = power.and_then(|p| p.power.as_ref()) {
         println!(

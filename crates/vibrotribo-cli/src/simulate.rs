@@ -265,7 +265,8 @@ fn print_summary(spec: &RunSpec, outcome: &RunOutcome, elapsed: f64, out: Option
     let contacts: Vec<String> = per_contact
         .iter()
         .enumerate()
-        .map(|(k, c)| format!("m{}–m{}: {c:.2}", k + 1, k + 2))
+        .filter(|&(k, _)| k + 1 < params.len() || params.is_stop(k))
+        .map(|(k, c)| format!("{}: {c:.2}", params.contact_name(k)))
         .collect();
     println!(
         "  after the transient: {:.2} impacts/period ({}), {} sticks, {} chatter sequences",
@@ -278,7 +279,8 @@ fn print_summary(spec: &RunSpec, outcome: &RunOutcome, elapsed: f64, out: Option
         .max_closing_speed
         .iter()
         .enumerate()
-        .map(|(k, v)| format!("m{}–m{}: {v:.3} m/s", k + 1, k + 2))
+        .filter(|&(k, _)| k + 1 < params.len() || params.is_stop(k))
+        .map(|(k, v)| format!("{}: {v:.3} m/s", params.contact_name(k)))
         .collect();
     println!("  largest closing speed: {}", speeds.join(", "));
     if let (Some(e), Some(h)) = (&outcome.electrical, &spec.harvester) {

@@ -306,7 +306,8 @@ fn write_value(
 ) -> Result<()> {
     let p = value.to_string();
     if let Ok(r) = result {
-        let n = columns.contacts + 1;
+        // Masses per stroboscopic sample.
+        let n = r.strobe.len() / r.strobe_periods.len().max(1);
         for (j, &period) in r.strobe_periods.iter().enumerate() {
             let mut row = vec![p.clone(), period.to_string()];
             row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
@@ -329,10 +330,11 @@ fn write_value(
     out.row(2, row)
 }
 
-/// The point columns of a chain of `masses` masses.
-pub fn point_columns(masses: usize, floquet: bool, lyapunov: bool) -> PointColumns {
+/// The point columns of a chain with `contacts` contacts
+/// ([`ChainParams::contact_count`](vibrotribo::ChainParams::contact_count)).
+pub fn point_columns(contacts: usize, floquet: bool, lyapunov: bool) -> PointColumns {
     PointColumns {
-        contacts: masses - 1,
+        contacts,
         floquet,
         lyapunov,
     }
@@ -436,7 +438,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         runner = PointRunner::new(runner.base().clone(), options, runner.mechanics_only());
     }
     let masses = runner.masses();
-    let columns = point_columns(masses, runner.options().floquet, args.lyapunov);
+    let columns = point_columns(runner.contacts(), runner.options().floquet, args.lyapunov);
     let values = grid(args.from, args.to, args.steps);
     check_distinct("--from/--to/--steps", &values)?;
     // Fail early on a bad key or on any value of the grid that makes a bad configuration.
@@ -625,10 +627,15 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     } else {
         // orbit.csv: param, period, x1_m, …, xN_m.
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
+        let floquet = floquet_of(first, "sweep.json")?;
+        let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
+        // summary.csv: param and the point columns (7 + contacts, the Floquet column, the
+        // two Lyapunov columns).
+        let extra = 1 + 7 + usize::from(floquet) + 2 * usize::from(lyapunov);
         let columns = PointColumns {
-            contacts: masses.saturating_sub(1),
-            floquet: floquet_of(first, "sweep.json")?,
-            lyapunov: crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true),
+            contacts: header_len(&first.join("summary.csv"))?.saturating_sub(extra),
+            floquet,
+            lyapunov,
         };
         crate::job::merge(
             &args.shards,

@@ -35,7 +35,7 @@ pub enum ParamError {
         /// Actual length.
         got: usize,
     },
-    /// The chain needs at least two masses.
+    /// The chain needs at least two masses (one with a rigid stop).
     #[error("the chain needs at least 2 masses, got {0}")]
     TooFewMasses(usize),
     /// The initial positions make two neighbouring masses overlap.
@@ -47,6 +47,14 @@ pub enum ParamError {
         /// 1-based contact index (k is the gap between mass k and k+1).
         contact: usize,
         /// The (negative) gap, m.
+        gap: f64,
+    },
+    /// The initial positions put a mass beyond a rigid stop.
+    #[error("initial positions put the {} mass beyond the {} stop: gap = {gap:.3e} m", if matches!(side, crate::model::StopSide::Upper) { "top" } else { "bottom" }, side.as_str())]
+    BeyondStop {
+        /// Which stop.
+        side: crate::model::StopSide,
+        /// The (negative) gap to the stop, m.
         gap: f64,
     },
     /// A parameter's value does not fit the others (e.g. a transducer mode that needs more

@@ -64,4 +64,7 @@ pub use dynamics::{
     Trajectory, UniformSampler,
 };
 pub use error::{ParamError, SimError};
-pub use model::{ChainParams, ChainState, Excitation, Frequency, NondimGroups, SimOptions};
+pub use model::{
+    ChainParams, ChainState, Excitation, Frequency, NondimGroups, SimOptions, Stop, StopFrame, StopSide,
+    Stops,
+};

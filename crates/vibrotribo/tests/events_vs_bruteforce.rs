@@ -145,6 +145,7 @@ fn four_mass_stack_with_sticking() {
             amplitude: 0.05,
             frequency: vibrotribo::Frequency::OmegaRatio(0.55),
         },
+        stops: Default::default(),
     };
     let out = check(&params, &ChainState::at_rest(4), 8.0, 200);
     println!(

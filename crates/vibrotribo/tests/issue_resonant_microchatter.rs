@@ -51,6 +51,7 @@ fn rattle_at_rounding_level_jumps_to_its_accumulation_point() {
             amplitude: 0.07139772183692365,
             frequency: Frequency::OmegaRatio(0.9973142543387674),
         },
+        stops: Default::default(),
     };
     // The forced amplitude of the top mass, A·|H| with H = (k + icω)/(k − mω² + icω).
     let (m, k, c, w) = (

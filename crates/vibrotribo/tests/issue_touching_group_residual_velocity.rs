@@ -123,6 +123,7 @@ fn a_touching_group_keeps_no_relative_velocity_after_an_impact() {
             amplitude: 0.005614759057145395,
             frequency: Frequency::OmegaRatio(0.5099264791714189),
         },
+        stops: Default::default(),
     };
     let velocities = vec![
         0.8526738169528798,
@@ -158,6 +159,7 @@ fn a_resting_cluster_is_equalized_with_the_mass_it_touches() {
             amplitude: 0.04765698130819764,
             frequency: Frequency::OmegaRatio(1.9834933780144521),
         },
+        stops: Default::default(),
     };
     let velocities = vec![
         0.23168185927641272,

@@ -170,6 +170,7 @@ fn touching_masses_with_equal_natural_frequency_move_together() {
             amplitude: 0.05,
             frequency: Frequency::OmegaRatio(0.7),
         },
+        stops: Default::default(),
     };
     let periods = 50.0;
     let t_end = periods * params.period();
@@ -306,6 +307,7 @@ fn two_masses(m: [f64; 2], k: [f64; 2], delta: f64) -> ChainParams {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(0.7),
         },
+        stops: Default::default(),
     }
 }
 

@@ -24,6 +24,7 @@ fn pair(k2: f64, mu: f64, omega: f64) -> ChainParams {
             amplitude: 0.05,
             frequency: Frequency::OmegaRatio(omega),
         },
+        stops: Default::default(),
     }
 }
 

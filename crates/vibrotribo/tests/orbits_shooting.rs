@@ -34,6 +34,7 @@ fn pair(omega: f64) -> ChainParams {
             amplitude: 0.05,
             frequency: Frequency::OmegaRatio(omega),
         },
+        stops: Default::default(),
     }
 }
 
@@ -51,6 +52,7 @@ fn impact_free_orbit_is_the_forced_response_with_multipliers_exp_lambda_t() {
                 amplitude: 0.03,
                 frequency: Frequency::OmegaRatio(rng.range(0.3, 1.5)),
             },
+            stops: Default::default(),
         };
         let orbit =
             find_periodic_orbit(&params, &ChainState::at_rest(n), 1, &ShootingOptions::default()).unwrap();

@@ -30,6 +30,7 @@ fn chain() -> impl Strategy<Value = ChainParams> {
                         amplitude,
                         frequency: Frequency::OmegaRatio(omega),
                     },
+                    stops: Default::default(),
                 },
             )
     })

@@ -171,6 +171,7 @@ fn homogeneous_case(rng: &mut StdRng, damped: bool) -> Graze {
         gaps: vec![delta],
         restitution: rng.random_range(0.0..1.0),
         excitation: excitation(amplitude, ratio),
+        stops: Default::default(),
     };
     let initial = ChainState {
         positions: vec![x1, x1 + r0],
@@ -254,6 +255,7 @@ fn forced_case(rng: &mut StdRng) -> Graze {
             gaps: vec![delta],
             restitution: rng.random_range(0.0..1.0),
             excitation: excitation(amplitude, ratio),
+            stops: Default::default(),
         };
         let initial = ChainState {
             positions: vec![amplitude * h1.1, amplitude * h2.1],
@@ -472,6 +474,7 @@ fn chatter_chain(index: u64) -> (ChainParams, ChainState) {
         gaps,
         restitution,
         excitation: excitation(rng.random_range(0.005..0.1), rng.random_range(0.3..2.0)),
+        stops: Default::default(),
     };
     let moving = rng.random_range(0.0..1.0) < 0.3;
     let initial = ChainState {

@@ -102,6 +102,7 @@ fn simultaneous_impacts_are_reported() {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(1.0),
         },
+        stops: Default::default(),
     };
     let initial = ChainState {
         positions: vec![0.0; 3],

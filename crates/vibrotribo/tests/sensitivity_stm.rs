@@ -257,6 +257,7 @@ fn impact_free_chain_matches_the_matrix_exponential() {
                 amplitude: 0.05,
                 frequency: Frequency::OmegaRatio(rng.range(0.3, 1.5)),
             },
+            stops: Default::default(),
         };
         let state = ChainState {
             positions: (0..n).map(|_| rng.range(-0.02, 0.02)).collect(),
@@ -294,6 +295,7 @@ fn stuck_cluster_matches_the_matrix_exponential_of_its_oscillator() {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(0.7),
         },
+        stops: Default::default(),
     };
     let state = ChainState {
         positions: vec![0.02, 0.02 + delta],

@@ -94,6 +94,7 @@ fn chatter_pair(v0: f64) -> (ChainParams, ChainState) {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(0.7),
         },
+        stops: Default::default(),
     };
     let initial = ChainState {
         positions: vec![0.01, 0.01 + delta],
@@ -342,6 +343,7 @@ fn all_three_stuck_release_at_the_analytic_time() {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(1.0),
         },
+        stops: Default::default(),
     };
     let s0 = 0.02;
     let offsets = [0.0, d[0], d[0] + d[1]];
@@ -406,6 +408,7 @@ fn newtons_cradle_with_elastic_impacts() {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(1.0),
         },
+        stops: Default::default(),
     };
     let initial = ChainState {
         positions: vec![0.0, 0.0, 0.0],
@@ -440,6 +443,7 @@ fn symmetric_simultaneous_impact() {
             amplitude: 0.0,
             frequency: Frequency::OmegaRatio(1.0),
         },
+        stops: Default::default(),
     };
     let initial = ChainState {
         positions: vec![0.0; 3],

@@ -6,6 +6,7 @@ mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_simulate_output_edges;
 mod lyapunov;
 mod periodic_orbits;
+mod stops;
 mod util;
 
 use std::path::Path;

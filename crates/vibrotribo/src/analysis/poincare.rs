@@ -364,6 +364,7 @@ mod tests {
                 amplitude: 0.01,
                 frequency: Frequency::OmegaRatio(0.8),
             },
+            stops: Default::default(),
         }
     }
 
@@ -520,6 +521,7 @@ mod tests {
                 amplitude: 0.0,
                 frequency: Frequency::Hertz(1.0),
             },
+            stops: Default::default(),
         };
         let wn = (k / m).sqrt();
         let t_star = (delta * wn / v0).asin() / wn;

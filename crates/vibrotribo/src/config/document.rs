@@ -8,7 +8,7 @@ use toml::{Table, Value};
 use super::error::ConfigError;
 use super::keys::{self, PerMass};
 use crate::electrical::{ChargeOptions, HarvesterParams, TransducerMode};
-use crate::model::{ChainParams, ChainState, Excitation, Frequency, SimOptions};
+use crate::model::{ChainParams, ChainState, Excitation, Frequency, SimOptions, Stops};
 use crate::study::{Harvester, RunSettings, RunSpec, Sampling};
 
 /// The `[oscillator]` table: the mechanical part of [`ChainParams`]. A single number for
@@ -22,6 +22,9 @@ pub(super) struct OscillatorTable {
     pub damping: Option<PerMass>,
     pub gaps: Option<PerMass>,
     pub restitution: Option<f64>,
+    /// `[oscillator.stops.upper]`, `[oscillator.stops.lower]`: rigid stops (none by default).
+    #[serde(skip_serializing_if = "Stops::is_empty")]
+    pub stops: Stops,
 }
 
 /// The `[excitation]` table: [`Excitation`] with its frequency as one of two keys.
@@ -141,9 +144,13 @@ impl Config {
             .initial_state(&chain)
             .map_err(|e| e.renamed(keys::state_key))?;
         doc.options.validate().map_err(|e| e.within("options"))?;
-        harvester
-            .validate_for_gaps(chain.len() - 1)
-            .map_err(|e| e.within("harvester"))?;
+        // A single mass (against a stop) has no gap between masses to harvest from: its runs
+        // are mechanics-only and its harvester is not checked.
+        if chain.len() > 1 {
+            harvester
+                .validate_for_gaps(chain.len() - 1)
+                .map_err(|e| e.within("harvester"))?;
+        }
         doc.electrical.validate().map_err(|e| e.within("electrical"))?;
         Ok(Config {
             table,
@@ -235,7 +242,7 @@ impl Config {
             chain: self.chain.clone(),
             initial: self.initial.clone(),
             options: self.options.clone(),
-            harvester: (!mechanics_only)
+            harvester: (!mechanics_only && self.chain.len() > 1)
                 .then(|| Harvester::new(self.harvester.clone(), self.electrical.clone())),
             periods: self.run.periods,
             transient_periods: self.run.transient(),
@@ -307,6 +314,7 @@ pub(super) fn lenient_chain(doc: &Document) -> Result<ChainParams, crate::error:
             amplitude: e.amplitude.unwrap_or(default.excitation.amplitude),
             frequency,
         },
+        stops: o.stops,
         masses,
     };
     Ok(params)

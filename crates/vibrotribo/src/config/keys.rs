@@ -95,7 +95,7 @@ pub(super) fn default_chain(n: usize) -> ChainParams {
 
 /// The key of a [`ChainParams`] field path (`masses[1]` → `oscillator.masses[1]`).
 pub(super) fn chain_key(name: &str) -> Option<String> {
-    ["masses", "stiffness", "damping", "gaps", "restitution"]
+    ["masses", "stiffness", "damping", "gaps", "restitution", "stops"]
         .iter()
         .any(|f| name.starts_with(f))
         .then(|| format!("oscillator.{name}"))
@@ -121,6 +121,12 @@ pub fn known_keys() -> Vec<String> {
         for (section, table) in sections {
             if let Some(fields) = table.as_object() {
                 keys.extend(fields.keys().map(|k| format!("{section}.{k}")));
+            }
+            if section == "oscillator" {
+                // The stops' keys (absent from an empty `Stops` when serialised).
+                for side in ["upper", "lower"] {
+                    keys.extend(STOP_FIELDS.iter().map(|f| format!("oscillator.stops.{side}.{f}")));
+                }
             }
         }
     }
@@ -281,9 +287,33 @@ pub(super) fn set_key(table: &mut Table, key: &str, value: Value) -> Result<(), 
     }
 }
 
+/// The fields of a stop's table, `[oscillator.stops.upper]` / `[oscillator.stops.lower]`.
+const STOP_FIELDS: [&str; 3] = ["gap", "restitution", "frame"];
+
 fn set_path(table: &mut Table, key: &str, value: Value) -> Result<(), ConfigError> {
     let (path, index) = split_key(key)?;
     let plain = path.join(".");
+    if let ["oscillator", "stops", side, field] = path[..] {
+        if index.is_some() || !known_keys().contains(&plain) {
+            return Err(unknown(key));
+        }
+        let stops = section_mut(table, "oscillator")?
+            .entry("stops")
+            .or_insert_with(|| Value::Table(Table::new()));
+        let Value::Table(stops) = stops else {
+            return Err(ConfigError::Malformed(
+                "`oscillator.stops` must be a table".into(),
+            ));
+        };
+        let stop = stops.entry(side).or_insert_with(|| Value::Table(Table::new()));
+        let Value::Table(stop) = stop else {
+            return Err(ConfigError::Malformed(format!(
+                "`oscillator.stops.{side}` must be a table"
+            )));
+        };
+        stop.insert(field.to_string(), value);
+        return Ok(());
+    }
     if path.len() != 2 || !known_keys().contains(&plain) {
         return Err(unknown(key));
     }

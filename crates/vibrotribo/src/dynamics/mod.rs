@@ -4,6 +4,7 @@
 //! Entry point: [`Simulator`]. Output goes to an [`Observer`]; ready-made observers are
 //! [`EventLog`], [`Trajectory`] (dense output at any time) and [`UniformSampler`].
 
+mod contact;
 mod observer;
 mod oscillator;
 mod roots;

@@ -48,7 +48,8 @@ pub struct Event {
     /// What happened.
     pub kind: EventKind,
     /// Contact index k, 0-based: contact k is the gap between mass k and mass k+1 (so the
-    /// paper's contact "m1–m2" is 0 here and 1 in files).
+    /// paper's contact "m1–m2" is 0 here and 1 in files); with rigid stops, N − 1 is the lower
+    /// stop and N the upper one ([`ChainParams::contact`](crate::ChainParams::contact)).
     pub contact: usize,
     /// For an impact, the closing speed just before it (≥ 0), m/s; 0 otherwise.
     pub velocity_before: f64,
@@ -80,6 +81,9 @@ pub struct ClusterFlow {
     pub last: usize,
     /// Closed-form motion of the cluster's top mass.
     pub oscillator: Oscillator,
+    /// The rigid stop the cluster is stuck to, if any (its motion is then the stop's,
+    /// [`Oscillator::is_prescribed`]).
+    pub stop: Option<crate::model::StopSide>,
 }
 
 /// The exact motion of the whole chain on `[t_start, t_end]`, between two events.

@@ -103,6 +103,9 @@ pub struct Oscillator {
     omega: f64,
     /// Size of the terms the displacement is summed from, m (see `magnitude`).
     magnitude: f64,
+    /// A prescribed motion (a cluster stuck to a rigid stop): no homogeneous part, and a
+    /// motion that does not depend on the initial state.
+    prescribed: bool,
 }
 
 /// Mechanical constants of one oscillator (a mass or a stuck cluster).
@@ -187,6 +190,7 @@ impl Oscillator {
             regime,
             omega: w,
             magnitude: 0.0,
+            prescribed: false,
         };
         let ph = forcing.phase(t0);
         let (sp, vp) = osc.forced(ph);
@@ -194,6 +198,35 @@ impl Oscillator {
         (osc.h1, osc.e1) = two_sum(v0, -vp);
         osc.magnitude = osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs();
         Ok(osc)
+    }
+
+    /// The prescribed motion `s(t) = mean + moves · A sin ωt` of a cluster stuck to a rigid
+    /// stop (`moves`: 1 for a stop that moves with the base, 0 for one fixed in space), from
+    /// `t0`, s. Its homogeneous part is zero (the nominal ω_n = 1/s only keeps the event
+    /// functions' bounds finite), and so is its [`state_jacobian`](Self::state_jacobian).
+    pub(crate) fn prescribed(forcing: &Forcing, t0: f64, mean: f64, moves: f64) -> Self {
+        let ps = moves * forcing.amplitude;
+        Oscillator {
+            t0,
+            mean,
+            pc: 0.0,
+            ps,
+            h0: 0.0,
+            h1: 0.0,
+            e0: 0.0,
+            e1: 0.0,
+            alpha: 0.0,
+            wn2: 1.0,
+            regime: Regime::Under { wd: 1.0 },
+            omega: forcing.omega,
+            magnitude: mean.abs() + ps.abs(),
+            prescribed: true,
+        }
+    }
+
+    /// Whether this is the prescribed motion of a cluster stuck to a rigid stop.
+    pub fn is_prescribed(&self) -> bool {
+        self.prescribed
     }
 
     /// Forced (particular) part: displacement, m, and velocity, m/s.
@@ -288,6 +321,9 @@ impl Oscillator {
     /// Its determinant is `e^{−2α(t − t₀)}` (Liouville).
     #[inline]
     pub(crate) fn state_jacobian(&self, t: f64) -> [[f64; 2]; 2] {
+        if self.prescribed {
+            return [[0.0; 2]; 2];
+        }
         let (c, s) = self.propagator(t - self.t0);
         let a = self.alpha;
         [[c + a * s, s], [-self.wn2 * s, c - a * s]]

@@ -215,10 +215,16 @@ mod tests {
             for q in [-0.7 * scale, -0.1 * scale, 0.0, 0.3 * scale, 1.2 * scale] {
                 let law = -q / t.capacitance(&gaps) + t.open_circuit_voltage(&gaps);
                 let v = e.voltage(q, &gaps);
-                assert!((v - law).abs() <= 1e-12 * law.abs().max(1.0), "{mode:?}: {v} vs {law}");
+                assert!(
+                    (v - law).abs() <= 1e-12 * law.abs().max(1.0),
+                    "{mode:?}: {v} vs {law}"
+                );
                 let h = 1e-4 * scale;
                 let du_dq = (e.energy(q + h, &gaps) - e.energy(q - h, &gaps)) / (2.0 * h);
-                assert!((-du_dq - law).abs() <= 1e-6 * law.abs(), "{mode:?}: {du_dq} vs {law}");
+                assert!(
+                    (-du_dq - law).abs() <= 1e-6 * law.abs(),
+                    "{mode:?}: {du_dq} vs {law}"
+                );
                 for (k, g) in e.gap_forces(q) {
                     let dg = 1e-6;
                     let mut up = gaps;

@@ -11,10 +11,17 @@
 //!
 //! Gap `k` (between mass `k` and `k+1`, seed eq. 2): `d_k = δ_k − (x_{k+1} − x_k) ≥ 0`.
 //!
+//! Optional rigid stops above the top mass and below the bottom one ([`Stops`], in
+//! `stops.rs`: geometry and contact numbering) make a chain of a single mass possible.
+//!
 //! Physical inputs live in [`ChainParams`]; numerical settings in
 //! [`SimOptions`]. Validate once with [`ChainParams::validate`].
 
 use crate::error::{ParamError, check, check_finite, check_non_negative, check_positive};
+
+mod stops;
+
+pub use stops::{Contact, Stop, StopFrame, StopSide, Stops};
 
 /// How the excitation frequency is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,6 +80,10 @@ pub struct ChainParams {
     pub restitution: f64,
     /// Base excitation.
     pub excitation: Excitation,
+    /// Rigid stops above the top mass and below the bottom mass (see [`Stops`]). Default
+    /// none.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Stops::is_empty"))]
+    pub stops: Stops,
 }
 
 impl Default for ChainParams {
@@ -84,6 +95,7 @@ impl Default for ChainParams {
             gaps: vec![0.020; 2],
             restitution: 0.6,
             excitation: Excitation::default(),
+            stops: Stops::default(),
         }
     }
 }
@@ -122,7 +134,7 @@ impl ChainParams {
         self.masses.len()
     }
 
-    /// Always false for a valid chain (N ≥ 2); provided for API completeness.
+    /// Always false for a valid chain (N ≥ 1); provided for API completeness.
     pub fn is_empty(&self) -> bool {
         self.masses.is_empty()
     }
@@ -131,7 +143,7 @@ impl ChainParams {
     /// field (`masses[1]`, `excitation.amplitude`, `excitation.omega_ratio`, …).
     pub fn validate(&self) -> Result<(), ParamError> {
         let n = self.masses.len();
-        if n < 2 {
+        if n < 2 && (n == 0 || self.stops.is_empty()) {
             return Err(ParamError::TooFewMasses(n));
         }
         check_len("stiffness", &self.stiffness, n)?;
@@ -157,7 +169,7 @@ impl ChainParams {
             Frequency::OmegaRatio(w) => check_positive("excitation.omega_ratio", w)?,
             Frequency::Hertz(f) => check_positive("excitation.frequency_hz", f)?,
         }
-        Ok(())
+        self.validate_stops()
     }
 
     /// Natural frequency of the top mass Ω₁ = √(k₁/m₁), rad/s (the paper's frequency unit).
@@ -183,9 +195,15 @@ impl ChainParams {
         2.0 * std::f64::consts::PI / self.omega()
     }
 
-    /// The paper's nondimensional groups (seed eqs. 3–6).
+    /// The paper's nondimensional groups (seed eqs. 3–6). A single mass with a stop takes the
+    /// stop's gap for δ₁ (the upper stop's if it has both) and has R_m = NaN.
     pub fn nondimensional(&self) -> NondimGroups {
         let w1 = self.omega1();
+        let first_gap = match (self.gaps.first(), self.stops.upper, self.stops.lower) {
+            (Some(&g), _, _) => g,
+            (None, Some(s), _) | (None, None, Some(s)) => s.gap,
+            (None, None, None) => f64::NAN,
+        };
         NondimGroups {
             damping_ratios: (0..self.len())
                 .map(|i| self.damping[i] / (2.0 * (self.masses[i] * self.stiffness[i]).sqrt()))
@@ -193,21 +211,28 @@ impl ChainParams {
             frequency_ratios: (0..self.len())
                 .map(|i| (self.stiffness[i] / self.masses[i]).sqrt() / w1)
                 .collect(),
-            amplitude_ratio: self.excitation.amplitude / self.gaps[0],
+            amplitude_ratio: self.excitation.amplitude / first_gap,
             omega_ratio: self.omega_ratio(),
-            mass_ratio: self.masses[1] / self.masses[0],
+            mass_ratio: self.masses.get(1).map_or(f64::NAN, |m| m / self.masses[0]),
             gap_ratio: if self.gaps.len() > 1 {
                 Some(self.gaps[1] / self.gaps[0])
             } else {
                 None
             },
             time_scale: 1.0 / w1,
-            length_scale: self.gaps[0],
+            length_scale: first_gap,
         }
     }
 
-    /// Checks an initial state against the chain: lengths, finiteness, no interpenetration.
+    /// Checks an initial state against the chain: lengths, finiteness, no interpenetration
+    /// (and no mass beyond a stop, with the base at its position of time 0).
     pub fn validate_state(&self, state: &ChainState) -> Result<(), ParamError> {
+        self.validate_state_at(state, 0.0)
+    }
+
+    /// [`validate_state`](Self::validate_state) for a state at time `t`, s (where a stop
+    /// that moves with the base stands).
+    pub fn validate_state_at(&self, state: &ChainState, t: f64) -> Result<(), ParamError> {
         let n = self.len();
         check_len("positions", &state.positions, n)?;
         check_len("velocities", &state.velocities, n)?;
@@ -225,7 +250,11 @@ impl ChainParams {
                 return Err(ParamError::Interpenetration { contact: k + 1, gap });
             }
         }
-        Ok(())
+        if self.stops.is_empty() {
+            Ok(())
+        } else {
+            self.validate_state_stops(&state.positions, t)
+        }
     }
 }
 

@@ -37,14 +37,16 @@
 //! Neimark–Sacker points, grazings and the onset of sticking, and marks why every branch
 //! ends; the method is described in [`continuation`].
 //!
-//! # Extending to other contacts
+//! # Rigid stops
 //!
-//! A contact against a wall with prescribed motion (a rigid stop fixed in space or moving
-//! with the base) fits the same scheme: its gap `h = δ − (x_k − w(t))` depends on time
-//! explicitly, so the impact saltation's denominator becomes `∇h·f⁻ + ∂h/∂t = −(v_k − w')`,
-//! and its reset changes one cluster only, `V⁺ = w' − μ(V⁻ − w')`, i.e. `R = I` except
-//! `∂V⁺/∂V⁻ = −μ`. The observer dispatches on the events' contact index; a wall contact
-//! needs its own `Impact` kind in `sensitivity::saltation` and nothing else here.
+//! Chains with rigid stops ([`Stops`](crate::Stops)) need nothing special here: their
+//! impacts, sticking and chatter against a stop enter the monodromy matrix through the
+//! saltation matrices of `sensitivity` (a gap `h` with explicit time dependence
+//! `∂h/∂t = ±Y'`, a reset of one cluster only), and the single-mass impact oscillator's
+//! (1,1) orbits, multipliers and period doubling agree with their closed form
+//! (`tests/stops.rs`). The grazing gap minimum watched during continuation (a branch
+//! approaching a new impact) includes the stops' gaps: the textbook orbit that never touches
+//! the stop meets it where its steady amplitude equals the gap.
 
 pub mod continuation;
 mod error;

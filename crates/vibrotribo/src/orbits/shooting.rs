@@ -108,7 +108,7 @@ impl PeriodicOrbit {
     /// Impacts per excitation period at each contact (chatter bounces included, as
     /// [`RunStats`](crate::analysis::RunStats) counts them).
     pub fn impacts_per_period(&self) -> Vec<f64> {
-        let mut counts = vec![0.0; self.params.gaps.len()];
+        let mut counts = vec![0.0; self.params.contact_count()];
         for e in self.events.iter().filter(|e| e.kind == EventKind::Impact) {
             counts[e.contact] += 1.0;
         }

@@ -15,7 +15,7 @@
 
 use crate::dynamics::ClusterFlow;
 use crate::dynamics::Forcing;
-use crate::model::ChainParams;
+use crate::model::{ChainParams, StopSide, Stops};
 
 /// Constants of one cluster, masses `first..=last` (0-based).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,6 +51,8 @@ pub(crate) struct ChainField {
     /// μ.
     pub restitution: f64,
     pub forcing: Forcing,
+    /// The rigid stops.
+    pub stops: Stops,
 }
 
 impl ChainField {
@@ -68,6 +70,7 @@ impl ChainField {
             offsets,
             restitution: params.restitution,
             forcing: Forcing::new(params.excitation.amplitude, params.omega()),
+            stops: params.stops,
         }
     }
 
@@ -133,11 +136,27 @@ impl ChainField {
         (c.damping * ydd + c.stiffness * yd) / c.mass
     }
 
+    /// The position of the stop on `side` at time `t`, m, and its first three derivatives
+    /// (zero for a fixed one).
+    pub fn wall(&self, side: StopSide, t: f64) -> [f64; 4] {
+        let frame = self.stops.get(side).map(|s| s.frame).unwrap_or_default();
+        let (y, yd) = self.forcing.base(self.forcing.phase(t));
+        ChainParams::frame_motion(frame, y, yd, self.forcing.omega)
+    }
+
     /// Fills `f` (length 2N) with the vector field at (`x`, `v`, `t`) for the partition
-    /// `clusters`.
+    /// `clusters`. A cluster stuck to a stop moves with it: `v̇_i = Ÿ`.
     pub fn fill(&self, clusters: &[ClusterFlow], x: &[f64], v: &[f64], t: f64, f: &mut [f64]) {
         let n = self.len();
         for cf in clusters {
+            if let Some(side) = cf.stop {
+                let a = self.wall(side, t)[2];
+                for i in cf.first..=cf.last {
+                    f[i] = v[i];
+                    f[n + i] = a;
+                }
+                continue;
+            }
             let c = self.cluster(cf.first, cf.last);
             let (s, vel) = self.coordinates(&c, x, v);
             let a = self.accel(&c, s, vel, t);

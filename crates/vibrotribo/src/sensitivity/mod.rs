@@ -67,6 +67,12 @@
 //! dropped; the dimension returns through the flow after it (perturbations of gap and
 //! relative velocity grow from zero at second order).
 //!
+//! **Rigid stops** ([`Stops`](crate::Stops)): an impact against a stop, or against a cluster
+//! stuck to one, changes the free cluster only, and the stop's gap depends on time
+//! explicitly; a cluster stuck to a stop follows the stop (its rows of Φ are zero). The
+//! saltation matrices for these, sticking to a stop and chatter jumps against one included,
+//! are derived in `stops.rs`.
+//!
 //! **Chatter accumulation point**, as [`Simulator`](crate::Simulator) implements it: at the
 //! impact that starts a jump (a rebound `u = μ v_c` under a closing acceleration `a`) the
 //! simulator applies Newton's law and then merges the two sides momentum-conservingly, so the
@@ -121,6 +127,7 @@ mod field;
 mod flow_map;
 mod saltation;
 mod stm;
+mod stops;
 
 pub use error::{NonSmoothPoint, SensitivityError};
 pub(crate) use flow_map::EventRecorder;

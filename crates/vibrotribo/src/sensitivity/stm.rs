@@ -7,6 +7,9 @@ use super::field::ChainField;
 use super::saltation::{
     Before, Impact, apply_impact, apply_time_shift, chatter_time_row, impact_time_row, propagate,
 };
+use super::stops::{
+    WallImpact, apply_wall_impact, is_closed, stop_gap, wall_chatter_time_row, wall_impact_time_row,
+};
 use crate::dynamics::{ClusterFlow, Event, EventKind, Flow, Observer, Simulator, StateView};
 use crate::model::ChainParams;
 
@@ -109,6 +112,10 @@ pub struct Sensitivity {
     chatter_set: Vec<bool>,
     failure: Option<NonSmoothPoint>,
     events: Vec<EventSensitivity>,
+    /// Number of contacts (N − 1, or N + 1 with stops).
+    contacts: usize,
+    /// Per contact: its restitution.
+    restitutions: Vec<f64>,
 }
 
 impl Sensitivity {
@@ -134,10 +141,14 @@ impl Sensitivity {
             f_post: vec![0.0; dim],
             row: vec![0.0; dim],
             scratch: vec![0.0; 3 * dim],
-            chatter_rows: vec![0.0; (n - 1) * dim],
-            chatter_set: vec![false; n - 1],
+            chatter_rows: vec![0.0; params.contact_count() * dim],
+            chatter_set: vec![false; params.contact_count()],
             failure: None,
             events: Vec::new(),
+            contacts: params.contact_count(),
+            restitutions: (0..params.contact_count())
+                .map(|k| params.contact_restitution(k))
+                .collect(),
         }
     }
 
@@ -296,14 +307,56 @@ impl Sensitivity {
             if others || !self.same_closures(post, Some(k)) {
                 return Err(simultaneous(&self.batch));
             }
-            for j in 0..self.field.gaps.len() {
-                let gap = self.field.gaps[j] - (self.pre_x[j + 1] - self.pre_x[j]);
-                if j != k && !is_closed(&self.last, j) && gap < self.contact_gap {
+            let n = self.field.len();
+            for j in 0..self.contacts {
+                let gap = if j + 1 < n {
+                    self.field.gaps[j] - (self.pre_x[j + 1] - self.pre_x[j])
+                } else {
+                    stop_gap(&self.field, j, &self.pre_x, t)
+                };
+                if j != k && !is_closed(&self.last, n, j) && gap < self.contact_gap {
                     return Err(NonSmoothPoint::Simultaneous {
                         time: t,
                         contacts: vec![k.min(j), k.max(j)],
                     });
                 }
+            }
+            let merged = is_closed(post, n, k);
+            if let Some(wall) = WallImpact::classify(&self.field, &self.last, k, &self.pre_v, t) {
+                let r = self.restitutions[k];
+                if merged && !stuck {
+                    wall_chatter_time_row(
+                        &self.field,
+                        &wall,
+                        r,
+                        t,
+                        &self.pre_x,
+                        &self.pre_v,
+                        &self.f_pre,
+                        &mut self.row,
+                        &mut self.scratch,
+                    );
+                    row_times(
+                        &self.row,
+                        &self.phi,
+                        &mut self.chatter_rows[k * dim..(k + 1) * dim],
+                    );
+                    self.chatter_set[k] = true;
+                }
+                wall_impact_time_row(&wall, &self.f_pre, &mut self.scratch[..dim]);
+                row_times(&self.scratch[..dim], &self.phi, &mut self.row);
+                let r = if merged { 0.0 } else { r };
+                apply_wall_impact(
+                    &mut self.phi,
+                    &self.field,
+                    &wall,
+                    r,
+                    t,
+                    &self.f_pre,
+                    &self.f_post,
+                    &mut self.scratch,
+                );
+                return Ok(());
             }
             let upper = self.field.cluster_of(&self.last, k);
             let lower = self.field.cluster_of(&self.last, k + 1);
@@ -317,7 +370,6 @@ impl Sensitivity {
             };
             // After the impact the two sides either move on apart (Newton's law with μ), or
             // merge: stuck (plastic) or jumping over a chatter tail (plastic until t_acc).
-            let merged = is_closed(post, k);
             if merged && !stuck {
                 let pre = Before {
                     t,
@@ -385,15 +437,9 @@ impl Sensitivity {
 
     /// Whether every contact but `except` is closed after as before.
     fn same_closures(&self, post: &[ClusterFlow], except: Option<usize>) -> bool {
-        (0..self.field.gaps.len())
-            .all(|j| Some(j) == except || is_closed(&self.last, j) == is_closed(post, j))
+        let n = self.field.len();
+        (0..self.contacts).all(|j| Some(j) == except || is_closed(&self.last, n, j) == is_closed(post, n, j))
     }
-}
-
-/// Whether contact `k` (between mass k and k+1) is closed in the partition `clusters`.
-fn is_closed(clusters: &[ClusterFlow], k: usize) -> bool {
-    let c = &clusters[clusters.partition_point(|c| c.last < k)];
-    c.last > k
 }
 
 /// `out = rowᵀ Φ`.

@@ -152,7 +152,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
     };
     let mut rec = Recorder {
         user: observer,
-        stats: RunStats::new(chain.len() - 1, period, spec.transient_periods),
+        stats: RunStats::new(chain.contact_count(), period, spec.transient_periods),
         solver,
         electrical_from: spec
             .harvester

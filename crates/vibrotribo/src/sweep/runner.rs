@@ -116,6 +116,12 @@ impl PointRunner {
         self.base.chain().len()
     }
 
+    /// Number of contacts of the base configuration's chain (N − 1, or N + 1 with stops:
+    /// [`ChainParams::contact_count`](crate::ChainParams::contact_count)).
+    pub fn contacts(&self) -> usize {
+        self.base.chain().contact_count()
+    }
+
     /// The base configuration with each `(key, value)` of `keys` set (validated).
     pub fn configure(&self, keys: &[(&str, f64)]) -> Result<Config, ConfigError> {
         let mut config = self.base.clone();

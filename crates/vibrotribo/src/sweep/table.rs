@@ -92,7 +92,7 @@ impl Table {
 /// - orbit (`orbit.csv`): the key columns, `period` (the index n of the stroboscopic sample
 ///   at t = nT) and the positions `x1_m … xN_m`, m, one row per recorded period;
 /// - impacts (`impacts.csv`): the key columns, `time_s` (from the start of the point's run),
-///   `contact` (1-based: contact k is the gap between masses k and k+1) and
+///   `contact` (1-based: contact k is the gap between masses k and k+1; with rigid stops N is the lower stop and N + 1 the upper) and
 ///   `rel_velocity_m_s` (the closing speed), one row per impact after the transient.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepColumns {
@@ -119,10 +119,10 @@ pub struct SweepColumns {
 
 impl SweepColumns {
     /// Empty tables for points keyed by `keys` (`["param"]` for a sweep, `["x", "y"]` for a
-    /// map) of a chain of `masses` masses; the orbit and impact tables are kept only if
-    /// `orbits`.
-    pub fn new(keys: &[&str], masses: usize, orbits: bool) -> Self {
-        let contacts = masses.saturating_sub(1);
+    /// map) of a chain of `masses` masses and `contacts` contacts
+    /// ([`ChainParams::contact_count`](crate::ChainParams::contact_count): N − 1, and one more
+    /// per rigid stop); the orbit and impact tables are kept only if `orbits`.
+    pub fn new(keys: &[&str], masses: usize, contacts: usize, orbits: bool) -> Self {
         let k = keys.len();
         SweepColumns {
             keys: keys.iter().map(|s| s.to_string()).collect(),
@@ -286,7 +286,7 @@ mod tests {
             .iter()
             .map(|&v| runner.run(&[("omega_ratio", v)], None))
             .collect();
-        let mut t = SweepColumns::new(&["param"], 3, true);
+        let mut t = SweepColumns::new(&["param"], 3, 2, true);
         for (v, r) in values.iter().zip(&results) {
             t.push(&[*v], r);
         }

@@ -201,6 +201,7 @@ pub fn random_chain(rng: &mut Lcg, n: usize, mu: f64) -> (ChainParams, vibrotrib
             amplitude: rng.range(0.02, 0.08),
             frequency: Frequency::OmegaRatio(rng.range(0.3, 1.2)),
         },
+        stops: Default::default(),
     };
     let v = vibrotribo::sensitivity::speed_scale(&params);
     let mut x = vec![0.0; n];
@@ -231,6 +232,7 @@ pub fn grazing_pair(eps: f64) -> (ChainParams, ChainState, f64) {
             amplitude: 0.05,
             frequency: Frequency::OmegaRatio(0.37),
         },
+        stops: Default::default(),
     };
     let initial = ChainState {
         positions: vec![0.0, 0.0],

@@ -222,7 +222,7 @@ impl<F: Fn(f64) -> ChainParams> Problem<'_, F> {
         let params = (self.family)(self.parameter(&ev.u));
         let end = self.phase + f64::from(self.period) * params.period();
         let events: Vec<_> = ev.eval.events.iter().filter(|e| e.time < end).copied().collect();
-        let mut impacts = vec![0.0; params.gaps.len()];
+        let mut impacts = vec![0.0; params.contact_count()];
         for e in events.iter().filter(|e| e.kind == EventKind::Impact) {
             impacts[e.contact] += 1.0 / f64::from(self.period);
         }
