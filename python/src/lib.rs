@@ -1,5 +1,5 @@
 //! The extension module `vibrotribo._vibrotribo`: Python bindings of vibrotribo's run layer
-//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation). The Python
+//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation, Lyapunov spectra). The Python
 //! package `vibrotribo` (python/vibrotribo/) wraps what this returns into result objects;
 //! nothing here computes: it converts arguments, releases the GIL while the library runs,
 //! watches for Ctrl-C at the library's checkpoints, and converts results to numpy arrays.
@@ -10,6 +10,7 @@ mod config;
 mod convert;
 mod interrupt;
 mod loads;
+mod lyapunov;
 mod orbits;
 mod simulate;
 mod sweep;
@@ -38,6 +39,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loads::load_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::continue_, m)?)?;
+    m.add_function(wrap_pyfunction!(lyapunov::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;
     m.add_function(wrap_pyfunction!(log_spaced, m)?)?;
     m.add("OrbitNotFound", m.py().get_type::<orbits::OrbitNotFound>())?;

@@ -162,7 +162,12 @@ fn points_to_py<'py>(py: Python<'py>, points: &[BranchPoint], n: usize) -> PyRes
     )?;
     d.set_item(
         "impacts_per_period",
-        array2(py, flat(&|p| &p.impacts_per_period), n - 1)?,
+        // One column per contact: N − 1, and one more per rigid stop.
+        array2(
+            py,
+            flat(&|p| &p.impacts_per_period),
+            points.first().map_or(n - 1, |p| p.impacts_per_period.len()),
+        )?,
     )?;
     d.set_item(
         "arclength",

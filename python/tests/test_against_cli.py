@@ -1,7 +1,8 @@
 """The Python results equal the command line's files for the same configuration, bit for bit
 in the numbers: samples, events, summary of `simulate`; the tables of `sweep` (parallel and
-continued) and `map`. Also the dtypes and shapes of every array."""
+continued), `map`, `load_sweep` and `lyapunov`. Also the dtypes and shapes of every array."""
 
+import json
 import math
 
 import numpy as np
@@ -192,3 +193,27 @@ def test_load_sweep_equals_the_files(cli, tmp_path):
     for key in ("optimum_at_edge", "configured_load_ohm", "configured_average_power_w",
                 "air_breakdown_last_period", "periods", "transient_periods"):
         same_json(getattr(r, key), expected[key], key)
+
+
+@pytest.mark.parametrize("sets", [[], ["oscillator.masses=[0.05,0.15,0.05]", "oscillator.gaps=[0.005,0.005]",
+                                       "omega_ratio=0.6"]])
+def test_lyapunov_equals_the_file(cli, tmp_path, sets):
+    args = [a for s in sets for a in ("--set", s)]
+    run_cli(cli, "lyapunov", *args, "--periods", "200", "--transient", "50", "--seed", "3", "--out", tmp_path)
+    expected = read_json(tmp_path / "lyapunov.json")
+    overrides = {s.split("=")[0]: json.loads(s.split("=")[1]) for s in sets}
+    r = vt.lyapunov(vt.Config(**{k: v for k, v in overrides.items()}), periods=200, transient=50, seed=3)
+    # lyapunov.json writes -inf as null.
+    want = [float("-inf") if e is None else e for e in expected["exponents"]]
+    assert r.exponents.tolist() == want
+    assert r.periods == expected["periods"] == 200
+    assert r.collapsed == expected["collapsed"]
+    assert r.exponents.shape == (6,) and r.spread.shape == (6,)
+    assert r.largest == r.exponents[0]
+
+
+def test_lyapunov_rejects_bad_input():
+    with pytest.raises(ValueError, match="periods"):
+        vt.lyapunov(None, periods=0)
+    with pytest.raises(ValueError, match="batches"):
+        vt.lyapunov(None, periods=10, batches=1)

@@ -39,6 +39,7 @@ from ._results import (
     Continuation,
     Events,
     LoadSweep,
+    Lyapunov,
     Map,
     Orbit,
     Simulation,
@@ -56,6 +57,8 @@ __all__ = [
     "load_sweep",
     "periodic",
     "continue_",
+    "lyapunov",
+    "Lyapunov",
     "grid",
     "log_spaced",
     "Simulation",
@@ -272,6 +275,27 @@ def continue_(
         max_step=max_step,
     )
     return Continuation._from(raw)
+
+
+def lyapunov(
+    config: ConfigLike = None,
+    *,
+    periods: int = 1000,
+    transient: int = 300,
+    seed: int = 1,
+    batches: int = 10,
+) -> Lyapunov:
+    """All 2N Lyapunov exponents of the configuration's run (mechanics), through impacts,
+    sticking and chatter, from the exact state-transition matrix: ``transient`` periods
+    (the motion settles and the tangent vectors align), then ``periods`` averaged over in
+    ``batches`` batches (the spread is their batch-means standard error). ``seed`` seeds the
+    initial tangent basis. The same numbers as ``vibrotribo lyapunov``. Ctrl-C raises
+    ``KeyboardInterrupt`` within a second.
+    """
+    raw = _vibrotribo.lyapunov(
+        _config(config), periods=int(periods), transient=int(transient), seed=int(seed), batches=int(batches)
+    )
+    return Lyapunov(**raw)
 
 
 def _floats(values: Iterable[float]) -> list:

@@ -416,6 +416,38 @@ class Orbit:
 
 
 @dataclass(frozen=True, eq=False)
+class Lyapunov:
+    """The Lyapunov spectrum of :func:`vibrotribo.lyapunov` (the numbers of ``lyapunov.json``).
+
+    Attributes:
+        exponents: the 2N exponents, 1/s, largest first; ``-inf`` for the directions a stuck
+            contact or a chatter sequence removes.
+        spread: the batch-means standard error of each, 1/s (0 for a ``-inf`` exponent).
+        largest, largest_spread: the largest exponent and its spread, 1/s.
+        sum: the sum of the exponents, 1/s (``-inf`` if any is).
+        kaplan_yorke_dimension: the Kaplan–Yorke dimension.
+        collapsed: number of ``-inf`` exponents.
+        periods: excitation periods averaged over; time_s: their duration, s.
+        skipped_periods: periods left out at non-differentiable points (grazing,
+            simultaneous impacts).
+        running_periods, running: the estimate after each batch (rows of ``running``).
+    """
+
+    exponents: np.ndarray
+    spread: np.ndarray
+    largest: float
+    largest_spread: float
+    sum: float
+    kaplan_yorke_dimension: float
+    collapsed: int
+    periods: int
+    time_s: float
+    skipped_periods: int
+    running_periods: np.ndarray
+    running: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
 class Branch:
     """One branch of a continuation.
 

@@ -109,6 +109,16 @@ def periodic(
 ) -> Dict[str, Any]:
     """A periodic orbit and its Floquet multipliers."""
 
+def lyapunov(
+    config: Any,
+    *,
+    periods: int = 1000,
+    transient: int = 300,
+    seed: int = 1,
+    batches: int = 10,
+) -> Dict[str, Any]:
+    """The Lyapunov spectrum of a run."""
+
 def continue_(
     config: Any,
     param: str,

@@ -133,19 +133,34 @@ pub fn known_keys() -> Vec<String> {
     keys
 }
 
-/// The first key of `table` (`section.name`, or a top-level name) that the schema lacks.
+/// The first key of `table` (`section.name`, `section.sub.name`, or a top-level name) that
+/// the schema lacks.
 pub(super) fn unknown_key_in(table: &Table) -> Option<String> {
-    let known = known_keys();
-    for (section, value) in table {
-        let prefix = format!("{section}.");
+    unknown_below("", table, &known_keys())
+}
+
+/// [`unknown_key_in`] for the keys of `table` under `prefix` (`""` or ending in `.`).
+fn unknown_below(prefix: &str, table: &Table, known: &[String]) -> Option<String> {
+    for (name, value) in table {
+        let key = format!("{prefix}{name}");
+        if known.contains(&key) {
+            continue;
+        }
+        let inner = format!("{key}.");
+        let is_section = known.iter().any(|k| k.starts_with(&inner));
         match value {
-            Value::Table(fields) => {
-                if let Some(name) = fields.keys().find(|n| !known.contains(&format!("{prefix}{n}"))) {
-                    return Some(format!("{prefix}{name}"));
+            Value::Table(fields) if is_section => {
+                if let Some(k) = unknown_below(&inner, fields, known) {
+                    return Some(k);
                 }
             }
-            _ if !known.iter().any(|k| k.starts_with(&prefix)) => return Some(section.clone()),
-            _ => {}
+            // A section given a value of the wrong kind is a type error, not an unknown key.
+            _ if is_section => {}
+            // An unknown table is named by its first key (`oscilator.masses`).
+            Value::Table(fields) => {
+                return Some(fields.keys().next().map_or(key.clone(), |n| format!("{key}.{n}")));
+            }
+            _ => return Some(key),
         }
     }
     None
