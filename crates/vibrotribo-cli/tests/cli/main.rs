@@ -3,6 +3,7 @@
 
 mod basins;
 mod issue_grid_jobs_stop_resume_and_merge;
+mod issue_motion_classified;
 mod issue_simulate_output_edges;
 mod lyapunov;
 mod periodic_orbits;

@@ -3,7 +3,7 @@
 //! A series `s_j ∈ ℝᴰ` converging onto a periodic orbit of period p has return distances
 //!
 //! ```text
-//! d_j = max_d |s_{j,d} − s_{j−p,d}| / scale
+//! d_j = ‖s_j − s_{j−p}‖₂ / scale
 //! ```
 //!
 //! that shrink geometrically, `d_j ≈ d_0 · r^j`, where r is the modulus of the slowest
@@ -21,9 +21,11 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Distances between returns `p` samples apart of a `dim`-dimensional row-major series,
-/// relative to `scale`: `d_j = max_d |s_{j,d} − s_{j−p,d}| / scale` for `j = p … len − 1`
-/// (see the module docs). Empty if the series holds `p` samples or fewer, or if `p` or
-/// `dim` is 0.
+/// relative to `scale`: `d_j = ‖s_j − s_{j−p}‖₂ / scale` for `j = p … len − 1` (see the
+/// module docs). Given positions and velocities over a frequency (a state in one unit), the
+/// Euclidean norm of a lightly damped mode's part decays smoothly, where a single component
+/// (or the largest) swings through zero at the mode's beat with the forcing. Empty if the
+/// series holds `p` samples or fewer, or if `p` or `dim` is 0.
 pub fn return_distances(samples: &[f64], dim: usize, p: usize, scale: f64) -> Vec<f64> {
     if dim == 0 || p == 0 {
         return Vec::new();
@@ -35,7 +37,7 @@ pub fn return_distances(samples: &[f64], dim: usize, p: usize, scale: f64) -> Ve
                 &samples[j * dim..(j + 1) * dim],
                 &samples[(j - p) * dim..(j - p + 1) * dim],
             );
-            a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
+            a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt() / scale
         })
         .collect()
 }
@@ -63,6 +65,8 @@ pub struct Convergence {
     pub distance: f64,
     /// Samples the fit covers.
     pub samples: usize,
+    /// Root mean square of the residuals of `ln d` about the line.
+    pub rms: f64,
 }
 
 impl Convergence {
@@ -72,11 +76,12 @@ impl Convergence {
     }
 
     /// Whether the distances shrink geometrically beyond doubt: a negative slope at least 5
-    /// standard errors from 0 that has halved the distance over the samples fitted.
+    /// standard errors from 0, and either the distance halved over the samples fitted or
+    /// the points within 0.25 (in ln d, root mean square) of the line, a slow but clean
+    /// geometric decay.
     pub fn converging(&self) -> bool {
-        self.slope < 0.0
-            && self.slope + 5.0 * self.slope_se < 0.0
-            && self.slope * (self.samples.saturating_sub(1)) as f64 <= -std::f64::consts::LN_2
+        let halved = self.slope * (self.samples.saturating_sub(1)) as f64 <= -std::f64::consts::LN_2;
+        self.slope < 0.0 && self.slope + 5.0 * self.slope_se < 0.0 && (halved || self.rms <= 0.25)
     }
 
     /// Samples still needed, at the fitted rate, for the distance to fall to `tolerance`
@@ -122,7 +127,26 @@ pub fn fit_convergence(distances: &[f64]) -> Option<Convergence> {
         slope_se: (ssr / (m - 2).max(1) as f64 / sxx).sqrt(),
         distance: (intercept + slope * last).exp(),
         samples: distances.len(),
+        rms: (ssr / m as f64).sqrt(),
     })
+}
+
+/// The smallest lag p ≤ `max_period` at which the return distances of `samples` (see
+/// [`return_distances`]) converge geometrically, with its fit; else `fallback` and the fit
+/// there. An orbit of period q is approached at lags q, 2q, …, and no other: its smallest
+/// converging lag is its period, even where a slow mode nearly repeats at another lag (a
+/// mode turning 10 times in 7 periods makes lag 7 the closest match of the positions).
+pub fn converging_lag(
+    samples: &[f64],
+    dim: usize,
+    max_period: usize,
+    scale: f64,
+    fallback: usize,
+) -> (usize, Option<Convergence>) {
+    let fit = |p| fit_convergence(&return_distances(samples, dim, p, scale));
+    (1..=max_period)
+        .find_map(|p| fit(p).filter(Convergence::converging).map(|f| (p, Some(f))))
+        .unwrap_or_else(|| (fallback, fit(fallback)))
 }
 
 /// How far a set of section points is from lying on one closed curve: the points, in a
@@ -262,7 +286,8 @@ mod tests {
     fn return_distances_of_a_period_two_series() {
         let s = [1.0, -2.0, 3.0, 4.0, 1.0, -2.0, 3.0, 4.0];
         assert_eq!(return_distances(&s, 2, 2, 1.0), vec![0.0, 0.0]);
-        assert_eq!(return_distances(&s, 2, 1, 2.0), vec![3.0, 3.0, 3.0]);
+        let d = 40f64.sqrt() / 2.0;
+        assert_eq!(return_distances(&s, 2, 1, 2.0), vec![d, d, d]);
         assert!(return_distances(&s, 2, 4, 1.0).is_empty());
     }
 

@@ -6,8 +6,9 @@
 //! - **periodic**: the stroboscopic positions repeat with a period p ≤ the largest tested
 //!   ([`PointOptions::period_options`]), within the period tolerance; the residual is the
 //!   test's relative mismatch.
-//! - **settling**: not periodic, but the return distances at the closest candidate period
-//!   shrink geometrically beyond doubt ([`Convergence::converging`]): the motion is still
+//! - **settling**: not periodic, but the return distances at some lag p ≤ the largest
+//!   tested period shrink geometrically beyond doubt ([`converging_lag`],
+//!   [`Convergence::converging`](crate::analysis::Convergence::converging)): the motion is still
 //!   approaching an orbit; the rate per period and the periods still needed to reach the
 //!   tolerance are reported. A motion whose largest Lyapunov exponent is negative beyond its
 //!   error bar is settling too (onto an orbit the window cannot show as periodic), with the
@@ -27,8 +28,8 @@
 use super::lyapunov::lyapunov_spectrum;
 use super::point::{PointOptions, PointResult};
 use super::settings::RunSpec;
-use super::settle::{SettleEnding, Settled};
-use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, fit_convergence, return_distances};
+use super::settle::{SettleEnding, Settled, section_states};
+use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, converging_lag};
 use crate::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::sensitivity::length_scale;
@@ -172,8 +173,14 @@ pub fn classify(
     report.residual_period = closest;
     let scale = amplitude(window.positions);
     let tolerance = options.period_tolerance;
-    if let Some(fit) =
-        fit_convergence(&return_distances(window.positions, n, closest, scale)).filter(|f| f.converging())
+    let states: Vec<f64> = section_states(window.positions, window.velocities, params).collect();
+    let max_lag = options
+        .period_options()
+        .max_period
+        .min(states.len() / (6 * n))
+        .max(1);
+    if let (_, Some(fit)) = converging_lag(&states, 2 * n, max_lag, scale, closest)
+        && fit.converging()
     {
         report.rate = Some(fit.rate());
         report.periods_needed = fit.samples_needed(tolerance).map(|p| p + test_window);

@@ -18,8 +18,8 @@ use super::point::{PointError, PointOptions};
 use super::settings::RunSpec;
 use super::simulate::{Ending, StudyError, simulate};
 use crate::analysis::{
-    Convergence, Periodicity, StroboscopicOptions, StroboscopicSection, amplitude, detect_period,
-    fit_convergence, return_distances,
+    Convergence, Periodicity, StroboscopicOptions, StroboscopicSection, amplitude, converging_lag,
+    detect_period,
 };
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::orbits::{ShootingOptions, find_periodic_orbit};
@@ -113,6 +113,28 @@ pub struct Settled {
     pub shot: Option<(u32, f64)>,
 }
 
+/// The section states `[x_1 … x_N, v_1/ω_1 … v_N/ω_N]`, m, of stroboscopic samples
+/// (positions and velocities row-major), one row per sample, with ω_i = √(k_i/m_i) each
+/// mass's own natural frequency (so that a free mass's decaying oscillation has a nearly
+/// constant norm between its decays): what the geometric fit reads.
+pub(super) fn section_states<'a>(
+    positions: &'a [f64],
+    velocities: &'a [f64],
+    params: &'a ChainParams,
+) -> impl Iterator<Item = f64> + 'a {
+    let n = params.len();
+    positions
+        .chunks_exact(n)
+        .zip(velocities.chunks_exact(n))
+        .flat_map(move |(x, v)| {
+            x.iter().copied().chain(
+                v.iter()
+                    .enumerate()
+                    .map(move |(i, v)| v / (params.stiffness[i] / params.masses[i]).sqrt()),
+            )
+        })
+}
+
 /// At most this many Newton attempts per point.
 const MAX_SHOTS: u32 = 3;
 
@@ -132,6 +154,7 @@ pub fn settle(
     let needed = popts.samples_needed();
     let block = auto.block.max(1);
     let mut history: Vec<f64> = Vec::new();
+    let mut states: Vec<f64> = Vec::new();
     let mut state = initial.clone();
     let mut done = 0u64;
     let mut shots = 0;
@@ -168,9 +191,15 @@ pub fn settle(
         done += len;
         state = outcome.final_state;
         history.extend_from_slice(&watch.inner.positions);
-        let keep = (needed.max(block as usize) + popts.max_period) * n;
-        if history.len() > keep {
-            history.drain(..history.len() - keep);
+        states.extend(section_states(
+            &watch.inner.positions,
+            &watch.inner.velocities,
+            params,
+        ));
+        let keep = needed.max(block as usize) + popts.max_period;
+        if history.len() > keep * n {
+            history.drain(..history.len() - keep * n);
+            states.drain(..states.len() - keep * 2 * n);
         }
         let samples = history.len() / n;
         let end = |ending, fit, fit_period| Settled {
@@ -190,10 +219,10 @@ pub fn settle(
                 Ok(Periodicity::NonPeriodic { closest_period, .. }) => fit_period = closest_period,
                 Err(_) => {}
             }
-            let fit_from = samples.saturating_sub(block as usize + fit_period);
-            let window = &history[fit_from * n..];
+            // The fit reads every sample kept (the test's window or a block, and p more).
             let scale = amplitude(tail);
-            last_fit = fit_convergence(&return_distances(window, n, fit_period, scale));
+            let max_lag = popts.max_period.min(samples / 3).max(1);
+            (fit_period, last_fit) = converging_lag(&states, 2 * n, max_lag, scale, fit_period);
             if let Some(fit) = last_fit.filter(Convergence::converging) {
                 let more = fit.samples_needed(options.period_tolerance).unwrap_or(0.0);
                 if auto.shoot && shots < MAX_SHOTS && more > block as f64 {
