@@ -11,10 +11,10 @@
 
 use thiserror::Error;
 
-use super::motion::{MotionReport, WARMUP as MOTION_WARMUP, Window, classify};
+use super::motion::{Motion, MotionReport, WARMUP as MOTION_WARMUP, Window, classify};
 use super::observer::{Mechanics, RunObserver};
 use super::settings::{ElectricalFailure, Harvester, RunSettings, RunSpec};
-use super::settle::{SettleEnding, SettleMode, settle};
+use super::settle::{AutoSettle, SettleEnding, SettleMode, settle};
 use super::simulate::{Ending, StudyError, simulate};
 use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, StroboscopicSection, detect_period};
 use crate::dynamics::{Event, EventKind, Observer, StateView};
@@ -273,42 +273,73 @@ pub fn run_point(
         }
         SettleMode::Auto(a) => a,
     };
-    let settled = settle(params, initial, sim_options, options, auto)?;
-    // A motion the settling found irregular will need its Lyapunov exponent: take it over
-    // the recorded window itself, the warm-up aligning the tangent vectors.
-    let irregular = settled.ending == SettleEnding::Irregular
-        || (settled.ending == SettleEnding::Cap && !settled.convergence.is_some_and(|c| c.converging()));
-    let own = LyapunovOptions::default();
-    let lyapunov = options
-        .lyapunov
-        .as_ref()
-        .or((options.classify && irregular).then_some(&own));
     let warmup = options.electrical_warmup_periods.max(MOTION_WARMUP);
-    let mut r = record(
-        params,
-        &settled.state,
-        sim_options,
-        harvester,
-        options,
-        (warmup, settled.periods),
-        lyapunov,
-    )?;
-    if options.classify {
-        let spectrum = r.lyapunov.as_ref().and_then(|s| s.as_ref().ok());
-        r.motion = Some(classify(
+    let mut start = initial.clone();
+    let mut before = 0u64;
+    let mut round = 0;
+    loop {
+        // A later round settles from where the previous window ended, within what is left
+        // of the cap.
+        let this = PointOptions {
+            transient_periods: options.transient_periods.saturating_sub(before),
+            ..options.clone()
+        };
+        let left = AutoSettle {
+            cap_periods: auto.cap_periods.saturating_sub(before).max(1),
+            ..*auto
+        };
+        let mut settled = settle(params, &start, sim_options, &this, &left)?;
+        settled.periods += before;
+        // A motion the settling found irregular will need its Lyapunov exponent: take it
+        // over the recorded window itself, the warm-up aligning the tangent vectors.
+        let irregular = settled.ending == SettleEnding::Irregular
+            || (settled.ending == SettleEnding::Cap && !settled.convergence.is_some_and(|c| c.converging()));
+        let own = LyapunovOptions::default();
+        let lyapunov = options
+            .lyapunov
+            .as_ref()
+            .or((options.classify && irregular).then_some(&own));
+        let mut r = record(
             params,
+            &settled.state,
             sim_options,
+            harvester,
             options,
-            Window::of(&r),
-            Some(&settled),
-            spectrum,
-        ));
+            (warmup, settled.periods),
+            lyapunov,
+        )?;
+        if options.classify {
+            let spectrum = r.lyapunov.as_ref().and_then(|s| s.as_ref().ok());
+            r.motion = Some(classify(
+                params,
+                sim_options,
+                options,
+                Window::of(&r),
+                Some(&settled),
+                spectrum,
+            ));
+        }
+        if options.lyapunov.is_none() {
+            r.lyapunov = None;
+        }
+        // The settling gave up on returns that did not shrink, but the window converges (a
+        // transient that looked irregular): settle again from the window's end.
+        let end = settled.periods + warmup + options.recorded_periods;
+        let again = settled.ending == SettleEnding::Irregular
+            && r.motion.as_ref().is_some_and(|m| m.motion == Motion::Settling)
+            && round < MAX_ROUNDS
+            && end < auto.cap_periods;
+        if !again {
+            return Ok(r);
+        }
+        round += 1;
+        before = end;
+        start = r.final_state;
     }
-    if options.lyapunov.is_none() {
-        r.lyapunov = None;
-    }
-    Ok(r)
 }
+
+/// Settling rounds after the first ([`run_point`] with [`SettleMode::Auto`]).
+const MAX_ROUNDS: u32 = 3;
 
 /// Runs `params` from `initial` for `transient + recorded` periods and condenses the
 /// recorded ones, with `lyapunov` the spectrum over them; `offset` periods ran before
