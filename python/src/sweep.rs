@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vibrotribo::config::Config;
-use vibrotribo::study::PointOptions;
+use vibrotribo::study::{AutoSettle, PointOptions, SettleMode};
 use vibrotribo::sweep::{Continuation, Delivery, PointRunner, SweepColumns, run_continued, run_grid_on};
 
 use crate::config::{config_error, config_of, table_to_dict};
@@ -22,13 +22,32 @@ pub struct PointSettings {
     pub mechanics_only: bool,
     pub threads: Option<usize>,
     pub period_tolerance: f64,
+    /// `"auto"` or `"fixed"` (the command line's `--settle`).
+    pub settle: String,
+    /// Most periods `"auto"` settles (`--settle-cap`).
+    pub settle_cap: u64,
 }
 
 impl PointSettings {
     /// The point runner on `base`, the options checked.
     fn runner(&self, base: Config) -> PyResult<PointRunner> {
+        let settle = match self.settle.as_str() {
+            "fixed" => SettleMode::Fixed,
+            "auto" if self.settle_cap > 0 => SettleMode::Auto(AutoSettle {
+                cap_periods: self.settle_cap,
+                ..AutoSettle::default()
+            }),
+            "auto" => return Err(PyValueError::new_err("settle_cap must be at least 1")),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "settle must be \"auto\" or \"fixed\", got {other:?}"
+                )));
+            }
+        };
         let options = PointOptions {
             period_tolerance: self.period_tolerance,
+            settle,
+            classify: true,
             ..PointOptions::from_run(base.run(), self.transient, self.recorded)
         };
         if options.recorded_periods == 0 {
@@ -74,6 +93,12 @@ fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'py, P
     d.set_item("grazing_ratio", o.grazing_ratio)?;
     d.set_item("electrical_warmup_periods", o.electrical_warmup_periods)?;
     d.set_item("mechanics_only", runner.mechanics_only())?;
+    d.set_item("settle", o.settle.as_str())?;
+    if let SettleMode::Auto(a) = &o.settle {
+        d.set_item("settle_cap_periods", a.cap_periods)?;
+        d.set_item("settle_block_periods", a.block)?;
+        d.set_item("settle_newton", a.shoot)?;
+    }
     d.set_item("settings", table_to_dict(py, runner.base().table())?)?;
     Ok(d)
 }
@@ -114,7 +139,7 @@ fn run_points(
 
 /// Runs a one-parameter sweep (see the Python `vibrotribo.sweep`).
 #[pyfunction]
-#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4))]
+#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4, settle = String::from("auto"), settle_cap = 2000))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -127,6 +152,8 @@ pub fn sweep<'py>(
     mechanics_only: bool,
     threads: Option<usize>,
     period_tolerance: f64,
+    settle: String,
+    settle_cap: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let continuation: Continuation = continuation.parse().map_err(PyValueError::new_err)?;
     let settings_of = PointSettings {
@@ -135,6 +162,8 @@ pub fn sweep<'py>(
         mechanics_only,
         threads,
         period_tolerance,
+        settle,
+        settle_cap,
     };
     let runner = settings_of.runner(config_of(config)?)?;
     let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
@@ -180,7 +209,7 @@ pub fn sweep<'py>(
 
 /// Runs a two-parameter map (see the Python `vibrotribo.map`).
 #[pyfunction]
-#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4))]
+#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4, settle = String::from("auto"), settle_cap = 2000))]
 #[allow(clippy::too_many_arguments)]
 pub fn map<'py>(
     py: Python<'py>,
@@ -194,6 +223,8 @@ pub fn map<'py>(
     mechanics_only: bool,
     threads: Option<usize>,
     period_tolerance: f64,
+    settle: String,
+    settle_cap: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let settings_of = PointSettings {
         transient,
@@ -201,6 +232,8 @@ pub fn map<'py>(
         mechanics_only,
         threads,
         period_tolerance,
+        settle,
+        settle_cap,
     };
     let runner = settings_of.runner(config_of(config)?)?;
     // Grid order as map.csv: y outer, x inner.

@@ -122,6 +122,8 @@ def sweep(
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = 1e-4,
+    settle: str = "auto",
+    settle_cap: int = 2000,
 ) -> Sweep:
     """A one-parameter sweep: the configuration with ``param`` set to each of ``values``,
     simulated for ``transient`` periods (default ``run.transient_periods``) and then
@@ -137,7 +139,11 @@ def sweep(
     ``--from a --to b --steps n``. The tables equal the command line's files for the same
     settings, whatever the thread count. An unknown key raises ``KeyError``, a value that
     makes a bad configuration ``ValueError`` (before anything runs); a point that fails on
-    the way is a row with its ``error``.
+    the way is a row with its ``error``. ``settle``: ``"auto"`` (each point runs until its
+    motion repeats, at most ``settle_cap`` periods, then ``recorded`` periods; see the
+    README's "How a point is classified") or ``"fixed"`` (exactly ``transient`` periods
+    first), as ``--settle``/``--settle-cap``; the summary's ``motion`` column says whether a
+    point is ``periodic``, ``settling``, ``quasiperiodic`` or ``chaotic``.
     """
     raw = _vibrotribo.sweep(
         _config(config),
@@ -149,6 +155,8 @@ def sweep(
         mechanics_only=mechanics_only,
         threads=threads,
         period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=settle_cap,
     )
     return Sweep._from(raw)
 
@@ -165,6 +173,8 @@ def map(  # noqa: A001 - the command's name
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = 1e-4,
+    settle: str = "auto",
+    settle_cap: int = 2000,
 ) -> Map:
     """A two-parameter map: every point (x, y) of the grid (y outer, x inner), each run as a
     sweep point (see :func:`sweep`); its ``summary`` is ``vibrotribo map``'s ``map.csv``."""
@@ -179,6 +189,8 @@ def map(  # noqa: A001 - the command's name
         mechanics_only=mechanics_only,
         threads=threads,
         period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=settle_cap,
     )
     return Map._from(raw)
 

@@ -69,6 +69,8 @@ def sweep(
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = 1e-4,
+    settle: str = "auto",
+    settle_cap: int = 2000,
 ) -> Dict[str, Any]:
     """A sweep: the columns of summary.csv, orbit.csv, impacts.csv and the settings."""
 
@@ -84,6 +86,8 @@ def map(
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = 1e-4,
+    settle: str = "auto",
+    settle_cap: int = 2000,
 ) -> Dict[str, Any]:
     """A map: the columns of map.csv and the settings."""
 

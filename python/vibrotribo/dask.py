@@ -49,6 +49,8 @@ def sweep(
     mechanics_only: bool = False,
     threads: Optional[int] = 1,
     period_tolerance: float = 1e-4,
+    settle: str = "auto",
+    settle_cap: int = 2000,
     chunk_size: Optional[int] = None,
 ) -> Sweep:
     """:func:`vibrotribo.sweep` with its values spread over the workers of the Dask
@@ -75,6 +77,8 @@ def sweep(
         mechanics_only=mechanics_only,
         threads=threads,
         period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=settle_cap,
     )
     if not vals:
         return _serial_sweep(cfg, param, vals, **kwargs)

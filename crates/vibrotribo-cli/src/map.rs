@@ -162,6 +162,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     if o.floquet {
         settings["floquet"] = json!(true);
     }
+    crate::sweep::add_settle_settings(&mut settings, o);
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -228,9 +229,11 @@ pub fn run(args: &MapArgs) -> Result<()> {
 
 /// Merges the shards of a map (`vibrotribo merge`).
 pub fn merge(args: &MergeArgs) -> Result<()> {
-    // map.csv: x, y, then the point columns: 7, one per contact, and the Floquet column.
+    // map.csv: x, y, then the point columns: 7, one per contact, the Floquet column and the
+    // motion columns.
     let floquet = floquet_of(&args.shards[0], "map.json")?;
-    let contacts = header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2 + 7 + usize::from(floquet));
+    let contacts = header_len(&args.shards[0].join("map.csv"))?
+        .saturating_sub(2 + 7 + usize::from(floquet) + vibrotribo::sweep::MOTION_COLUMNS.len());
     let columns = PointColumns {
         contacts,
         floquet,
@@ -426,7 +429,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             if let Some(csv) = grid_csv.as_mut() {
                 // Of the point's columns: average_power_w, impacts_per_period, period, error.
                 let mut cells = point_columns(contacts, false, false).cells(res);
-                let error = cells.pop().unwrap_or_default();
+                let error = cells.get(6 + contacts).cloned().unwrap_or_default();
                 cells.truncate(3);
                 csv.row(
                     [w.to_string(), r.to_string()]

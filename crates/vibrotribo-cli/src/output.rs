@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use vibrotribo::study::PointResult;
-use vibrotribo::sweep::point_columns;
+use vibrotribo::sweep::{MOTION_COLUMNS, MotionCells, point_columns};
 
 /// A CSV file written row by row.
 pub struct CsvFile {
@@ -219,8 +219,10 @@ pub fn si(value: f64, unit: &str) -> String {
 
 /// The columns describing one sweep or map point, after its key columns ([`point_columns`]): `average_power_w`,
 /// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
-/// `impacts_per_period_1..contacts`, `error`, with `floquet` `max_abs_multiplier`, and with
-/// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`.
+/// `impacts_per_period_1..contacts`, `error`, with `floquet` `max_abs_multiplier`, with
+/// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`, and last the motion columns
+/// ([`MOTION_COLUMNS`]: `motion`, `average_power_se_w`, `settle_periods`, `settle_rate`,
+/// `residual`, `settle_periods_needed`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointColumns {
     /// Contacts of the chain (N − 1, or N + 1 with stops).
@@ -245,6 +247,7 @@ impl PointColumns {
         if self.lyapunov {
             cols.extend(LYAPUNOV_COLUMNS.map(String::from));
         }
+        cols.extend(MOTION_COLUMNS.map(String::from));
         cols
     }
 
@@ -290,6 +293,13 @@ impl PointColumns {
                 _ => [String::new(), String::new()],
             });
         }
+        row.extend(
+            match result {
+                Ok(p) => MotionCells::of(p),
+                Err(_) => MotionCells::missing(),
+            }
+            .texts(),
+        );
         row
     }
 }

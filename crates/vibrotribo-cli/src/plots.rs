@@ -62,6 +62,19 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
     let (oh, orows) = read_csv(&dir.join("orbit.csv"))?;
     let p = numbers(&orows, 0);
     let masses = oh.len() - 2;
+    let (sh, srows) = read_csv(&dir.join("summary.csv"))?;
+    // The motion of each value, to colour the orbit diagram by (older files have none).
+    let motion_of: std::collections::HashMap<String, String> = match column(&sh, "motion") {
+        Ok(c) => srows
+            .iter()
+            .map(|r| (r[0].clone(), r.get(c).cloned().unwrap_or_default()))
+            .collect(),
+        Err(_) => Default::default(),
+    };
+    let motions: Vec<&str> = orows
+        .iter()
+        .map(|r| motion_of.get(&r[0]).map_or("", String::as_str))
+        .collect();
     for i in 0..masses {
         let x: Vec<f64> = numbers(&orows, 2 + i).iter().map(|v| v / delta1).collect();
         let mut fig = Figure::new(
@@ -69,9 +82,24 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
             param.clone(),
             format!("X{} (dimensionless)", i + 1),
         );
-        fig.legend = Legend::Hidden;
+        let groups = by_motion(&motions, &p, &x);
+        fig.legend = if groups.len() > 1 || groups.iter().any(|g| !g.0.is_empty()) {
+            Legend::UpperLeft
+        } else {
+            Legend::Hidden
+        };
+        let series: Vec<Series<'_>> = groups
+            .iter()
+            .map(|(name, k, xs, ys)| {
+                if name.is_empty() {
+                    Series::unlabelled(xs, ys)
+                } else {
+                    Series::new(name, xs, ys).colour(*k)
+                }
+            })
+            .collect();
         both(dir, &format!("orbit_x{}", i + 1), |path| {
-            plot::scatter_plot(path, &fig, &[Series::unlabelled(&p, &x)], 2)
+            plot::scatter_plot(path, &fig, &series, 2)
         })?;
     }
     let (ih, irows) = read_csv(&dir.join("impacts.csv"))?;
@@ -105,7 +133,6 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
             plot::scatter_plot(path, &fig, &[Series::unlabelled(&xs, &ys)], 2)
         })?;
     }
-    let (sh, srows) = read_csv(&dir.join("summary.csv"))?;
     let sp = numbers(&srows, column(&sh, "param")?);
     let power = numbers(&srows, column(&sh, "average_power_w")?);
     if power.iter().any(|x| x.is_finite()) {
@@ -167,6 +194,33 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
     })
 }
 
+/// The motions in the order of their colours.
+const MOTIONS: [&str; 4] = ["periodic", "settling", "quasiperiodic", "chaotic"];
+
+/// The points `(x, y)` grouped by their motion (`motions`, one per point): per motion
+/// present, its name, colour index and points; points without a motion in one unnamed group.
+fn by_motion<'a>(motions: &[&str], x: &[f64], y: &[f64]) -> Vec<(&'a str, usize, Vec<f64>, Vec<f64>)> {
+    let mut groups = Vec::new();
+    for (k, name) in MOTIONS.iter().copied().chain([""]).enumerate() {
+        let (xs, ys): (Vec<f64>, Vec<f64>) = motions
+            .iter()
+            .zip(x.iter().zip(y))
+            .filter(|(m, _)| {
+                if name.is_empty() {
+                    !MOTIONS.contains(m)
+                } else {
+                    **m == name
+                }
+            })
+            .map(|(_, (a, b))| (*a, *b))
+            .unzip();
+        if !xs.is_empty() {
+            groups.push((name, k, xs, ys));
+        }
+    }
+    groups
+}
+
 /// Heat maps of a two-parameter map.
 pub fn plot_map(dir: &Path) -> Result<()> {
     let settings = read_json(&dir.join("map.json"))?;
@@ -217,6 +271,24 @@ pub fn plot_map(dir: &Path) -> Result<()> {
         both(dir, &format!("map_{col}"), |path| {
             plot::heat_map(path, &fig, &map)
         })?;
+    }
+    if let Ok(c) = column(&h, "motion") {
+        let cells: Vec<Option<usize>> = rows
+            .iter()
+            .map(|r| MOTIONS.iter().position(|m| r.get(c).is_some_and(|v| v == m)))
+            .collect();
+        let names: Vec<String> = MOTIONS.map(String::from).to_vec();
+        let map = plot::CategoryMap {
+            x_nodes: (xs[0], xs[xs.len() - 1]),
+            y_nodes: (ys[0], ys[ys.len() - 1]),
+            nx: xs.len(),
+            ny: ys.len(),
+            cells: &cells,
+            names: &names,
+            missing: "failed",
+        };
+        let fig = Figure::new("Motion", xk.clone(), yk.clone());
+        both(dir, "map_motion", |path| plot::category_map(path, &fig, &map))?;
     }
     Ok(())
 }

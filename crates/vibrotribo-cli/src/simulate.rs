@@ -5,15 +5,21 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Result;
+use serde_json::json;
+use vibrotribo::analysis::{StroboscopicOptions, StroboscopicSection, detect_period};
 use vibrotribo::config::Config;
 use vibrotribo::electrical::{HarvesterParams, Load, LoadKind, TransducerMode};
-use vibrotribo::study::{Ending, RunObserver, RunOutcome, RunSpec, Sample, simulate};
+use vibrotribo::study::{
+    Ending, Mechanics, Motion, MotionReport, PointOptions, RunObserver, RunOutcome, RunSpec, Sample,
+    SettleMode, Settled, Window, classify, settle, simulate,
+};
 use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
 use crate::limits;
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Interrupted, Progress, Watch};
+use crate::sweep::{SETTLE_CAP, Settle};
 
 /// Options of `vibrotribo simulate`.
 #[derive(Debug, clap::Args)]
@@ -36,6 +42,16 @@ pub struct SimulateArgs {
     /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
     #[arg(long)]
     pub allow_large: bool,
+    /// `fixed`: the run as configured, from the initial state. `auto`: first settle (as
+    /// `sweep --settle auto` does, mechanics only, at most --settle-cap periods), then the
+    /// configured run from the settled state (the files start there; summary.json's
+    /// `settle_periods` says how many periods came before). Either way the motion after the
+    /// transient is classified (`motion` in summary.json).
+    #[arg(long, default_value = "fixed", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
+    pub settle: Settle,
+    /// Most periods `--settle auto` runs before the configured run.
+    #[arg(long, default_value_t = SETTLE_CAP, value_name = "PERIODS")]
+    pub settle_cap: u64,
 }
 
 /// Streams `events.csv` and `trajectory.csv` as the run goes.
@@ -161,26 +177,66 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         Some(dir) => Some(Files::create(dir, &spec.chain, harvester)?),
         None => None,
     };
+    let started = Instant::now();
+    let point_options = PointOptions {
+        transient_periods: spec.transient_periods,
+        recorded_periods: spec.periods.saturating_sub(spec.transient_periods).max(1),
+        settle: args.settle.mode(args.settle_cap),
+        classify: true,
+        ..PointOptions::default()
+    };
+    let settled = match &point_options.settle {
+        SettleMode::Auto(auto) => {
+            if args.settle_cap == 0 {
+                anyhow::bail!("--settle-cap must be at least 1");
+            }
+            let s = settle(&spec.chain, &spec.initial, &spec.options, &point_options, auto)
+                .map_err(|e| anyhow::anyhow!("while settling: {e}"))?;
+            spec.initial = s.state.clone();
+            Some(s)
+        }
+        SettleMode::Fixed => None,
+    };
     let mut watch = Watch {
         progress: Progress::new(spec.periods, "periods", args.quiet),
     };
-    let started = Instant::now();
+    let mut strobe = Mechanics::new(
+        StroboscopicSection::new(
+            spec.chain.len(),
+            spec.chain.period(),
+            StroboscopicOptions {
+                phase_time: 0.0,
+                transient_periods: spec.transient_periods + 1,
+            },
+        )
+        .map_err(|e| anyhow::anyhow!("{e}"))?,
+    );
     let outcome = match files.as_mut() {
-        Some(f) => simulate(&spec, &mut (f, &mut watch))?,
-        None => simulate(&spec, &mut watch)?,
+        Some(f) => simulate(&spec, &mut (f, (&mut watch, &mut strobe)))?,
+        None => simulate(&spec, &mut (&mut watch, &mut strobe))?,
     };
     watch.progress.finish();
+    let motion = (outcome.ending == Ending::Completed)
+        .then(|| motion_of(&spec, &point_options, &strobe.inner, &outcome, settled.as_ref()));
     let elapsed = started.elapsed().as_secs_f64();
     let failure = failure_error(&outcome);
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
-        let summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
+        let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
+        summary["settle"] = json!(args.settle.as_str());
+        if let SettleMode::Auto(a) = &point_options.settle {
+            summary["settle_cap_periods"] = json!(a.cap_periods);
+        }
+        summary["motion"] = motion_json(motion.as_ref());
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
             crate::plots::analyze_run(dir, None)?;
         }
     }
     print_summary(&spec, &outcome, elapsed, args.out.as_deref());
+    if let Some(m) = &motion {
+        print_motion(m);
+    }
     if let Some(e) = failure {
         return Err(e);
     }
@@ -200,6 +256,81 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .into());
     }
     Ok(())
+}
+
+/// The motion after the transient of a run of `spec` (its stroboscopic samples `strobe`)
+/// that ended in `outcome`, after the settling `settled`.
+fn motion_of(
+    spec: &RunSpec,
+    options: &PointOptions,
+    strobe: &StroboscopicSection,
+    outcome: &RunOutcome,
+    settled: Option<&Settled>,
+) -> MotionReport {
+    let n = spec.chain.len();
+    let popts = options.period_options();
+    let periodicity = (strobe.len() >= popts.samples_needed())
+        .then(|| detect_period(&strobe.positions, n, &popts).ok())
+        .flatten();
+    classify(
+        &spec.chain,
+        &spec.options,
+        options,
+        Window {
+            positions: &strobe.positions,
+            velocities: &strobe.velocities,
+            periodicity,
+            final_state: &outcome.final_state,
+        },
+        settled,
+        None,
+    )
+}
+
+/// summary.json's `motion` object (null for a run that did not complete): `motion`,
+/// `period` (0 unless periodic), `residual`, `residual_period`, `settle_periods`,
+/// `settle_ending`, `settle_rate`, `settle_periods_needed`, `newton` (period and residual
+/// of a shot orbit), `lyapunov_max_1_s`, `lyapunov_spread_1_s`, `section_curve_ratio`.
+fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
+    let Some(m) = m else {
+        return serde_json::Value::Null;
+    };
+    let finite = |x: f64| x.is_finite().then_some(x);
+    json!({
+        "motion": m.motion.as_str(),
+        "period": if m.motion == Motion::Periodic { m.residual_period } else { 0 },
+        "residual": finite(m.residual),
+        "residual_period": m.residual_period,
+        "settle_periods": m.settle_periods,
+        "settle_ending": m.settle_ending.as_str(),
+        "settle_rate": m.rate,
+        "settle_periods_needed": m.periods_needed,
+        "newton": m.shot.map(|(p, r)| json!({"period": p, "residual": r})),
+        "lyapunov_max_1_s": m.lyapunov.map(|l| l.0).and_then(finite),
+        "lyapunov_spread_1_s": m.lyapunov.map(|l| l.1).and_then(finite),
+        "section_curve_ratio": m.curve_ratio,
+    })
+}
+
+fn print_motion(m: &MotionReport) {
+    let detail = match m.motion {
+        Motion::Periodic => format!("period {}, residual {:.1e}", m.residual_period, m.residual),
+        Motion::Settling => format!(
+            "rate {} per period, about {} more periods needed",
+            m.rate.map_or("?".into(), |r| format!("{r:.5}")),
+            m.periods_needed.map_or("?".into(), |p| format!("{p:.0}"))
+        ),
+        Motion::Quasiperiodic | Motion::Chaotic => match m.lyapunov {
+            Some((l, s)) => format!("λ1 = {l:.4} ± {s:.4} 1/s"),
+            None => "no Lyapunov exponent".into(),
+        },
+    };
+    println!(
+        "  motion after {} settling periods ({}): {} ({detail})",
+        m.settle_periods,
+        m.settle_ending.as_str(),
+        m.motion
+    );
 }
 
 /// The error of a failed run, with how far it got (summary.json holds the same text,

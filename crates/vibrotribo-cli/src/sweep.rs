@@ -10,7 +10,7 @@ use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::config::Config;
 use vibrotribo::lyapunov::LyapunovOptions;
-use vibrotribo::study::{PointOptions, PointResult};
+use vibrotribo::study::{AutoSettle, PointOptions, PointResult, SettleMode};
 use vibrotribo::sweep::{Continuation, Delivery, PointRunner, error_text, grid, run_chunks, run_continued};
 
 use crate::config::ConfigArgs;
@@ -52,6 +52,52 @@ impl std::str::FromStr for Shard {
     }
 }
 
+/// `--settle`: how long each point runs before its recorded window.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Settle {
+    /// Until the motion repeats, finishing a geometric approach by Newton shooting, at most
+    /// `--settle-cap` periods ([`SettleMode::Auto`]).
+    #[default]
+    Auto,
+    /// The fixed `--transient` ([`SettleMode::Fixed`]).
+    Fixed,
+}
+
+impl std::str::FromStr for Settle {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Settle::Auto),
+            "fixed" => Ok(Settle::Fixed),
+            other => Err(format!("unknown --settle {other:?}: expected auto or fixed")),
+        }
+    }
+}
+
+impl Settle {
+    /// `auto` or `fixed`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Settle::Auto => "auto",
+            Settle::Fixed => "fixed",
+        }
+    }
+
+    /// The library's settle mode, with at most `cap` periods for `auto`.
+    pub fn mode(self, cap: u64) -> SettleMode {
+        match self {
+            Settle::Auto => SettleMode::Auto(AutoSettle {
+                cap_periods: cap,
+                ..AutoSettle::default()
+            }),
+            Settle::Fixed => SettleMode::Fixed,
+        }
+    }
+}
+
+/// The default of `--settle-cap`, periods.
+pub const SETTLE_CAP: u64 = 2000;
+
 /// Settings shared by sweeps and maps.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
@@ -71,6 +117,16 @@ pub struct RunArgs {
     /// its largest Floquet multiplier modulus (column `max_abs_multiplier`; < 1: stable).
     #[arg(long)]
     pub floquet: bool,
+    /// How long each point runs before its recorded window: `auto` until the motion repeats
+    /// within the period tolerance (checked every 50 periods; a geometric approach to a
+    /// periodic orbit is finished by Newton shooting; a motion whose returns do not shrink
+    /// stops after --transient periods), at most --settle-cap periods; `fixed` exactly
+    /// --transient periods (the results of earlier versions).
+    #[arg(long, default_value = "auto", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
+    pub settle: Settle,
+    /// Most periods `--settle auto` runs before the recorded window.
+    #[arg(long, default_value_t = SETTLE_CAP, value_name = "PERIODS")]
+    pub settle_cap: u64,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -151,11 +207,16 @@ impl RunArgs {
                 self.period_tolerance
             );
         }
+        if self.settle_cap == 0 {
+            bail!("--settle-cap must be at least 1");
+        }
         let options = PointOptions {
             transient_periods: transient,
             recorded_periods: recorded,
             period_tolerance: self.period_tolerance,
             floquet: self.floquet,
+            settle: self.settle.mode(self.settle_cap),
+            classify: true,
             ..PointOptions::default()
         };
         Ok(PointRunner::new(base, options, self.mechanics_only))
@@ -370,11 +431,23 @@ fn settings_json(
     if o.floquet {
         settings["floquet"] = json!(true);
     }
+    add_settle_settings(&mut settings, o);
     if args.lyapunov {
         // Only with the option, so that other sweeps' manifests stay as they were.
         settings["lyapunov"] = json!(true);
     }
     settings
+}
+
+/// Records the settling of `options` in a manifest (`sweep.json`, `map.json`): `settle`
+/// (`auto` or `fixed`), and for `auto` `settle_cap_periods` and `settle_block_periods`.
+pub fn add_settle_settings(settings: &mut serde_json::Value, options: &PointOptions) {
+    settings["settle"] = json!(options.settle.as_str());
+    if let SettleMode::Auto(a) = &options.settle {
+        settings["settle_cap_periods"] = json!(a.cap_periods);
+        settings["settle_block_periods"] = json!(a.block);
+        settings["settle_newton"] = json!(a.shoot);
+    }
 }
 
 /// Checks that a grid's values are distinct: rows are keyed by their value.
@@ -404,7 +477,11 @@ pub fn estimate_point_output(runner: &PointRunner, orbit: bool) -> f64 {
 pub fn estimate_point_memory(runner: &PointRunner) -> f64 {
     let o = runner.options();
     let n = runner.masses() as f64;
-    (o.transient_periods + o.recorded_periods) as f64 * (8.0 * n + 96.0)
+    let before = match &o.settle {
+        SettleMode::Auto(a) => a.cap_periods.max(o.transient_periods),
+        SettleMode::Fixed => o.transient_periods,
+    };
+    (before + o.recorded_periods) as f64 * (8.0 * n + 96.0)
 }
 
 /// Runs `vibrotribo sweep`.
@@ -630,8 +707,12 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
         let floquet = floquet_of(first, "sweep.json")?;
         let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
         // summary.csv: param and the point columns (7 + contacts, the Floquet column, the
-        // two Lyapunov columns).
-        let extra = 1 + 7 + usize::from(floquet) + 2 * usize::from(lyapunov);
+        // two Lyapunov columns, the motion columns).
+        let extra = 1
+            + 7
+            + usize::from(floquet)
+            + 2 * usize::from(lyapunov)
+            + vibrotribo::sweep::MOTION_COLUMNS.len();
         let columns = PointColumns {
             contacts: header_len(&first.join("summary.csv"))?.saturating_sub(extra),
             floquet,

@@ -81,6 +81,10 @@ pub fn run_summary(
             "peak_voltage_v".into(),
             json!(s.as_ref().map(|s| s.peak_voltage_v)),
         );
+        obj.insert(
+            "average_power_se_w".into(),
+            json!(e.average_power_se(spec.transient_periods)),
+        );
         obj.insert("power_curve".into(), json!(e.power_curve()));
         obj.insert(
             "energy_in_each_period_j".into(),

@@ -105,6 +105,9 @@ impl Ctx {
             mechanics_only,
             period_tolerance: 1e-4,
             floquet: false,
+            // The report's numbers as they were; the motions are classified all the same.
+            settle: crate::sweep::Settle::Fixed,
+            settle_cap: crate::sweep::SETTLE_CAP,
             threads: None,
             quiet: true,
             allow_large: false,

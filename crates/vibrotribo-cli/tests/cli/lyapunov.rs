@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use super::util::*;
+use vibrotribo::sweep::MOTION_COLUMNS;
 
 fn json(dir: &Path, name: &str) -> serde_json::Value {
     serde_json::from_str(&read(dir, name)).unwrap()
@@ -100,17 +101,23 @@ fn sweep_lyapunov_adds_two_columns_and_agrees_with_the_lyapunov_command() {
     let root = tempdir();
     let plain = root.path().join("plain");
     let with = root.path().join("with");
-    run(&sweep(&plain, &[]));
-    run(&sweep(&with, &["--lyapunov", "--plot"]));
-    // The other files and the leading columns are those of a sweep without the option.
+    // A fixed transient, as the `lyapunov` command has.
+    run(&sweep(&plain, &["--settle", "fixed"]));
+    run(&sweep(&with, &["--lyapunov", "--plot", "--settle", "fixed"]));
+    // The other files, the leading and the motion columns are those of a sweep without the
+    // option; the two Lyapunov columns come between.
     files_equal(&plain, &with, &["orbit.csv", "impacts.csv"]);
     let (a, b) = (read(&plain, "summary.csv"), read(&with, "summary.csv"));
+    let motion = MOTION_COLUMNS.len();
     for (p, w) in a.lines().zip(b.lines()) {
-        assert!(w.starts_with(p), "{w} does not extend {p}");
-        assert_eq!(w[p.len()..].matches(',').count(), 2);
+        let (p, w): (Vec<&str>, Vec<&str>) = (p.split(',').collect(), w.split(',').collect());
+        assert_eq!(w.len(), p.len() + 2);
+        assert_eq!(p[..p.len() - motion], w[..p.len() - motion]);
+        assert_eq!(p[p.len() - motion..], w[w.len() - motion..]);
     }
     let (h, rows) = read_csv(&with.join("summary.csv"));
-    assert_eq!(h[h.len() - 2..], ["lyapunov_max_1_s", "lyapunov_spread_1_s"]);
+    let at = h.len() - motion - 2;
+    assert_eq!(h[at..at + 2], ["lyapunov_max_1_s", "lyapunov_spread_1_s"]);
     assert!(with.join("lyapunov.png").exists());
     // The value R_δ = 1.42 alone, through `lyapunov` with the same transient and periods.
     let row = rows.iter().find(|r| r[0] == "1.42").unwrap();
@@ -131,7 +138,7 @@ fn sweep_lyapunov_adds_two_columns_and_agrees_with_the_lyapunov_command() {
     ]
     .map(String::from));
     let j = json(&one, "lyapunov.json");
-    let swept: f64 = row[row.len() - 2].parse().unwrap();
+    let swept: f64 = row[at].parse().unwrap();
     let alone = j["largest"].as_f64().unwrap();
     assert!((swept - alone).abs() <= 1e-12 * alone.abs(), "{swept} vs {alone}");
 }

@@ -3,6 +3,7 @@
 
 mod basins;
 mod issue_grid_jobs_stop_resume_and_merge;
+mod issue_motion_classified;
 mod issue_simulate_output_edges;
 mod lyapunov;
 mod periodic_orbits;
@@ -456,7 +457,11 @@ fn shards_merge_into_exactly_the_unsharded_output() {
 #[test]
 fn sweep_rows_agree_with_separate_simulate_runs() {
     let sweep = tempdir();
-    let o = vibrotribo(&sweep_args(sweep.path().to_str().unwrap(), &[]));
+    // A fixed transient: the sweep's window is then the simulate run's.
+    let o = vibrotribo(&sweep_args(
+        sweep.path().to_str().unwrap(),
+        &["--settle", "fixed"],
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let (sh, srows) = read_csv(&sweep.path().join("summary.csv"));
     let (_, orows) = read_csv(&sweep.path().join("orbit.csv"));

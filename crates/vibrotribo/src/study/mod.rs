@@ -7,20 +7,24 @@
 
 mod loads;
 mod lyapunov;
+mod motion;
 mod observer;
 mod orbit;
 mod point;
 mod record;
 mod replay;
 mod settings;
+mod settle;
 mod simulate;
 
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
+pub use motion::{Motion, MotionReport, Window, classify};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
 pub use record::{EventColumns, Recording, SampleColumns};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use settings::{ElectricalFailure, Harvester, RunSettings, RunSpec, Sampling};
+pub use settle::{AutoSettle, SettleEnding, SettleMode, Settled, settle};
 pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};

@@ -11,8 +11,10 @@
 
 use thiserror::Error;
 
+use super::motion::{Motion, MotionReport, WARMUP as MOTION_WARMUP, Window, classify};
 use super::observer::{Mechanics, RunObserver};
 use super::settings::{ElectricalFailure, Harvester, RunSettings, RunSpec};
+use super::settle::{AutoSettle, SettleEnding, SettleMode, settle};
 use super::simulate::{Ending, StudyError, simulate};
 use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, StroboscopicSection, detect_period};
 use crate::dynamics::{Event, EventKind, Observer, StateView};
@@ -47,6 +49,12 @@ pub struct PointOptions {
     /// Also compute the Lyapunov spectrum over the recorded periods (the tangent vectors
     /// align during the transient; [`PointResult::lyapunov`]). Default `None`.
     pub lyapunov: Option<LyapunovOptions>,
+    /// How long to run before the recorded window: a fixed transient, or until the motion
+    /// repeats ([`SettleMode`]). Default [`SettleMode::Fixed`].
+    pub settle: SettleMode,
+    /// Also classify the motion of the recorded window ([`PointResult::motion`]; may run a
+    /// Lyapunov spectrum for a point that is neither periodic nor settling). Default false.
+    pub classify: bool,
 }
 
 impl Default for PointOptions {
@@ -59,6 +67,8 @@ impl Default for PointOptions {
             electrical_warmup_periods: 20,
             floquet: false,
             lyapunov: None,
+            settle: SettleMode::Fixed,
+            classify: false,
         }
     }
 }
@@ -137,6 +147,13 @@ pub struct PointResult {
     /// The Lyapunov spectrum over the recorded periods, if [`PointOptions::lyapunov`] asked
     /// for it.
     pub lyapunov: Option<Result<LyapunovSpectrum, LyapunovError>>,
+    /// Batch-means standard error of [`average_power_w`](Self::average_power_w), W: the
+    /// per-period powers of the recorded window in 10 consecutive batches
+    /// ([`batch_means_se`]); about 0 for a periodic motion, the sampling error of a
+    /// non-periodic one.
+    pub average_power_se_w: Option<f64>,
+    /// The motion of the recorded window, with [`PointOptions::classify`].
+    pub motion: Option<MotionReport>,
 }
 
 impl PointResult {
@@ -216,10 +233,13 @@ impl RunObserver for Impacts {
 }
 
 /// Runs one sweep point: `params` from `initial` for `transient + recorded` periods (see the
-/// module docs). With `harvester`, the charge solver starts
-/// [`electrical_warmup_periods`](PointOptions::electrical_warmup_periods) before the recorded
-/// window and the average power over the recorded periods is reported; a failure of the
-/// charge solver is reported beside the motion, which goes on.
+/// module docs), or with [`SettleMode::Auto`] until the motion repeats and then `recorded`
+/// periods (after [`electrical_warmup_periods`](PointOptions::electrical_warmup_periods)
+/// more; period indices and impact times still count from `initial`). With `harvester`, the
+/// charge solver starts `electrical_warmup_periods` before the recorded window and the
+/// average power over the recorded periods is reported; a failure of the charge solver is
+/// reported beside the motion, which goes on. With [`PointOptions::classify`] the motion is
+/// classified ([`PointResult::motion`]).
 pub fn run_point(
     params: &ChainParams,
     initial: &ChainState,
@@ -227,9 +247,114 @@ pub fn run_point(
     harvester: Option<(&HarvesterParams, &ChargeOptions)>,
     options: &PointOptions,
 ) -> Result<PointResult, PointError> {
+    let auto = match &options.settle {
+        SettleMode::Fixed => {
+            let mut r = record(
+                params,
+                initial,
+                sim_options,
+                harvester,
+                options,
+                (options.transient_periods, 0),
+                options.lyapunov.as_ref(),
+            )?;
+            if options.classify {
+                let spectrum = r.lyapunov.as_ref().and_then(|s| s.as_ref().ok());
+                r.motion = Some(classify(
+                    params,
+                    sim_options,
+                    options,
+                    Window::of(&r),
+                    None,
+                    spectrum,
+                ));
+            }
+            return Ok(r);
+        }
+        SettleMode::Auto(a) => a,
+    };
+    let warmup = options.electrical_warmup_periods.max(MOTION_WARMUP);
+    let mut start = initial.clone();
+    let mut before = 0u64;
+    let mut round = 0;
+    loop {
+        // A later round settles from where the previous window ended, within what is left
+        // of the cap.
+        let this = PointOptions {
+            transient_periods: options.transient_periods.saturating_sub(before),
+            ..options.clone()
+        };
+        let left = AutoSettle {
+            cap_periods: auto.cap_periods.saturating_sub(before).max(1),
+            ..*auto
+        };
+        let mut settled = settle(params, &start, sim_options, &this, &left)?;
+        settled.periods += before;
+        // A motion the settling found irregular will need its Lyapunov exponent: take it
+        // over the recorded window itself, the warm-up aligning the tangent vectors.
+        let irregular = settled.ending == SettleEnding::Irregular
+            || (settled.ending == SettleEnding::Cap && !settled.convergence.is_some_and(|c| c.converging()));
+        let own = LyapunovOptions::default();
+        let lyapunov = options
+            .lyapunov
+            .as_ref()
+            .or((options.classify && irregular).then_some(&own));
+        let mut r = record(
+            params,
+            &settled.state,
+            sim_options,
+            harvester,
+            options,
+            (warmup, settled.periods),
+            lyapunov,
+        )?;
+        if options.classify {
+            let spectrum = r.lyapunov.as_ref().and_then(|s| s.as_ref().ok());
+            r.motion = Some(classify(
+                params,
+                sim_options,
+                options,
+                Window::of(&r),
+                Some(&settled),
+                spectrum,
+            ));
+        }
+        if options.lyapunov.is_none() {
+            r.lyapunov = None;
+        }
+        // The settling gave up on returns that did not shrink, but the window converges (a
+        // transient that looked irregular): settle again from the window's end.
+        let end = settled.periods + warmup + options.recorded_periods;
+        let again = settled.ending == SettleEnding::Irregular
+            && r.motion.as_ref().is_some_and(|m| m.motion == Motion::Settling)
+            && round < MAX_ROUNDS
+            && end < auto.cap_periods;
+        if !again {
+            return Ok(r);
+        }
+        round += 1;
+        before = end;
+        start = r.final_state;
+    }
+}
+
+/// Settling rounds after the first ([`run_point`] with [`SettleMode::Auto`]).
+const MAX_ROUNDS: u32 = 3;
+
+/// Runs `params` from `initial` for `transient + recorded` periods and condenses the
+/// recorded ones, with `lyapunov` the spectrum over them; `offset` periods ran before
+/// `initial` (added to the period indices and impact times).
+fn record(
+    params: &ChainParams,
+    initial: &ChainState,
+    sim_options: &SimOptions,
+    harvester: Option<(&HarvesterParams, &ChargeOptions)>,
+    options: &PointOptions,
+    (transient, offset): (u64, u64),
+    lyapunov: Option<&LyapunovOptions>,
+) -> Result<PointResult, PointError> {
     let n = params.len();
     let period = params.period();
-    let transient = options.transient_periods;
     let total = transient + options.recorded_periods;
     let warmup = options.electrical_warmup_periods.min(transient);
     let spec = RunSpec {
@@ -256,7 +381,7 @@ pub fn run_point(
         },
     )
     .expect("valid stroboscopic options");
-    let lyapunov = match &options.lyapunov {
+    let lyapunov = match lyapunov {
         Some(o) => Some(LyapunovObserver::new(params, transient, o).map_err(StudyError::from)?),
         None => None,
     };
@@ -280,6 +405,10 @@ pub fn run_point(
         Ending::Completed | Ending::Stopped => {}
     }
     let (strobe, (lyapunov, impacts)) = (watch.0.inner, (watch.1.0.inner, watch.1.1));
+    let average_power_se_w = outcome
+        .electrical
+        .as_ref()
+        .and_then(|e| e.average_power_se(transient));
     let (average_power_w, electrical_error) = match &outcome.electrical {
         Some(e) => match &e.power {
             Some(p) if e.solver_error.is_none() => (Some(p.average_power_w), None),
@@ -308,21 +437,35 @@ pub fn run_point(
         .map(|o| o.spectral_radius())
         .map_err(|e| e.to_string())
     });
+    let grazing = impacts.grazing;
+    let mut impacts = impacts.records;
+    let mut strobe_periods = strobe.indices;
+    if offset > 0 {
+        let shift = offset as f64 * params.period();
+        for i in &mut impacts {
+            i.time += shift;
+        }
+        for j in &mut strobe_periods {
+            *j += offset;
+        }
+    }
     Ok(PointResult {
-        strobe_periods: strobe.indices,
+        strobe_periods,
         strobe: strobe.positions,
         strobe_velocities: strobe.velocities,
         impacts_per_period: stats.impacts_per_period(total),
-        impacts: impacts.records,
+        impacts,
         periodicity,
         chatter: stats.chatter_sequences > 0,
         sticking: stats.sticks > 0,
-        grazing: impacts.grazing,
+        grazing,
         average_power_w,
         electrical_error,
         final_state: outcome.final_state,
         max_abs_multiplier,
         lyapunov: lyapunov.map(LyapunovObserver::finish),
+        average_power_se_w,
+        motion: None,
     })
 }
 

@@ -72,6 +72,20 @@ impl ElectricalOutcome {
         power_curve(&self.periods, self.period)
     }
 
+    /// The batch-means standard error of the average power over the complete periods from
+    /// period `transient` on (counted from t = 0), W: their powers in 10 consecutive batches
+    /// ([`batch_means_se`](crate::analysis::batch_means_se)). About 0 for a periodic motion;
+    /// for a non-periodic one, the sampling error of the average over a finite window.
+    pub fn average_power_se(&self, transient: u64) -> Option<f64> {
+        let powers: Vec<f64> = self
+            .periods
+            .iter()
+            .filter(|p| p.index >= transient as i64 && p.is_complete(self.period))
+            .map(|p| p.energy_j / self.period)
+            .collect();
+        crate::analysis::batch_means_se(&powers, 10)
+    }
+
     /// Average power and related figures over the complete periods after the first
     /// `transient` of the harvester's ([`summarize`](crate::electrical::summarize)).
     pub fn power_after(&self, transient: usize) -> Option<PowerSummary> {

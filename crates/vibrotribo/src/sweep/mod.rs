@@ -11,4 +11,4 @@ mod table;
 pub use runner::{
     Continuation, Delivery, PointRunner, SweepError, grid, run_chunks, run_continued, run_grid, run_grid_on,
 };
-pub use table::{Column, SweepColumns, Table, error_text, point_columns};
+pub use table::{Column, MOTION_COLUMNS, MotionCells, SweepColumns, Table, error_text, point_columns};

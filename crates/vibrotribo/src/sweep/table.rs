@@ -24,6 +24,83 @@ pub fn point_columns(contacts: usize) -> Vec<String> {
     cols
 }
 
+/// The columns describing a point's motion, after all the others of `summary.csv` and
+/// `map.csv`: `motion` (`periodic`, `settling`, `quasiperiodic`, `chaotic`; empty where not
+/// classified or failed), `average_power_se_w` (the power's batch-means standard error, W),
+/// `settle_periods` (periods run before the recorded window), `settle_rate` (decay factor
+/// of the return distances per period, where converging), `residual` (the period test's
+/// relative mismatch at the detected or closest period), `settle_periods_needed` (for a
+/// settling motion, periods still needed). See [`MotionReport`](crate::study::MotionReport).
+pub const MOTION_COLUMNS: [&str; 6] = [
+    "motion",
+    "average_power_se_w",
+    "settle_periods",
+    "settle_rate",
+    "residual",
+    "settle_periods_needed",
+];
+
+/// A point's values of [`MOTION_COLUMNS`] (NaN, −1 or empty text where missing).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionCells {
+    /// `motion`.
+    pub motion: String,
+    /// `average_power_se_w`, W.
+    pub power_se: f64,
+    /// `settle_periods` (−1 where missing).
+    pub settle_periods: i64,
+    /// `settle_rate`.
+    pub rate: f64,
+    /// `residual`.
+    pub residual: f64,
+    /// `settle_periods_needed`.
+    pub needed: f64,
+}
+
+impl MotionCells {
+    /// The values of point `p`.
+    pub fn of(p: &PointResult) -> Self {
+        let m = p.motion.as_ref();
+        MotionCells {
+            motion: m.map_or(String::new(), |m| m.motion.as_str().to_string()),
+            power_se: p.average_power_se_w.unwrap_or(f64::NAN),
+            settle_periods: m.map_or(-1, |m| m.settle_periods as i64),
+            rate: m.and_then(|m| m.rate).unwrap_or(f64::NAN),
+            residual: m.map_or(f64::NAN, |m| m.residual),
+            needed: m.and_then(|m| m.periods_needed).unwrap_or(f64::NAN),
+        }
+    }
+
+    /// The values of a failed point.
+    pub fn missing() -> Self {
+        MotionCells {
+            motion: String::new(),
+            power_se: f64::NAN,
+            settle_periods: -1,
+            rate: f64::NAN,
+            residual: f64::NAN,
+            needed: f64::NAN,
+        }
+    }
+
+    /// The CSV cells, in the order of [`MOTION_COLUMNS`] (empty where missing).
+    pub fn texts(&self) -> Vec<String> {
+        let num = |x: f64| if x.is_nan() { String::new() } else { x.to_string() };
+        vec![
+            self.motion.clone(),
+            num(self.power_se),
+            if self.settle_periods < 0 {
+                String::new()
+            } else {
+                self.settle_periods.to_string()
+            },
+            num(self.rate),
+            num(self.residual),
+            num(self.needed),
+        ]
+    }
+}
+
 /// The text of a point's failure, as the `error` column holds it.
 pub fn error_text(e: &SweepError) -> String {
     format!("{e:#}")
@@ -86,9 +163,9 @@ impl Table {
 /// Collects the results of sweep or map points, in the order they are pushed, into the
 /// columns of its three tables:
 ///
-/// - summary (`summary.csv`, `map.csv`): the key columns, then [`point_columns`]; a failed
-///   point has NaN numbers, `period` −1, false flags and its error (the files leave those
-///   cells empty);
+/// - summary (`summary.csv`, `map.csv`): the key columns, then [`point_columns`], then
+///   [`MOTION_COLUMNS`]; a failed point has NaN numbers, `period` and `settle_periods` −1,
+///   false flags, no motion and its error (the files leave those cells empty);
 /// - orbit (`orbit.csv`): the key columns, `period` (the index n of the stroboscopic sample
 ///   at t = nT) and the positions `x1_m … xN_m`, m, one row per recorded period;
 /// - impacts (`impacts.csv`): the key columns, `time_s` (from the start of the point's run),
@@ -108,6 +185,7 @@ pub struct SweepColumns {
     grazing: Vec<bool>,
     by_contact: Vec<Vec<f64>>,
     error: Vec<String>,
+    motion: Vec<MotionCells>,
     orbit_keys: Vec<Vec<f64>>,
     orbit_period: Vec<i64>,
     orbit_x: Vec<Vec<f64>>,
@@ -137,6 +215,7 @@ impl SweepColumns {
             grazing: Vec::new(),
             by_contact: vec![Vec::new(); contacts],
             error: Vec::new(),
+            motion: Vec::new(),
             orbit_keys: vec![Vec::new(); k],
             orbit_period: Vec::new(),
             orbit_x: vec![Vec::new(); masses],
@@ -175,6 +254,7 @@ impl SweepColumns {
                     col.push(c);
                 }
                 self.error.push(p.electrical_error.clone().unwrap_or_default());
+                self.motion.push(MotionCells::of(p));
                 if self.orbits {
                     self.push_orbit(key_values, p);
                 }
@@ -190,6 +270,7 @@ impl SweepColumns {
                     col.push(f64::NAN);
                 }
                 self.error.push(error_text(e));
+                self.motion.push(MotionCells::missing());
             }
         }
     }
@@ -238,6 +319,19 @@ impl SweepColumns {
             add(Column::Float(c.clone()));
         }
         add(Column::Text(self.error.clone()));
+        let m = &self.motion;
+        let float = |f: fn(&MotionCells) -> f64| Column::Float(m.iter().map(f).collect());
+        let motion = [
+            Column::Text(m.iter().map(|c| c.motion.clone()).collect()),
+            float(|c| c.power_se),
+            Column::Int(m.iter().map(|c| c.settle_periods).collect()),
+            float(|c| c.rate),
+            float(|c| c.residual),
+            float(|c| c.needed),
+        ];
+        for (name, c) in MOTION_COLUMNS.iter().zip(motion) {
+            columns.push((name.to_string(), c));
+        }
         Table { columns }
     }
 
@@ -292,7 +386,8 @@ mod tests {
         }
         let s = t.summary();
         assert_eq!(s.names()[..3], ["param", "average_power_w", "impacts_per_period"]);
-        assert_eq!(s.names().last(), Some(&"error"));
+        assert_eq!(s.names()[s.names().len() - 7], "error");
+        assert_eq!(s.names()[s.names().len() - 6..], MOTION_COLUMNS);
         assert_eq!(s.rows(), 3);
         let Some(Column::Float(p)) = s.get("average_power_w") else {
             panic!()

@@ -1,0 +1,249 @@
+//! What kind of motion a recorded window shows: periodic, still settling, quasi-periodic or
+//! chaotic.
+//!
+//! [`classify`] reads the recorded window of a sweep point:
+//!
+//! - **periodic**: the stroboscopic positions repeat with a period p ≤ the largest tested
+//!   ([`PointOptions::period_options`]), within the period tolerance; the residual is the
+//!   test's relative mismatch.
+//! - **settling**: not periodic, but the return distances at some lag p ≤ the largest
+//!   tested period shrink geometrically beyond doubt ([`converging_lag`],
+//!   [`Convergence::converging`](crate::analysis::Convergence::converging)): the motion is still
+//!   approaching an orbit; the rate per period and the periods still needed to reach the
+//!   tolerance are reported. A motion whose largest Lyapunov exponent is negative beyond its
+//!   error bar is settling too (onto an orbit the window cannot show as periodic), with the
+//!   rate `exp(λ₁T)`.
+//! - **chaotic**: the largest Lyapunov exponent over the recorded window is positive beyond
+//!   three batch-means standard errors.
+//! - **quasiperiodic**: the largest exponent is within three standard errors of 0. The
+//!   section's [`closed_curve_ratio`] is reported beside it: below
+//!   [`CLOSED_CURVE_RATIO`](crate::analysis::CLOSED_CURVE_RATIO) the section points lie on
+//!   a closed curve, the section of a two-torus; above it the window is a cloud (a torus of
+//!   higher dimension, or chaos too weak to show in the window).
+//!
+//! The Lyapunov exponent is computed only for a point that is neither periodic nor settling
+//! (over the recorded window when the settling already found the motion irregular, else by
+//! a run of the same length from the final state), so periodic points cost nothing extra.
+
+use super::lyapunov::lyapunov_spectrum;
+use super::point::{PointOptions, PointResult};
+use super::settings::RunSpec;
+use super::settle::{SettleEnding, Settled, section_states};
+use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, converging_lag};
+use crate::lyapunov::{LyapunovOptions, LyapunovSpectrum};
+use crate::model::{ChainParams, ChainState, SimOptions};
+use crate::sensitivity::length_scale;
+
+/// The kind of motion of a recorded window (see the [module docs](self)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    /// Repeats with a period.
+    Periodic,
+    /// Still converging.
+    Settling,
+    /// Largest Lyapunov exponent indistinguishable from 0.
+    Quasiperiodic,
+    /// Largest Lyapunov exponent positive beyond its error bar.
+    Chaotic,
+}
+
+impl Motion {
+    /// `periodic`, `settling`, `quasiperiodic` or `chaotic`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Motion::Periodic => "periodic",
+            Motion::Settling => "settling",
+            Motion::Quasiperiodic => "quasiperiodic",
+            Motion::Chaotic => "chaotic",
+        }
+    }
+}
+
+impl std::fmt::Display for Motion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A point's motion and how it was found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionReport {
+    /// The kind of motion.
+    pub motion: Motion,
+    /// Periods run before the recorded window.
+    pub settle_periods: u64,
+    /// How the settling ended.
+    pub settle_ending: SettleEnding,
+    /// Relative mismatch of the period test at the detected (or closest) period
+    /// ([`Periodicity`]); NaN with too few recorded periods.
+    pub residual: f64,
+    /// The period the residual is measured at (the detected one, or the closest candidate).
+    pub residual_period: usize,
+    /// Decay factor per excitation period of the return distances (< 1: converging): from
+    /// the geometric fit of the recorded window where that converges, else from the
+    /// settling's last fit, or `exp(λ₁T)` for a motion settling by its Lyapunov exponent.
+    pub rate: Option<f64>,
+    /// For a settling motion: periods still needed at that rate before a recorded window
+    /// would show the period (the return distance down to the tolerance, then the window
+    /// the period test reads).
+    pub periods_needed: Option<f64>,
+    /// After Newton shooting finished the settling: the orbit's period and residual.
+    pub shot: Option<(u32, f64)>,
+    /// The largest Lyapunov exponent and its batch-means standard error, 1/s, where
+    /// computed.
+    pub lyapunov: Option<(f64, f64)>,
+    /// The recorded section's [`closed_curve_ratio`] (scaled positions and velocities), for
+    /// a quasi-periodic or chaotic motion.
+    pub curve_ratio: Option<f64>,
+}
+
+/// Error bars a Lyapunov exponent must clear to count as nonzero.
+const SIGMAS: f64 = 3.0;
+
+/// A recorded window: its stroboscopic samples (t = nT, row-major like
+/// [`PointResult::strobe`]), the period test's verdict on them and the state at its end.
+#[derive(Debug, Clone, Copy)]
+pub struct Window<'a> {
+    /// Positions x_i, m.
+    pub positions: &'a [f64],
+    /// Velocities, m/s.
+    pub velocities: &'a [f64],
+    /// The period test's verdict (`None`: too few samples).
+    pub periodicity: Option<Periodicity>,
+    /// State at the window's end (where a Lyapunov run starts).
+    pub final_state: &'a ChainState,
+}
+
+impl<'a> Window<'a> {
+    /// The recorded window of a sweep point.
+    pub fn of(result: &'a PointResult) -> Self {
+        Window {
+            positions: &result.strobe,
+            velocities: &result.strobe_velocities,
+            periodicity: result.periodicity,
+            final_state: &result.final_state,
+        }
+    }
+}
+
+/// Classifies a recorded `window` of `params` (see the [module docs](self)); `settled` is
+/// the adaptive settling before it, `None` after a fixed transient of
+/// `options.transient_periods`; `spectrum` the Lyapunov spectrum over the window if one was
+/// computed. Without one, a window that is neither periodic nor settling gets the spectrum
+/// over `options.recorded_periods` periods from its final state (mechanics only).
+pub fn classify(
+    params: &ChainParams,
+    sim_options: &SimOptions,
+    options: &PointOptions,
+    window: Window<'_>,
+    settled: Option<&Settled>,
+    spectrum: Option<&LyapunovSpectrum>,
+) -> MotionReport {
+    let n = params.len();
+    let test_window = options.period_options().samples_needed() as f64;
+    let mut report = MotionReport {
+        motion: Motion::Settling,
+        settle_periods: settled.map_or(options.transient_periods, |s| s.periods),
+        settle_ending: settled.map_or(SettleEnding::Fixed, |s| s.ending),
+        residual: f64::NAN,
+        residual_period: 0,
+        rate: settled
+            .and_then(|s| s.convergence)
+            .filter(|c| c.converging())
+            .map(|c| c.rate()),
+        periods_needed: None,
+        shot: settled.and_then(|s| s.shot),
+        lyapunov: None,
+        curve_ratio: None,
+    };
+    let (closest, mismatch) = match window.periodicity {
+        Some(Periodicity::Periodic { period, mismatch }) => {
+            report.motion = Motion::Periodic;
+            report.residual = mismatch;
+            report.residual_period = period;
+            return report;
+        }
+        Some(Periodicity::NonPeriodic {
+            closest_period,
+            mismatch,
+        }) => (closest_period, mismatch),
+        None => (1, f64::NAN),
+    };
+    report.residual = mismatch;
+    report.residual_period = closest;
+    let scale = amplitude(window.positions);
+    let tolerance = options.period_tolerance;
+    let states: Vec<f64> = section_states(window.positions, window.velocities, params).collect();
+    let max_lag = options
+        .period_options()
+        .max_period
+        .min(states.len() / (6 * n))
+        .max(1);
+    if let (_, Some(fit)) = converging_lag(&states, 2 * n, max_lag, scale, closest)
+        && fit.converging()
+    {
+        report.rate = Some(fit.rate());
+        report.periods_needed = fit.samples_needed(tolerance).map(|p| p + test_window);
+        return report;
+    }
+    let spectrum = match spectrum {
+        Some(s) => Some(s.clone()),
+        None => {
+            let mut spec = RunSpec::new(params.clone(), WARMUP + options.recorded_periods);
+            spec.initial = window.final_state.clone();
+            spec.options = sim_options.clone();
+            spec.transient_periods = WARMUP;
+            lyapunov_spectrum(&spec, &LyapunovOptions::default(), &mut ())
+                .ok()
+                .and_then(|r| r.spectrum.ok())
+        }
+    };
+    report.curve_ratio = section_curve_ratio(params, window);
+    let Some(s) = spectrum else {
+        // No period could be averaged (every one met a grazing or simultaneous impact): the
+        // section's shape is all there is to go by.
+        report.motion = match report.curve_ratio {
+            Some(r) if r < crate::analysis::CLOSED_CURVE_RATIO => Motion::Quasiperiodic,
+            _ => Motion::Chaotic,
+        };
+        return report;
+    };
+    let (largest, se) = (s.largest(), s.largest_spread());
+    report.lyapunov = Some((largest, se));
+    let se = if se.is_finite() { se } else { 0.0 };
+    report.motion = if largest - SIGMAS * se > 0.0 {
+        Motion::Chaotic
+    } else if largest + SIGMAS * se < 0.0 {
+        let per_period = largest * params.period();
+        report.rate = Some(per_period.exp());
+        report.periods_needed = (mismatch.is_finite() && mismatch > 0.0)
+            .then(|| ((tolerance / mismatch).ln() / per_period).max(0.0) + test_window);
+        Motion::Settling
+    } else {
+        Motion::Quasiperiodic
+    };
+    report
+}
+
+/// Periods the tangent vectors of a classifying Lyapunov run align over before averaging.
+pub(super) const WARMUP: u64 = 20;
+
+/// The [`closed_curve_ratio`] of the recorded section, positions over L = Σδ + A and
+/// velocities over L·ω.
+fn section_curve_ratio(params: &ChainParams, window: Window<'_>) -> Option<f64> {
+    let n = params.len();
+    let l = length_scale(params);
+    let v = l * params.omega();
+    let points: Vec<f64> = window
+        .positions
+        .chunks_exact(n)
+        .zip(window.velocities.chunks_exact(n))
+        .flat_map(|(x, u)| {
+            x.iter()
+                .map(|x| x / l)
+                .chain(u.iter().map(|u| u / v))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    closed_curve_ratio(&points, 2 * n)
+}
