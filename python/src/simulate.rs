@@ -9,8 +9,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibrotribo::electrical::LoadKind;
-use vibrotribo::report::{failure_text, run_summary};
-use vibrotribo::study::{Recording, simulate as run};
+use vibrotribo::report::{failure_text, motion_json, run_summary};
+use vibrotribo::study::{Ending, Recording, RunMotion, simulate as run};
 
 use crate::config::config_of;
 use crate::convert::{array1, array2, json_to_py};
@@ -29,12 +29,23 @@ pub fn simulate<'py>(
     let config = config_of(config)?;
     let mut spec = config.sampled_run_spec(mechanics_only);
     spec.breakdown_check = true;
-    let (outcome, recording, elapsed, signals) = py.detach(|| {
+    let mut motion = RunMotion::new(&spec).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let (outcome, recording, elapsed, signals, report) = py.detach(|| {
         let mut recording = Recording::new(samples);
         let mut signals = Signals::new();
         let started = Instant::now();
-        let outcome = run(&spec, &mut (&mut recording, &mut signals));
-        (outcome, recording, started.elapsed().as_secs_f64(), signals)
+        let outcome = run(&spec, &mut (&mut recording, (&mut signals, motion.observer())));
+        // The motion after the transient, as the command line's summary.json reports it.
+        let report = outcome.as_ref().ok().and_then(|o| {
+            (o.ending == Ending::Completed).then(|| motion.finish(&spec, &o.final_state, None))
+        });
+        (
+            outcome,
+            recording,
+            started.elapsed().as_secs_f64(),
+            signals,
+            report,
+        )
     });
     signals.result()?;
     let outcome = outcome.map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -69,7 +80,9 @@ pub fn simulate<'py>(
     events.set_item("x", array2(py, e.positions, n)?)?;
     events.set_item("v", array2(py, e.velocities, n)?)?;
     out.set_item("events", events)?;
-    let summary = run_summary(&config, &spec, &outcome, elapsed);
+    let mut summary = run_summary(&config, &spec, &outcome, elapsed);
+    summary["settle"] = "fixed".into();
+    summary["motion"] = motion_json(report.as_ref());
     out.set_item("summary", json_to_py(py, &summary)?)?;
     out.set_item("error", failure_text(&outcome))?;
     Ok(out)

@@ -6,12 +6,11 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde_json::json;
-use vibrotribo::analysis::{StroboscopicOptions, StroboscopicSection, detect_period};
 use vibrotribo::config::Config;
 use vibrotribo::electrical::{HarvesterParams, Load, LoadKind, TransducerMode};
 use vibrotribo::study::{
-    Ending, Mechanics, Motion, MotionReport, PointOptions, RunObserver, RunOutcome, RunSpec, Sample,
-    SettleMode, Settled, Window, classify, settle, simulate,
+    Ending, Motion, MotionReport, RunMotion, RunObserver, RunOutcome, RunSpec, Sample, SettleMode, settle,
+    simulate,
 };
 use vibrotribo::{ChainParams, Event, StateView};
 
@@ -178,20 +177,22 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         None => None,
     };
     let started = Instant::now();
-    let point_options = PointOptions {
-        transient_periods: spec.transient_periods,
-        recorded_periods: spec.periods.saturating_sub(spec.transient_periods).max(1),
-        settle: args.settle.mode(args.settle_cap),
-        classify: true,
-        ..PointOptions::default()
-    };
-    let settled = match &point_options.settle {
+    let mut run_motion = RunMotion::new(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mode = args.settle.mode(args.settle_cap);
+    run_motion.options_mut().settle = mode;
+    let settled = match &mode {
         SettleMode::Auto(auto) => {
             if args.settle_cap == 0 {
                 anyhow::bail!("--settle-cap must be at least 1");
             }
-            let s = settle(&spec.chain, &spec.initial, &spec.options, &point_options, auto)
-                .map_err(|e| anyhow::anyhow!("while settling: {e}"))?;
+            let s = settle(
+                &spec.chain,
+                &spec.initial,
+                &spec.options,
+                run_motion.options(),
+                auto,
+            )
+            .map_err(|e| anyhow::anyhow!("while settling: {e}"))?;
             spec.initial = s.state.clone();
             Some(s)
         }
@@ -200,34 +201,23 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut watch = Watch {
         progress: Progress::new(spec.periods, "periods", args.quiet),
     };
-    let mut strobe = Mechanics::new(
-        StroboscopicSection::new(
-            spec.chain.len(),
-            spec.chain.period(),
-            StroboscopicOptions {
-                phase_time: 0.0,
-                transient_periods: spec.transient_periods + 1,
-            },
-        )
-        .map_err(|e| anyhow::anyhow!("{e}"))?,
-    );
     let outcome = match files.as_mut() {
-        Some(f) => simulate(&spec, &mut (f, (&mut watch, &mut strobe)))?,
-        None => simulate(&spec, &mut (&mut watch, &mut strobe))?,
+        Some(f) => simulate(&spec, &mut (f, (&mut watch, run_motion.observer())))?,
+        None => simulate(&spec, &mut (&mut watch, run_motion.observer()))?,
     };
     watch.progress.finish();
     let motion = (outcome.ending == Ending::Completed)
-        .then(|| motion_of(&spec, &point_options, &strobe.inner, &outcome, settled.as_ref()));
+        .then(|| run_motion.finish(&spec, &outcome.final_state, settled.as_ref()));
     let elapsed = started.elapsed().as_secs_f64();
     let failure = failure_error(&outcome);
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
         let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
         summary["settle"] = json!(args.settle.as_str());
-        if let SettleMode::Auto(a) = &point_options.settle {
+        if let SettleMode::Auto(a) = &run_motion.options().settle {
             summary["settle_cap_periods"] = json!(a.cap_periods);
         }
-        summary["motion"] = motion_json(motion.as_ref());
+        summary["motion"] = vibrotribo::report::motion_json(motion.as_ref());
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
             crate::plots::analyze_run(dir, None)?;
@@ -256,60 +246,6 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .into());
     }
     Ok(())
-}
-
-/// The motion after the transient of a run of `spec` (its stroboscopic samples `strobe`)
-/// that ended in `outcome`, after the settling `settled`.
-fn motion_of(
-    spec: &RunSpec,
-    options: &PointOptions,
-    strobe: &StroboscopicSection,
-    outcome: &RunOutcome,
-    settled: Option<&Settled>,
-) -> MotionReport {
-    let n = spec.chain.len();
-    let popts = options.period_options();
-    let periodicity = (strobe.len() >= popts.samples_needed())
-        .then(|| detect_period(&strobe.positions, n, &popts).ok())
-        .flatten();
-    classify(
-        &spec.chain,
-        &spec.options,
-        options,
-        Window {
-            positions: &strobe.positions,
-            velocities: &strobe.velocities,
-            periodicity,
-            final_state: &outcome.final_state,
-        },
-        settled,
-        None,
-    )
-}
-
-/// summary.json's `motion` object (null for a run that did not complete): `motion`,
-/// `period` (0 unless periodic), `residual`, `residual_period`, `settle_periods`,
-/// `settle_ending`, `settle_rate`, `settle_periods_needed`, `newton` (period and residual
-/// of a shot orbit), `lyapunov_max_1_s`, `lyapunov_spread_1_s`, `section_curve_ratio`.
-fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
-    let Some(m) = m else {
-        return serde_json::Value::Null;
-    };
-    let finite = |x: f64| x.is_finite().then_some(x);
-    json!({
-        "motion": m.motion.as_str(),
-        "period": if m.motion == Motion::Periodic { m.residual_period } else { 0 },
-        "residual": finite(m.residual),
-        "residual_period": m.residual_period,
-        "settle_periods": m.settle_periods,
-        "settle_ending": m.settle_ending.as_str(),
-        "settle_rate": m.rate,
-        "settle_periods_needed": m.periods_needed,
-        "newton": m.shot.map(|(p, r)| json!({"period": p, "residual": r})),
-        "lyapunov_max_1_s": m.lyapunov.map(|l| l.0).and_then(finite),
-        "lyapunov_spread_1_s": m.lyapunov.map(|l| l.1).and_then(finite),
-        "section_curve_ratio": m.curve_ratio,
-    })
 }
 
 fn print_motion(m: &MotionReport) {

@@ -9,7 +9,7 @@ use serde_json::json;
 
 use crate::config::Config;
 use crate::electrical::LoadKind;
-use crate::study::{Ending, RunOutcome, RunSpec};
+use crate::study::{Ending, Motion, MotionReport, RunOutcome, RunSpec};
 
 /// Why a run failed, as one line: `simulation stopped after N complete periods: <error>:
 /// <its source>: …` (the error and the chain of its sources, each after `: `).
@@ -110,6 +110,31 @@ pub fn run_summary(
     obj.insert("interrupted".into(), json!(outcome.ending == Ending::Stopped));
     obj.insert("error".into(), json!(failure_text(outcome)));
     out
+}
+
+/// summary.json's `motion` object (null for a run that did not complete): `motion`,
+/// `period` (0 unless periodic), `residual`, `residual_period`, `settle_periods`,
+/// `settle_ending`, `settle_rate`, `settle_periods_needed`, `newton` (period and residual
+/// of a shot orbit), `lyapunov_max_1_s`, `lyapunov_spread_1_s`, `section_curve_ratio`.
+pub fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
+    let Some(m) = m else {
+        return serde_json::Value::Null;
+    };
+    let finite = |x: f64| x.is_finite().then_some(x);
+    json!({
+        "motion": m.motion.as_str(),
+        "period": if m.motion == Motion::Periodic { m.residual_period } else { 0 },
+        "residual": finite(m.residual),
+        "residual_period": m.residual_period,
+        "settle_periods": m.settle_periods,
+        "settle_ending": m.settle_ending.as_str(),
+        "settle_rate": m.rate,
+        "settle_periods_needed": m.periods_needed,
+        "newton": m.shot.map(|(p, r)| json!({"period": p, "residual": r})),
+        "lyapunov_max_1_s": m.lyapunov.map(|l| l.0).and_then(finite),
+        "lyapunov_spread_1_s": m.lyapunov.map(|l| l.1).and_then(finite),
+        "section_curve_ratio": m.curve_ratio,
+    })
 }
 
 #[cfg(test)]

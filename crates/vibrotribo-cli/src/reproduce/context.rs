@@ -105,8 +105,9 @@ impl Ctx {
             mechanics_only,
             period_tolerance: 1e-4,
             floquet: false,
-            // The report's numbers as they were; the motions are classified all the same.
-            settle: crate::sweep::Settle::Fixed,
+            // Settled before recording, so that "not periodic" is a finding, not a short
+            // transient; the motions are classified.
+            settle: crate::sweep::Settle::Auto,
             settle_cap: crate::sweep::SETTLE_CAP,
             threads: None,
             quiet: true,

@@ -8,7 +8,7 @@ use vibrotribo::study::PointResult;
 
 use super::context::{Ctx, Verdict};
 use super::draw::{both, closing_speeds, impact_figure, lines, orbit_figure, return_map, running_power};
-use super::runs::{arr, config, describe_ranges, f, run_series, sweep, with};
+use super::runs::{arr, config, describe_motions, f, motion_of, run_series, sweep, with};
 use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
@@ -153,21 +153,15 @@ pub(super) fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
         .enumerate()
         .max_by(|a, b| a.1.total_cmp(b.1))
         .unwrap_or((0, &0.0));
-    let np: Vec<f64> = values
-        .iter()
-        .zip(&res)
-        .filter(|(_, r)| r.period() == 0)
-        .map(|(v, _)| *v)
-        .collect();
     let at4 = res[values.iter().position(|v| *v >= 4.0 - 1e-9).unwrap_or(0)].impacts_per_period[0];
     ctx.finding(
         "14–15",
         "At Ω = 0.72 (m1 = m3 = 50 g) the optimal mass ratio is about 3.5; non-periodic for R_m ≈ 3.06–3.64; three m1–m2 impacts per cycle at R_m = 4.",
         format!(
-            "On R_m ∈ [1.5, 8] power is largest at R_m = {best_r:.2} ({}); the largest V12 (the paper's criterion) is at R_m = {:.2}; non-periodic values: {}; m1–m2 impacts per period at R_m = 4: {at4:.2}.",
+            "On R_m ∈ [1.5, 8] power is largest at R_m = {best_r:.2} ({}); the largest V12 (the paper's criterion) is at R_m = {:.2}; not periodic after settling: {}; m1–m2 impacts per period at R_m = 4: {at4:.2}.",
             si(best_p, "W"),
             values[vi],
-            describe_ranges(&np, values[1] - values[0])
+            describe_motions(&values, &res, values[1] - values[0])
         ),
         Verdict::of(
             usize::from((best_r - 3.5).abs() < 0.3) + usize::from((at4 - 3.0).abs() < 0.01),
@@ -448,6 +442,7 @@ pub(super) fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         )?);
     }
     let period_421 = p.period();
+    let motion_421 = motion_of(&p);
     ctx.figure(
         "19",
         "Poincaré sections at Ω = 0.30, R_m = 4.21",
@@ -462,13 +457,10 @@ pub(super) fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         "18–19",
         "At Ω = 0.30 a period-doubling cascade with non-periodic windows as R_m varies; non-periodic at R_m = 4.21.",
         format!(
-            "Period-doubling sequences (runs of period p → 2p → 4p along R_m): {}; non-periodic values: {}; R_m = 4.21: {}.",
+            "Period-doubling sequences (runs of period p → 2p → 4p along R_m): {}; not periodic after settling: {}; R_m = 4.21: {}.",
             if cascades.is_empty() { "none".to_string() } else { cascades.join("; ") },
-            describe_ranges(
-                &values.iter().zip(&res).filter(|(_, r)| r.period() == 0).map(|(v, _)| *v).collect::<Vec<_>>(),
-                values[1] - values[0]
-            ),
-            if period_421 == 0 { "non-periodic".to_string() } else { format!("period {period_421}") }
+            describe_motions(&values, &res, values[1] - values[0]),
+            if period_421 == 0 { motion_421.to_string() } else { format!("period {period_421}") }
         ),
         if doubling && non_periodic && period_421 == 0 {
             Verdict::Agrees

@@ -186,6 +186,34 @@ pub(super) fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
+/// The motion of a point that is not periodic after settling: `chaotic`, `quasiperiodic`
+/// or `settling` (`non-periodic` if it was not classified).
+pub(super) fn motion_of(r: &PointResult) -> &'static str {
+    r.motion.as_ref().map_or("non-periodic", |m| m.motion.as_str())
+}
+
+/// The values of `values` whose point is not periodic, by motion (`chaotic: 1.2–1.4;
+/// quasiperiodic: …`), or `none`.
+pub(super) fn describe_motions(values: &[f64], results: &[PointResult], step: f64) -> String {
+    let mut parts = Vec::new();
+    for kind in ["chaotic", "quasiperiodic", "settling", "non-periodic"] {
+        let at: Vec<f64> = values
+            .iter()
+            .zip(results)
+            .filter(|(_, r)| r.period() == 0 && motion_of(r) == kind)
+            .map(|(v, _)| *v)
+            .collect();
+        if !at.is_empty() {
+            parts.push(format!("{kind} at {}", describe_ranges(&at, step)));
+        }
+    }
+    if parts.is_empty() {
+        "none".into()
+    } else {
+        parts.join("; ")
+    }
+}
+
 pub(super) fn describe_ranges(values: &[f64], step: f64) -> String {
     if values.is_empty() {
         return "none".into();

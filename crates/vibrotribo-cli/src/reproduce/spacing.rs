@@ -7,7 +7,7 @@ use vibrotribo::study::PointResult;
 
 use super::context::{Ctx, Verdict};
 use super::draw::{closing_speeds, d1_figures, impact_figure, lines, orbit_figure, return_map, scatter};
-use super::runs::{arr, config, f, mean, run_series, sweep, with};
+use super::runs::{arr, config, f, mean, motion_of, run_series, sweep, with};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
 use crate::sweep::RunArgs;
@@ -222,7 +222,7 @@ pub(super) fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
     for ((r, claim), p) in points.iter().zip(&res) {
         let period = p.period();
         let ours = if period == 0 {
-            "non-periodic".to_string()
+            format!("not periodic ({})", motion_of(p))
         } else {
             format!("period {period}")
         };
