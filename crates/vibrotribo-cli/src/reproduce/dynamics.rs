@@ -319,7 +319,7 @@ fn basins(ctx: &Ctx, name: &str, sets: &[&str], x: (f64, f64)) -> Result<(usize,
             format!(
                 "attractor {} ({period}, {} impacts per period): {} of the starts",
                 get(0),
-                get(5),
+                get(5).parse::<f64>().map_or("?".into(), |v| format!("{v:.2}")),
                 get(3)
                     .parse::<f64>()
                     .map_or("?".into(), |v| format!("{:.0} %", 100.0 * v))
