@@ -5,72 +5,10 @@
 
 mod common;
 
+use common::fd::{FdComparison, compare_with_fd};
 use common::{Lcg, random_chain};
-use nalgebra::{DMatrix, DVector};
-use vibrotribo::sensitivity::{
-    Horizon, SensitivityError, SensitivityOptions, flow_map, length_scale, speed_scale, state_from_vector,
-    state_vector,
-};
-use vibrotribo::{
-    ChainParams, ChainState, Event, EventKind, EventLog, SimOptions, Simulator, Stop, StopFrame, Stops,
-};
-
-fn run(params: &ChainParams, z: &DVector<f64>, horizon: Horizon) -> Option<(DVector<f64>, Vec<Event>)> {
-    let mut sim = Simulator::new(params, &state_from_vector(z.as_slice()), SimOptions::default()).ok()?;
-    let mut log = EventLog::default();
-    sim.run_until(horizon.end_time(params), &mut log).ok()?;
-    Some((
-        state_vector(&sim.state()),
-        log.events.iter().map(|e| e.event).collect(),
-    ))
-}
-
-fn signature(events: &[Event]) -> Vec<(EventKind, usize)> {
-    events.iter().map(|e| (e.kind, e.contact)).collect()
-}
-
-/// Φ against Richardson-extrapolated central differences (relative step `h_rel` of the state
-/// scales), in scaled units: (error, the differences' own uncertainty), or `None` if a step
-/// changes the event sequence.
-fn compare_with_fd(
-    params: &ChainParams,
-    state: &ChainState,
-    horizon: Horizon,
-    phi: &DMatrix<f64>,
-    events: &[Event],
-    h_rel: f64,
-) -> Option<(f64, f64)> {
-    let n = params.len();
-    let (l, v) = (length_scale(params), speed_scale(params));
-    let scale = |i: usize| if i < n { l } else { v };
-    let z0 = state_vector(state);
-    let reference = signature(events);
-    let (mut error, mut uncertainty, mut phi_max) = (0.0f64, 0.0f64, 0.0f64);
-    for j in 0..2 * n {
-        let h = h_rel * scale(j);
-        let mut ends = Vec::with_capacity(4);
-        for step in [h, -h, 2.0 * h, -2.0 * h] {
-            let mut z = z0.clone();
-            z[j] += step;
-            let (end, ev) = run(params, &z, horizon)?;
-            if signature(&ev) != reference {
-                return None;
-            }
-            ends.push(end);
-        }
-        for i in 0..2 * n {
-            let d1 = (ends[0][i] - ends[1][i]) / (2.0 * h);
-            let d2 = (ends[2][i] - ends[3][i]) / (4.0 * h);
-            let fd = (d1 + (d1 - d2) / 3.0) * scale(j) / scale(i);
-            let exact = phi[(i, j)] * scale(j) / scale(i);
-            phi_max = phi_max.max(exact.abs());
-            error = error.max((fd - exact).abs());
-            uncertainty = uncertainty.max(((d1 - d2) * scale(j) / scale(i)).abs());
-        }
-    }
-    let norm = phi_max.max(1.0);
-    Some((error / norm, uncertainty / norm))
-}
+use vibrotribo::sensitivity::{Horizon, SensitivityError, SensitivityOptions, flow_map};
+use vibrotribo::{ChainParams, ChainState, EventKind, SimOptions, Stop, StopFrame, Stops};
 
 /// A random chain of 1–3 masses with random stops (gaps 0–10 mm, restitution 0–0.9, either
 /// frame) and a random state that leaves them open.
@@ -167,8 +105,10 @@ fn sweep(samples: usize, seed: u64) -> Tally {
             }
             Err(e) => panic!("sample {s}: {e}\n{params:?}\n{state:?}"),
         };
-        let Some((error, uncertainty)) =
-            compare_with_fd(&params, &state, horizon, &map.stm, &map.events, 1e-6)
+        let Some(FdComparison {
+            error,
+            fd_uncertainty: uncertainty,
+        }) = compare_with_fd(&params, &state, horizon, &map.stm, &map.events, 1e-6)
         else {
             tally.skipped += 1;
             continue;

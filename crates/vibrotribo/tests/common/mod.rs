@@ -2,6 +2,8 @@
 //! `ode_solvers`, not the closed form under test) and reference-data loading.
 #![allow(dead_code)]
 
+pub mod fd;
+
 use ode_solvers::{DVector, Dop853, OutputType, System};
 use vibrotribo::{ChainParams, ChainState, Excitation, Frequency};
 
