@@ -1,5 +1,5 @@
-"""examples/python/quickstart.py (the paper's Fig. 22) runs and writes its picture (where
-matplotlib is installed; the test environment of scripts/test does not install it)."""
+"""examples/python/quickstart.py (the paper's Fig. 22) runs and writes its picture
+(scripts/test installs matplotlib into its environment; elsewhere the test needs it)."""
 
 import runpy
 
