@@ -229,16 +229,13 @@ pub fn run(args: &MapArgs) -> Result<()> {
 
 /// Merges the shards of a map (`vibrotribo merge`).
 pub fn merge(args: &MergeArgs) -> Result<()> {
-    // map.csv: x, y, then the point columns: 7, one per contact, the Floquet column and the
-    // motion columns.
+    // map.csv: x, y, then the point columns.
     let floquet = floquet_of(&args.shards[0], "map.json")?;
-    let contacts = header_len(&args.shards[0].join("map.csv"))?
-        .saturating_sub(2 + 7 + usize::from(floquet) + vibrotribo::sweep::MOTION_COLUMNS.len());
-    let columns = PointColumns {
-        contacts,
+    let columns = PointColumns::from_width(
+        header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2),
         floquet,
-        lyapunov: false,
-    };
+        false,
+    );
     let keys = |m: &serde_json::Value| -> Result<Vec<String>> {
         let axis = |a: &str| -> Result<Vec<f64>> {
             m[a]["values"]

@@ -238,6 +238,24 @@ pub struct PointColumns {
 const LYAPUNOV_COLUMNS: [&str; 2] = ["lyapunov_max_1_s", "lyapunov_spread_1_s"];
 
 impl PointColumns {
+    /// The columns of a file whose point columns are `width` wide (its header less its key
+    /// columns), with or without the Floquet and Lyapunov columns: the contacts are what the
+    /// other columns leave.
+    pub fn from_width(width: usize, floquet: bool, lyapunov: bool) -> Self {
+        let fixed = PointColumns {
+            contacts: 0,
+            floquet,
+            lyapunov,
+        }
+        .names()
+        .len();
+        PointColumns {
+            contacts: width.saturating_sub(fixed),
+            floquet,
+            lyapunov,
+        }
+    }
+
     /// The column names.
     pub fn names(&self) -> Vec<String> {
         let mut cols = point_columns(self.contacts);

@@ -706,18 +706,12 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
         let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
         let floquet = floquet_of(first, "sweep.json")?;
         let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
-        // summary.csv: param and the point columns (7 + contacts, the Floquet column, the
-        // two Lyapunov columns, the motion columns).
-        let extra = 1
-            + 7
-            + usize::from(floquet)
-            + 2 * usize::from(lyapunov)
-            + vibrotribo::sweep::MOTION_COLUMNS.len();
-        let columns = PointColumns {
-            contacts: header_len(&first.join("summary.csv"))?.saturating_sub(extra),
+        // summary.csv: param, then the point columns.
+        let columns = PointColumns::from_width(
+            header_len(&first.join("summary.csv"))?.saturating_sub(1),
             floquet,
             lyapunov,
-        };
+        );
         crate::job::merge(
             &args.shards,
             &args.out,

@@ -4,16 +4,13 @@ use anyhow::Result;
 
 use super::context::{Ctx, Verdict};
 use super::draw::{d1_figures, impact_figure, lines, orbit_figure};
-use super::runs::{arr, config, describe_ranges, mean, run_series, sweep, with};
+use super::runs::{chatter_case, describe_ranges, mean, run_series, sweep, with};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
 use vibrotribo::sweep::grid;
 
 pub(super) fn figs_20_25(ctx: &mut Ctx) -> Result<()> {
-    let base = config(&[
-        ("oscillator.masses", arr(&[0.05, 0.15, 0.05])),
-        ("oscillator.gaps", arr(&[0.005, 0.005])),
-    ])?;
+    let base = chatter_case()?;
     let values = grid(0.3, 1.0, ctx.budget.coarse);
     let res = sweep(ctx, &base, "omega_ratio", &values, false)?;
     let a = orbit_figure(

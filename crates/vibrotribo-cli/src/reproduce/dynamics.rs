@@ -4,18 +4,20 @@
 //! the average power of Figs. 14–16's candidates with batch-means error bars, the basins
 //! behind Fig. 7's jump, and the expected power of an unknown start across Fig. 20's Ω.
 
+use std::cmp::Ordering;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
+use vibrotribo::analysis::batch_means_se;
 use vibrotribo::config::Config;
 use vibrotribo::lyapunov::{LyapunovOptions, LyapunovSpectrum};
-use vibrotribo::study::{PointOptions, PointResult, lyapunov_spectrum};
+use vibrotribo::study::{PointOptions, PointResult, exponent_sign, lyapunov_spectrum};
 use vibrotribo::sweep::{PointRunner, grid};
 
 use super::context::{Ctx, Verdict};
 use super::draw::lines;
-use super::runs::{arr, config, f, with};
+use super::runs::{arr, chatter_case, config, f, with};
 use crate::attractors::AttractorsArgs;
 use crate::basins::{BasinsArgs, GridSize};
 use crate::config::ConfigArgs;
@@ -23,9 +25,10 @@ use crate::output::{read_csv, si};
 use crate::plot::{Figure, Scale};
 use crate::progress::check_interrupt;
 
-/// How a motion's largest Lyapunov exponent classifies it: clearly positive (beyond three
-/// batch-means standard errors) is chaotic, clearly negative a stable periodic orbit, and
-/// within the error bar of 0 neutral (a quasi-periodic torus).
+/// How a motion's largest Lyapunov exponent classifies it (the sweeps' rule,
+/// [`exponent_sign`]): clearly positive (beyond three batch-means standard errors) is
+/// chaotic, clearly negative a stable periodic orbit, and within the error bar of 0 neutral
+/// (a quasi-periodic torus).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Motion {
     Chaotic,
@@ -35,13 +38,10 @@ enum Motion {
 
 impl Motion {
     fn of(s: &LyapunovSpectrum) -> Self {
-        let (l, e) = (s.largest(), s.largest_spread());
-        if l > 3.0 * e && l > 0.0 {
-            Motion::Chaotic
-        } else if l < -3.0 * e {
-            Motion::Periodic
-        } else {
-            Motion::Quasiperiodic
+        match exponent_sign(s.largest(), s.largest_spread()) {
+            Ordering::Greater => Motion::Chaotic,
+            Ordering::Less => Motion::Periodic,
+            Ordering::Equal => Motion::Quasiperiodic,
         }
     }
 
@@ -145,10 +145,7 @@ fn windows(ctx: &mut Ctx) -> Result<()> {
 
 /// The largest Lyapunov exponent across the chatter range of Fig. 20.
 fn chatter_range(ctx: &mut Ctx) -> Result<()> {
-    let base = config(&[
-        ("oscillator.masses", arr(&[0.05, 0.15, 0.05])),
-        ("oscillator.gaps", arr(&[0.005, 0.005])),
-    ])?;
+    let base = chatter_case()?;
     let values = grid(0.3, 0.65, if ctx.quick { 36 } else { 71 });
     let options = PointOptions {
         transient_periods: ctx.budget.transient,
@@ -216,10 +213,10 @@ fn batch_power(
         powers.push(r.average_power_w.context("no average power")?);
         state = r.final_state;
     }
-    let n = powers.len() as f64;
-    let mean = powers.iter().sum::<f64>() / n;
-    let var = powers.iter().map(|p| (p - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    Ok((mean, (var / n).sqrt()))
+    let mean = powers.iter().sum::<f64>() / powers.len() as f64;
+    // Each window is one batch.
+    let se = batch_means_se(&powers, batches).context("fewer than two windows")?;
+    Ok((mean, se))
 }
 
 /// Figs. 14–16's candidates for the optimal mass ratio at Ω = 0.72, with error bars.
@@ -403,10 +400,7 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
         "oscillator.gaps=[0.005,0.005]".to_string(),
     ];
     let args = AttractorsArgs {
-        input: ConfigArgs {
-            config: None,
-            set: set.clone(),
-        },
+        input: ConfigArgs { config: None, set },
         param: "omega_ratio".into(),
         from: 0.55,
         to: 0.80,
@@ -425,10 +419,7 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
     };
     crate::attractors::run(&args)?;
     let (omega, expected, se) = read_expected(&dir.join("expected_power.csv"))?;
-    let base = config(&[
-        ("oscillator.masses", arr(&[0.05, 0.15, 0.05])),
-        ("oscillator.gaps", arr(&[0.005, 0.005])),
-    ])?;
+    let base = chatter_case()?;
     let from_rest: Vec<f64> = super::runs::sweep(ctx, &base, "omega_ratio", &omega, false)?
         .iter()
         .map(|r| r.average_power_w.unwrap_or(f64::NAN))

@@ -22,6 +22,14 @@ pub(super) fn config(sets: &[(&str, Value)]) -> Result<Config> {
 }
 
 /// `config` with the numeric `key` set to `value`.
+/// The paper's chatter case (Sect. 4.4, Figs. 20–25): m1 = m3 = 50 g, R_m = 3, δ1 = δ2 = 5 mm.
+pub(super) fn chatter_case() -> Result<Config> {
+    config(&[
+        ("oscillator.masses", arr(&[0.05, 0.15, 0.05])),
+        ("oscillator.gaps", arr(&[0.005, 0.005])),
+    ])
+}
+
 pub(super) fn with(config: &Config, key: &str, value: f64) -> Result<Config> {
     crate::config::with(config, key, value)
 }

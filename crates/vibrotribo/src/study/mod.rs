@@ -20,7 +20,7 @@ mod simulate;
 
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
-pub use motion::{Motion, MotionReport, Window, classify};
+pub use motion::{Motion, MotionReport, Window, classify, exponent_sign};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};

@@ -25,6 +25,8 @@
 //! (over the recorded window when the settling already found the motion irregular, else by
 //! a run of the same length from the final state), so periodic points cost nothing extra.
 
+use std::cmp::Ordering;
+
 use super::lyapunov::lyapunov_spectrum;
 use super::point::{PointOptions, PointResult};
 use super::settings::RunSpec;
@@ -210,19 +212,33 @@ pub fn classify(
     };
     let (largest, se) = (s.largest(), s.largest_spread());
     report.lyapunov = Some((largest, se));
-    let se = if se.is_finite() { se } else { 0.0 };
-    report.motion = if largest - SIGMAS * se > 0.0 {
-        Motion::Chaotic
-    } else if largest + SIGMAS * se < 0.0 {
-        let per_period = largest * params.period();
-        report.rate = Some(per_period.exp());
-        report.periods_needed = (mismatch.is_finite() && mismatch > 0.0)
-            .then(|| ((tolerance / mismatch).ln() / per_period).max(0.0) + test_window);
-        Motion::Settling
-    } else {
-        Motion::Quasiperiodic
+    report.motion = match exponent_sign(largest, se) {
+        Ordering::Greater => Motion::Chaotic,
+        Ordering::Less => {
+            let per_period = largest * params.period();
+            report.rate = Some(per_period.exp());
+            report.periods_needed = (mismatch.is_finite() && mismatch > 0.0)
+                .then(|| ((tolerance / mismatch).ln() / per_period).max(0.0) + test_window);
+            Motion::Settling
+        }
+        Ordering::Equal => Motion::Quasiperiodic,
     };
     report
+}
+
+/// The sign of a largest Lyapunov exponent `largest` (1/s) told apart from 0 by its
+/// standard error `se` (1/s): `Greater` or `Less` only beyond [`SIGMAS`] errors, `Equal`
+/// within them (a non-finite error counts as 0). The rule behind `chaotic`,
+/// `quasiperiodic` and a contracting (settling) window.
+pub fn exponent_sign(largest: f64, se: f64) -> Ordering {
+    let se = if se.is_finite() { se } else { 0.0 };
+    if largest - SIGMAS * se > 0.0 {
+        Ordering::Greater
+    } else if largest + SIGMAS * se < 0.0 {
+        Ordering::Less
+    } else {
+        Ordering::Equal
+    }
 }
 
 /// Periods the tangent vectors of a classifying Lyapunov run align over before averaging.
