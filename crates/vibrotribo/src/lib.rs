@@ -65,6 +65,6 @@ pub use dynamics::{
 };
 pub use error::{ParamError, SimError};
 pub use model::{
-    ChainParams, ChainState, Excitation, Frequency, NondimGroups, SimOptions, Stop, StopFrame, StopSide,
-    Stops,
+    ChainParams, ChainState, Excitation, ForcePolynomial, Frequency, NondimGroups, SimOptions, Stop,
+    StopFrame, StopSide, Stops,
 };

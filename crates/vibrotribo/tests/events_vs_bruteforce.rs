@@ -146,6 +146,7 @@ fn four_mass_stack_with_sticking() {
             frequency: vibrotribo::Frequency::OmegaRatio(0.55),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let out = check(&params, &ChainState::at_rest(4), 8.0, 200);
     println!(

@@ -55,6 +55,7 @@ fn free_pair(c2: f64) -> ChainParams {
             frequency: Frequency::OmegaRatio(0.7),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     }
 }
 
@@ -95,6 +96,7 @@ fn stuck_cluster_flow() {
             frequency: Frequency::OmegaRatio(0.7),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     // Contact force N = m1 m2/(m1+m2) (a2 − a1) with a_i = −k_i x_i/m_i: at x1 = 0.01,
     // x2 = 0.015, a1 = −48, a2 = −3 → compressive.

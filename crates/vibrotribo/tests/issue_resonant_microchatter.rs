@@ -52,6 +52,7 @@ fn rattle_at_rounding_level_jumps_to_its_accumulation_point() {
             frequency: Frequency::OmegaRatio(0.9973142543387674),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     // The forced amplitude of the top mass, A·|H| with H = (k + icω)/(k − mω² + icω).
     let (m, k, c, w) = (

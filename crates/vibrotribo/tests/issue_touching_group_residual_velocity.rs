@@ -124,6 +124,7 @@ fn a_touching_group_keeps_no_relative_velocity_after_an_impact() {
             frequency: Frequency::OmegaRatio(0.5099264791714189),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let velocities = vec![
         0.8526738169528798,
@@ -160,6 +161,7 @@ fn a_resting_cluster_is_equalized_with_the_mass_it_touches() {
             frequency: Frequency::OmegaRatio(1.9834933780144521),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let velocities = vec![
         0.23168185927641272,

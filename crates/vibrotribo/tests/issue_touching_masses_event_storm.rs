@@ -171,6 +171,7 @@ fn touching_masses_with_equal_natural_frequency_move_together() {
             frequency: Frequency::OmegaRatio(0.7),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let periods = 50.0;
     let t_end = periods * params.period();
@@ -308,6 +309,7 @@ fn two_masses(m: [f64; 2], k: [f64; 2], delta: f64) -> ChainParams {
             frequency: Frequency::OmegaRatio(0.7),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     }
 }
 

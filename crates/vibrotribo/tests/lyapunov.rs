@@ -87,6 +87,7 @@ fn impact_free_chains_match_the_closed_form() {
                 frequency: Frequency::OmegaRatio(rng.range(0.4, 1.4)),
             },
             stops: Default::default(),
+            forces: Vec::new(),
         };
         let mut expected: Vec<f64> = (0..n)
             .flat_map(|i| oscillator_rates(masses[i], damping[i], stiffness[i]))

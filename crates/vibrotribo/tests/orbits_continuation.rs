@@ -25,6 +25,7 @@ fn pair(k2: f64, mu: f64, omega: f64) -> ChainParams {
             frequency: Frequency::OmegaRatio(omega),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     }
 }
 

@@ -35,6 +35,7 @@ fn pair(omega: f64) -> ChainParams {
             frequency: Frequency::OmegaRatio(omega),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     }
 }
 
@@ -53,6 +54,7 @@ fn impact_free_orbit_is_the_forced_response_with_multipliers_exp_lambda_t() {
                 frequency: Frequency::OmegaRatio(rng.range(0.3, 1.5)),
             },
             stops: Default::default(),
+            forces: Vec::new(),
         };
         let orbit =
             find_periodic_orbit(&params, &ChainState::at_rest(n), 1, &ShootingOptions::default()).unwrap();

@@ -31,6 +31,7 @@ fn chain() -> impl Strategy<Value = ChainParams> {
                         frequency: Frequency::OmegaRatio(omega),
                     },
                     stops: Default::default(),
+                    forces: Vec::new(),
                 },
             )
     })

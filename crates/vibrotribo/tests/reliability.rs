@@ -172,6 +172,7 @@ fn homogeneous_case(rng: &mut StdRng, damped: bool) -> Graze {
         restitution: rng.random_range(0.0..1.0),
         excitation: excitation(amplitude, ratio),
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let initial = ChainState {
         positions: vec![x1, x1 + r0],
@@ -256,6 +257,7 @@ fn forced_case(rng: &mut StdRng) -> Graze {
             restitution: rng.random_range(0.0..1.0),
             excitation: excitation(amplitude, ratio),
             stops: Default::default(),
+            forces: Vec::new(),
         };
         let initial = ChainState {
             positions: vec![amplitude * h1.1, amplitude * h2.1],
@@ -475,6 +477,7 @@ fn chatter_chain(index: u64) -> (ChainParams, ChainState) {
         restitution,
         excitation: excitation(rng.random_range(0.005..0.1), rng.random_range(0.3..2.0)),
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let moving = rng.random_range(0.0..1.0) < 0.3;
     let initial = ChainState {

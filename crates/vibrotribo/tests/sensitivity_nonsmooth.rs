@@ -103,6 +103,7 @@ fn simultaneous_impacts_are_reported() {
             frequency: Frequency::OmegaRatio(1.0),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let initial = ChainState {
         positions: vec![0.0; 3],

@@ -180,6 +180,7 @@ fn impact_free_chain_matches_the_matrix_exponential() {
                 frequency: Frequency::OmegaRatio(rng.range(0.3, 1.5)),
             },
             stops: Default::default(),
+            forces: Vec::new(),
         };
         let state = ChainState {
             positions: (0..n).map(|_| rng.range(-0.02, 0.02)).collect(),
@@ -218,6 +219,7 @@ fn stuck_cluster_matches_the_matrix_exponential_of_its_oscillator() {
             frequency: Frequency::OmegaRatio(0.7),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let state = ChainState {
         positions: vec![0.02, 0.02 + delta],

@@ -95,6 +95,7 @@ fn chatter_pair(v0: f64) -> (ChainParams, ChainState) {
             frequency: Frequency::OmegaRatio(0.7),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let initial = ChainState {
         positions: vec![0.01, 0.01 + delta],
@@ -344,6 +345,7 @@ fn all_three_stuck_release_at_the_analytic_time() {
             frequency: Frequency::OmegaRatio(1.0),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let s0 = 0.02;
     let offsets = [0.0, d[0], d[0] + d[1]];
@@ -409,6 +411,7 @@ fn newtons_cradle_with_elastic_impacts() {
             frequency: Frequency::OmegaRatio(1.0),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let initial = ChainState {
         positions: vec![0.0, 0.0, 0.0],
@@ -444,6 +447,7 @@ fn symmetric_simultaneous_impact() {
             frequency: Frequency::OmegaRatio(1.0),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let initial = ChainState {
         positions: vec![0.0; 3],

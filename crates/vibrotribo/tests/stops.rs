@@ -51,6 +51,7 @@ fn single(omega_ratio: f64, gap: f64) -> ChainParams {
             }),
             lower: None,
         },
+        forces: Vec::new(),
     }
 }
 
@@ -552,6 +553,7 @@ fn elastic_chain_between_two_stops_conserves_energy() {
             upper: stop(0.003),
             lower: stop(0.005),
         },
+        forces: Vec::new(),
     };
     let state = ChainState {
         positions: vec![0.0, 0.0],

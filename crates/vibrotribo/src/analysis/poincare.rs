@@ -365,6 +365,7 @@ mod tests {
                 frequency: Frequency::OmegaRatio(0.8),
             },
             stops: Default::default(),
+            forces: Vec::new(),
         }
     }
 
@@ -522,6 +523,7 @@ mod tests {
                 frequency: Frequency::Hertz(1.0),
             },
             stops: Default::default(),
+            forces: Vec::new(),
         };
         let wn = (k / m).sqrt();
         let t_star = (delta * wn / v0).asin() / wn;

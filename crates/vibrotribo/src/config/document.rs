@@ -12,8 +12,10 @@ use crate::model::{ChainParams, ChainState, Excitation, Frequency, SimOptions, S
 use crate::study::{Harvester, RunSettings, RunSpec, Sampling};
 
 /// The `[oscillator]` table: the mechanical part of [`ChainParams`]. A single number for
-/// `stiffness`, `damping` or `gaps` applies to every mass (gap); absent keys take the
-/// paper's values (repeated for the chain's length).
+/// `stiffness`, `damping`, `gaps` or `forces` applies to every mass (gap); absent keys take
+/// the paper's values (repeated for the chain's length). `forces` are constant external
+/// forces on the masses, N, positive upward along x (docs/MODEL.md), e.g. gravity
+/// `forces = [-0.47, -1.18, -0.47]` (−m_i g); absent: none ([`ChainParams::forces`]).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub(super) struct OscillatorTable {
@@ -22,6 +24,7 @@ pub(super) struct OscillatorTable {
     pub damping: Option<PerMass>,
     pub gaps: Option<PerMass>,
     pub restitution: Option<f64>,
+    pub forces: Option<PerMass>,
     /// `[oscillator.stops.upper]`, `[oscillator.stops.lower]`: rigid stops (none by default).
     #[serde(skip_serializing_if = "Stops::is_empty")]
     pub stops: Stops,
@@ -315,6 +318,7 @@ pub(super) fn lenient_chain(doc: &Document) -> Result<ChainParams, crate::error:
             frequency,
         },
         stops: o.stops,
+        forces: o.forces.as_ref().map_or(Vec::new(), |s| s.expand(n)),
         masses,
     };
     Ok(params)

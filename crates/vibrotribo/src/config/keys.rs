@@ -95,10 +95,18 @@ pub(super) fn default_chain(n: usize) -> ChainParams {
 
 /// The key of a [`ChainParams`] field path (`masses[1]` → `oscillator.masses[1]`).
 pub(super) fn chain_key(name: &str) -> Option<String> {
-    ["masses", "stiffness", "damping", "gaps", "restitution", "stops"]
-        .iter()
-        .any(|f| name.starts_with(f))
-        .then(|| format!("oscillator.{name}"))
+    [
+        "masses",
+        "stiffness",
+        "damping",
+        "gaps",
+        "restitution",
+        "stops",
+        "forces",
+    ]
+    .iter()
+    .any(|f| name.starts_with(f))
+    .then(|| format!("oscillator.{name}"))
 }
 
 /// The key of a [`ChainState`](crate::ChainState) field path (`positions[1]` →
@@ -246,6 +254,8 @@ fn current_array(table: &Table, section: &str, name: &str) -> Result<Option<Vec<
         ("oscillator", "stiffness") => chain.stiffness,
         ("oscillator", "damping") => chain.damping,
         ("oscillator", "gaps") => chain.gaps,
+        ("oscillator", "forces") if chain.forces.is_empty() => vec![0.0; n],
+        ("oscillator", "forces") => chain.forces,
         ("run", "initial_positions") => doc.run.initial_positions.unwrap_or(vec![0.0; n]),
         ("run", "initial_velocities") => doc.run.initial_velocities.unwrap_or(vec![0.0; n]),
         ("harvester", "dielectric_thickness") => h.dielectric_thickness.to_vec(),

@@ -5,8 +5,10 @@
 //! [`EventLog`], [`Trajectory`] (dense output at any time) and [`UniformSampler`].
 
 mod contact;
+mod forces;
 mod observer;
 mod oscillator;
+pub(crate) mod poly;
 mod roots;
 mod signal;
 mod simulator;

@@ -19,7 +19,12 @@
 //! where α = C/2M, ω_n² = K/M and (c, s) = (cos ω_d τ, sin(ω_d τ)/ω_d) when under-damped,
 //! (1, τ) when critically damped and (cosh βτ, sinh(βτ)/β) when over-damped. The form is
 //! continuous across regimes, so near-critical damping loses no accuracy.
+//!
+//! An external force polynomial in time `f(t)` on the right-hand side (see
+//! [`super::forces`]) adds its polynomial particular solution `p(t)` (same degree) to `s_p`;
+//! without one the flow is computed exactly as before.
 
+use super::poly::{Poly, TERMS};
 use crate::error::SimError;
 
 /// The forcing phase at a time: `cos ωt` and `sin ωt`, computed once per time and shared by
@@ -106,6 +111,8 @@ pub struct Oscillator {
     /// A prescribed motion (a cluster stuck to a rigid stop): no homogeneous part, and a
     /// motion that does not depend on the initial state.
     prescribed: bool,
+    /// Particular solution of the polynomial external forcing, m (zero if none).
+    pub(crate) poly: Poly,
 }
 
 /// Mechanical constants of one oscillator (a mass or a stuck cluster).
@@ -116,6 +123,8 @@ pub(crate) struct OscConstants {
     pub stiffness: f64,
     /// Constant force F₀, N.
     pub force: f64,
+    /// Polynomial external force f(t), N (zero if none).
+    pub poly: Poly,
 }
 
 /// The homogeneous part of an [`Oscillator`] at one instant (see `Oscillator::homogeneous`).
@@ -148,6 +157,7 @@ impl Oscillator {
             damping: c,
             stiffness: kk,
             force: f0,
+            poly: fpoly,
         } = k;
         let w = forcing.omega;
         let a = forcing.amplitude;
@@ -191,12 +201,20 @@ impl Oscillator {
             omega: w,
             magnitude: 0.0,
             prescribed: false,
+            poly: if fpoly.is_zero() {
+                Poly::ZERO
+            } else {
+                fpoly.particular(m, c, kk)
+            },
         };
         let ph = forcing.phase(t0);
-        let (sp, vp) = osc.forced(ph);
+        let (sp, vp) = osc.forced(t0, ph);
         (osc.h0, osc.e0) = two_sum(s0, -sp);
         (osc.h1, osc.e1) = two_sum(v0, -vp);
         osc.magnitude = osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs();
+        if !osc.poly.is_zero() {
+            osc.magnitude += osc.poly.magnitude_at(t0);
+        }
         Ok(osc)
     }
 
@@ -221,6 +239,7 @@ impl Oscillator {
             omega: forcing.omega,
             magnitude: mean.abs() + ps.abs(),
             prescribed: true,
+            poly: Poly::ZERO,
         }
     }
 
@@ -229,13 +248,28 @@ impl Oscillator {
         self.prescribed
     }
 
-    /// Forced (particular) part: displacement, m, and velocity, m/s.
+    /// Forced (particular) part at time `t` (phase `ph` of `t`): displacement, m, and
+    /// velocity, m/s.
     #[inline]
-    pub(crate) fn forced(&self, ph: Phase) -> (f64, f64) {
-        (
-            self.mean + self.pc * ph.cos + self.ps * ph.sin,
-            self.omega * (self.ps * ph.cos - self.pc * ph.sin),
-        )
+    pub(crate) fn forced(&self, t: f64, ph: Phase) -> (f64, f64) {
+        let s = self.mean + self.pc * ph.cos + self.ps * ph.sin;
+        let v = self.omega * (self.ps * ph.cos - self.pc * ph.sin);
+        if self.poly.is_zero() {
+            (s, v)
+        } else {
+            let (p, pd) = self.poly.value_and_rate(t);
+            (s + p, v + pd)
+        }
+    }
+
+    /// The external polynomial forcing per unit mass that drives this flow, `f(t)/M`, m/s²
+    /// (`p'' + 2α p' + ω_n² p` of its particular polynomial p; zero if none).
+    pub(crate) fn driving(&self) -> Poly {
+        if self.poly.is_zero() {
+            Poly::ZERO
+        } else {
+            self.poly.driving(self.alpha, self.wn2)
+        }
     }
 
     /// Homogeneous part at time `t`: `h` and `h'`, the rounding-error initial conditions
@@ -297,7 +331,7 @@ impl Oscillator {
     /// part.
     #[inline]
     pub(crate) fn state(&self, t: f64, ph: Phase) -> (f64, f64) {
-        let (sp, vp) = self.forced(ph);
+        let (sp, vp) = self.forced(t, ph);
         let g = self.homogeneous(t);
         ((sp + g.h) + g.eh, (vp + g.hd) + g.ehd)
     }
@@ -308,6 +342,16 @@ impl Oscillator {
     /// displacement's rounding.
     pub(crate) fn magnitude(&self) -> f64 {
         self.magnitude
+    }
+
+    /// [`magnitude`](Self::magnitude) with the size of the polynomial part's terms at time
+    /// `t` added, m (the polynomial part grows along the piece).
+    pub(crate) fn magnitude_at(&self, t: f64) -> f64 {
+        if self.poly.is_zero() {
+            self.magnitude
+        } else {
+            self.magnitude + self.poly.magnitude_at(t)
+        }
     }
 
     /// Start time of this flow, s.
@@ -348,9 +392,12 @@ impl Oscillator {
     /// `c = 1/K + 1/K²` of the larger of the two before it, so the tail after `j` is below
     /// `2c/(1 − c)·max(|g_{j−1}|, |g_j|)`. The forced part's terms then fall by K per term,
     /// so its tail is below `K/(K − 1)` times its next term. The first two coefficients are
-    /// the values [`state`](Self::state) returns.
+    /// the values [`state`](Self::state) returns. A polynomial part (external forces) adds
+    /// its own scaled Taylor coefficients about `tc`, exact and finite: at least as many
+    /// terms as it has are written, and it has no tail (its size over the radius,
+    /// `Σ |p⁽ʲ⁾(tc)| rʲ/j!`, joins the size of the motion).
     pub(crate) fn taylor(&self, tc: f64, ph: Phase, r: f64, rel: f64, coef: &mut [f64]) -> (usize, f64, f64) {
-        let (sp, vp) = self.forced(ph);
+        let (sp, vp) = self.forced(tc, ph);
         let Homogeneous { h, hd, eh, ehd, .. } = self.homogeneous(tc);
         let max_terms = coef.len();
         // Homogeneous part g_j and forced part F_j = wⱼ·cyc(j) with wⱼ = (ωr)ʲ/j!.
@@ -361,10 +408,23 @@ impl Oscillator {
         let amp_b = self.ps * ph.cos - self.pc * ph.sin;
         // No overflow is possible at these magnitudes: no need for hypot.
         let amp = (self.pc * self.pc + self.ps * self.ps).sqrt();
-        let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs());
+        // The polynomial part's scaled Taylor coefficients b_j r^j about tc (none: len 0).
+        let mut poly = [0.0; TERMS];
+        let poly_len = self.poly.len;
+        let mut poly_size = 0.0;
+        if poly_len > 0 {
+            let (b, _) = self.poly.taylor_at(tc);
+            let mut rj = 1.0;
+            for j in 0..poly_len {
+                poly[j] = b[j] * rj;
+                poly_size += poly[j].abs();
+                rj *= r;
+            }
+        }
+        let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs() + poly_size);
         // Terms beyond the reciprocal table are never needed (a sub-piece needs about 20).
         let max_terms = max_terms.min(RECIPROCALS - 1);
-        if max_terms < 2 {
+        if max_terms < 2 || max_terms < poly_len {
             return (0, f64::INFINITY, tol);
         }
         coef[0] = (sp + h) + eh;
@@ -385,13 +445,17 @@ impl Oscillator {
             let step = wr * inv_j;
             (p, q) = (q * step, -p * step);
             w *= step;
-            *slot = p + g_next;
+            *slot = if j < poly_len {
+                p + g_next + poly[j]
+            } else {
+                p + g_next
+            };
             g_prev = g;
             g = g_next;
             inv_prev = inv_j;
             n = j + 1;
             // Terms 0..=j are written: bound the tail Σ_{i > j} (see the docs).
-            if j as f64 >= min_terms {
+            if j as f64 >= min_terms && j + 1 >= poly_len {
                 let forced_tail = FORCED_TAIL * amp * w * wr * INV[j + 1];
                 tail = forced_tail + HOMOGENEOUS_TAIL * g.abs().max(g_prev.abs());
                 if tail <= tol {
@@ -450,12 +514,13 @@ mod tests {
             damping: 0.0,
             stiffness: 100.0,
             force: 0.0,
+            poly: Poly::ZERO,
         };
         let wn = (k.stiffness / k.mass).sqrt();
         let forcing = Forcing::new(0.08, wn * (1.0 - 1e-5));
         for (t0, s0, v0) in [(0.37, 0.07146086647170276, 2.697164490916262), (5.1, -0.013, 0.4)] {
             let osc = Oscillator::new(k, &forcing, t0, s0, v0).unwrap();
-            let (sp, _) = osc.forced(forcing.phase(t0));
+            let (sp, _) = osc.forced(t0, forcing.phase(t0));
             assert!(sp.abs() > 100.0 * s0.abs(), "not near resonance: {sp}");
             let (s, v) = osc.state(t0, forcing.phase(t0));
             assert!((s - s0).abs() <= 2.0 * f64::EPSILON * s0.abs(), "{s} vs {s0}");
@@ -474,6 +539,7 @@ mod tests {
                 damping: c,
                 stiffness: 100.0,
                 force: 0.7,
+                poly: Poly::ZERO,
             };
             let osc = Oscillator::new(k, &forcing, 0.3, 0.01, -0.2).unwrap();
             let (s0, v0) = osc.state(0.3, forcing.phase(0.3));
@@ -488,6 +554,50 @@ mod tests {
                 let (y, yd) = forcing.base(ph);
                 let res = k.mass * acc + c * (v - yd) + k.stiffness * (s - y) - k.force;
                 assert!(res.abs() < 1e-6, "c = {c}, t = {t}, residual {res}");
+            }
+        }
+    }
+
+    /// With a polynomial external force the closed form still satisfies its ODE (residual by
+    /// finite differences), starts at its initial state, and its scaled Taylor coefficients
+    /// sum to the closed form inside the radius.
+    #[test]
+    fn polynomial_forcing_residual_and_taylor() {
+        let forcing = Forcing::new(0.05, 30.0);
+        let f = Poly::new(0.2, &[0.3, -2.0, 5.0, 40.0, -100.0, 300.0, 900.0]);
+        for c in [0.0, 0.3, 20.0] {
+            let k = OscConstants {
+                mass: 0.1,
+                damping: c,
+                stiffness: 100.0,
+                force: 0.7,
+                poly: f,
+            };
+            let osc = Oscillator::new(k, &forcing, 0.3, 0.01, -0.2).unwrap();
+            let (s0, v0) = osc.state(0.3, forcing.phase(0.3));
+            assert!((s0 - 0.01).abs() < 1e-15 && (v0 + 0.2).abs() < 1e-15);
+            for &t in &[0.32, 0.4, 0.55] {
+                let hstep = 1e-5;
+                let (s, v) = osc.state(t, forcing.phase(t));
+                let (_, vp) = osc.state(t + hstep, forcing.phase(t + hstep));
+                let (_, vm) = osc.state(t - hstep, forcing.phase(t - hstep));
+                let acc = (vp - vm) / (2.0 * hstep);
+                let (y, yd) = forcing.base(forcing.phase(t));
+                let res = k.mass * acc + c * (v - yd) + k.stiffness * (s - y) - k.force - f.value(t);
+                assert!(res.abs() < 1e-6, "c = {c}, t = {t}, residual {res}");
+            }
+            let (tc, r) = (0.4, 0.01);
+            let mut coef = [0.0; 40];
+            let (n, tail, tol) = osc.taylor(tc, forcing.phase(tc), r, 0.25 * f64::EPSILON, &mut coef);
+            assert!(tail <= tol && n >= f.len, "{n} terms, tail {tail:e} > {tol:e}");
+            for x in [-1.0, -0.3, 0.5, 1.0] {
+                let t = tc + x * r;
+                let sum = coef[..n].iter().rev().fold(0.0, |acc, &cj| acc * x + cj);
+                let (s, _) = osc.state(t, forcing.phase(t));
+                assert!(
+                    (sum - s).abs() <= 1e-14 * osc.magnitude_at(t),
+                    "c = {c}, x = {x}: {sum} vs {s}"
+                );
             }
         }
     }

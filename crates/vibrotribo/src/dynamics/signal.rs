@@ -5,18 +5,23 @@
 //!
 //! - a constant,
 //! - one harmonic `f_c cos ωt + f_s sin ωt` at the excitation frequency,
-//! - homogeneous parts `a h(t) + b h'(t)` of at most two oscillators.
+//! - homogeneous parts `a h(t) + b h'(t)` of at most two oscillators,
+//! - with external force polynomials (see [`super::forces`]), a polynomial in time.
 //!
 //! [`Signal::jet`] returns the value and first three derivatives at a time, and bounds
-//! `B_n ≥ sup_{s ≥ t} |f^{(n)}(s)|`, n = 1..4, valid for the whole future of the current flow.
+//! `B_n ≥ sup_{t ≤ s ≤ H} |f^{(n)}(s)|`, n = 1..4, up to the horizon H of the search (for all
+//! the future of the current flow when there is no polynomial part).
 //! The bounds come from an energy argument: any solution `g` of `g'' + 2αg' + ω_n² g = 0` with
 //! α ≥ 0 has non-increasing `E = g'² + ω_n² g²`, and every derivative of `g` is again such a
 //! solution, so `|g^{(n)}(s)| ≤ √(g^{(n)}(t)² + g^{(n+1)}(t)²/ω_n²)` for all s ≥ t. The
-//! harmonic part contributes `R ωⁿ` with R its amplitude. These bounds make the root search
-//! of [`super::roots`] certified: it can never step over a zero.
+//! harmonic part contributes `R ωⁿ` with R its amplitude. A polynomial part with Taylor
+//! coefficients `b_k = P⁽ᵏ⁾(t)/k!` about t contributes, by the triangle inequality on its own
+//! (finite) Taylor expansion, `Σ_{k≥n} |b_k| k!/(k−n)! (H − t)^{k−n}` on `[t, H]`. These
+//! bounds make the root search of [`super::roots`] certified: it can never step over a zero.
 
 use super::observer::ClusterFlow;
 use super::oscillator::{Oscillator, Phase};
+use super::poly::{Poly, falling};
 
 /// `a·h + b·h'` of the oscillator with index `osc`.
 #[derive(Debug, Clone, Copy, Default)]
@@ -38,6 +43,8 @@ pub(crate) struct Signal {
     pub forced_mag: f64,
     pub terms: [Term; 2],
     pub nterms: usize,
+    /// Polynomial part (external forces; zero if none).
+    pub poly: Poly,
 }
 
 /// Value, derivatives and bounds of a [`Signal`] at one time.
@@ -63,6 +70,16 @@ impl Signal {
         self.add_harmonic(a * osc.pc + b * omega * osc.ps, a * osc.ps - b * omega * osc.pc);
         self.terms[self.nterms] = Term { osc: osc_index, a, b };
         self.nterms += 1;
+        if !osc.poly.is_zero() {
+            // a·p + b·p' of the particular polynomial p.
+            self.poly.add_scaled(&osc.poly, a);
+            self.poly.add_scaled(&osc.poly.derivative(), b);
+        }
+    }
+
+    /// Adds `a × q(t)` for a polynomial `q`.
+    pub fn add_polynomial(&mut self, q: &Poly, a: f64) {
+        self.poly.add_scaled(q, a);
     }
 
     /// The function with the opposite sign (same rounding noise).
@@ -74,6 +91,9 @@ impl Signal {
         for term in &mut s.terms[..s.nterms] {
             term.a = -term.a;
             term.b = -term.b;
+        }
+        for c in &mut s.poly.c {
+            *c = -*c;
         }
         s
     }
@@ -91,9 +111,10 @@ impl Signal {
         self.forced_mag += c.hypot(s);
     }
 
-    /// Value, derivatives and bounds at time `t` (phase `ph` of `t`).
+    /// Value, derivatives and bounds at time `t` (phase `ph` of `t`), the bounds valid up to
+    /// the horizon `horizon` ≥ t, s, of the search.
     #[inline]
-    pub fn jet(&self, t: f64, ph: Phase, clusters: &[ClusterFlow], omega: f64) -> Jet {
+    pub fn jet(&self, t: f64, ph: Phase, clusters: &[ClusterFlow], omega: f64, horizon: f64) -> Jet {
         let f0 = self.fc * ph.cos + self.fs * ph.sin;
         let f1 = omega * (self.fs * ph.cos - self.fc * ph.sin);
         let w2 = omega * omega;
@@ -143,10 +164,37 @@ impl Signal {
                 bound[n] += up.min(down);
             }
         }
+        if !self.poly.is_zero() {
+            self.add_poly_jet(t, horizon, &mut d, &mut bound, &mut mag);
+        }
         Jet {
             d,
             bound,
             noise: mag.map(|m| NOISE * m),
+        }
+    }
+
+    /// The polynomial part's derivatives at `t`, their rounding sizes, and the bounds of its
+    /// derivatives on `[t, horizon]` (module docs).
+    #[cold]
+    fn add_poly_jet(&self, t: f64, horizon: f64, d: &mut [f64; 4], bound: &mut [f64; 5], mag: &mut [f64; 4]) {
+        let len = self.poly.len;
+        let (b, babs) = self.poly.taylor_at(t);
+        let span = (horizon - t).max(0.0);
+        for n in 0..4 {
+            if n < len {
+                let f = falling(n, n);
+                d[n] += f * b[n];
+                mag[n] += f * babs[n];
+            }
+        }
+        for (n, bn) in bound.iter_mut().enumerate().skip(1) {
+            // Σ_{k≥n} |b_k| k!/(k−n)! span^{k−n}, by Horner in span.
+            let mut acc = 0.0;
+            for k in (n..len).rev() {
+                acc = acc * span + falling(k, n) * b[k].abs();
+            }
+            *bn += acc;
         }
     }
 }

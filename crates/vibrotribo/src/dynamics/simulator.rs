@@ -14,11 +14,12 @@
 use std::ops::ControlFlow;
 
 use super::contact::Closure;
+use super::forces::ExternalForces;
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
 use super::oscillator::{Forcing, OscConstants, Oscillator};
 use super::roots::{Found, Stall, first_root};
 use crate::error::{ParamError, SimError};
-use crate::model::{ChainParams, ChainState, SimOptions};
+use crate::model::{ChainParams, ChainState, ForcePolynomial, SimOptions};
 
 /// How [`Simulator::run_until`] ended.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,7 +70,7 @@ pub(super) struct ClusterConsts {
     pub(super) mass: f64,
     pub(super) damping: f64,
     pub(super) stiffness: f64,
-    /// F₀ = −Σ k_i o_i, N.
+    /// F₀ = −Σ k_i o_i + Σ F_i (the constant external forces), N.
     pub(super) force: f64,
 }
 
@@ -90,6 +91,8 @@ pub struct Simulator {
     pub(super) params: ChainParams,
     pub(super) options: SimOptions,
     pub(super) forcing: Forcing,
+    /// The external forces on the masses.
+    pub(super) forces: ExternalForces,
     /// G_i = Σ_{j<i} δ_j: position offset of mass i inside a cluster, relative to its top.
     pub(super) offsets: Vec<f64>,
     pub(super) t: f64,
@@ -161,6 +164,7 @@ impl Simulator {
         }
         let mut sim = Simulator {
             forcing: Forcing::new(params.excitation.amplitude, params.omega()),
+            forces: ExternalForces::new(params),
             params: params.clone(),
             options,
             offsets,
@@ -224,6 +228,52 @@ impl Simulator {
             positions: self.x.clone(),
             velocities: self.v.clone(),
         }
+    }
+
+    /// Sets time-polynomial external forces on the masses from the current time on, until the
+    /// next call: mass i feels `forces[i]` (N, positive along x, docs/MODEL.md) on top of its
+    /// constant force [`ChainParams::forces`]. One polynomial per mass, of degree at most
+    /// [`MAX_FORCE_DEGREE`](crate::model::MAX_FORCE_DEGREE), or none (an empty slice) to
+    /// return to the constant forces only. The polynomials are meant to be evaluated from
+    /// [`time`](Self::time) on; a later [`run_until`](Self::run_until) follows them exactly.
+    ///
+    /// Every cluster's closed-form flow is rebuilt at the current time with the state
+    /// continuous: no event is logged and no observer is called.
+    ///
+    /// Errors (naming `forces`, `forces[i].t_ref` or `forces[i].coefficients[j]`) on a wrong
+    /// number of polynomials, a degree above 8 or a value that is not finite; the simulator is
+    /// then unchanged.
+    ///
+    /// ```
+    /// use vibrotribo::{ChainParams, ChainState, EventLog, ForcePolynomial, SimOptions, Simulator};
+    ///
+    /// let params = ChainParams::default();
+    /// let mut sim = Simulator::new(&params, &ChainState::at_rest(3), SimOptions::default())?;
+    /// // A force on the middle mass rising by 0.5 N/s from now.
+    /// let t = sim.time();
+    /// let f = [ForcePolynomial::zero(), ForcePolynomial::new(t, vec![0.0, 0.5]), ForcePolynomial::zero()];
+    /// sim.set_external_forces(&f)?;
+    /// sim.run_until(t + params.period(), &mut EventLog::default())?;
+    /// sim.clear_external_forces()?;
+    /// # Ok::<(), vibrotribo::SimError>(())
+    /// ```
+    pub fn set_external_forces(&mut self, forces: &[ForcePolynomial]) -> Result<(), SimError> {
+        let mut next = self.forces.clone();
+        next.set_polynomials(forces, self.x.len(), self.t)?;
+        self.forces = next;
+        self.rebuild()
+    }
+
+    /// Removes the time-polynomial forces of [`set_external_forces`](Self::set_external_forces)
+    /// (the constant ones of [`ChainParams::forces`] stay), with the same rebuild.
+    pub fn clear_external_forces(&mut self) -> Result<(), SimError> {
+        self.set_external_forces(&[])
+    }
+
+    /// The external force on mass `i` (0-based) at time `t`, N: its constant force and its
+    /// current polynomial (which holds from the last [`set_external_forces`](Self::set_external_forces) on).
+    pub fn external_force(&self, i: usize, t: f64) -> f64 {
+        self.forces.at(i, t).0
     }
 
     /// Status of each contact (index k: between mass k and k+1, 0-based; with stops, N − 1 is
@@ -374,6 +424,9 @@ impl Simulator {
                 momentum += m * self.v[j];
                 moment += m * (self.x[j] - o);
             }
+            if !self.forces.is_empty() {
+                k.force += self.forces.range_constant(first, last);
+            }
             if let Some((osc, stop)) = self.anchored_flow(first, last) {
                 self.term_scale = self.term_scale.max(osc.magnitude());
                 self.clusters.push(ClusterFlow {
@@ -398,6 +451,7 @@ impl Simulator {
                     damping: k.damping,
                     stiffness: k.stiffness,
                     force: k.force,
+                    poly: self.forces.range_poly(first, last),
                 },
                 &self.forcing,
                 self.t,
@@ -453,7 +507,7 @@ impl Simulator {
                 }
                 _ => (self.force_signal(k), self.t),
             };
-            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
+            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w, horizon);
             match first_root(eval, start, horizon) {
                 Ok(Found::Root(te)) if te < horizon => {
                     horizon = te.max(self.t);
@@ -486,7 +540,7 @@ impl Simulator {
         let mut best = None;
         let mut horizon = horizon;
         for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
-            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w);
+            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w, horizon);
             match first_root(eval, self.t, horizon) {
                 Ok(Found::Root(te)) if te < horizon => {
                     horizon = te.max(self.t);
@@ -512,6 +566,16 @@ impl Simulator {
     }
 
     fn handle(&mut self, what: Pending) -> Result<(), SimError> {
+        if self.forces.has_polynomials() {
+            // The polynomial parts of the flows grew along the piece: the scale of the terms
+            // the state is summed from is theirs at the event.
+            let t = self.t;
+            self.term_scale = self
+                .clusters
+                .iter()
+                .map(|c| c.oscillator.magnitude_at(t))
+                .fold(self.term_scale, f64::max);
+        }
         self.refresh_tolerances();
         // Contacts struck at this event (none unless it is an impact).
         self.scratch_first_speed.fill(f64::NAN);

@@ -19,8 +19,10 @@
 
 use crate::error::{ParamError, check, check_finite, check_non_negative, check_positive};
 
+mod forces;
 mod stops;
 
+pub use forces::{ForcePolynomial, MAX_FORCE_DEGREE};
 pub use stops::{Contact, Stop, StopFrame, StopSide, Stops};
 
 /// How the excitation frequency is given.
@@ -84,6 +86,13 @@ pub struct ChainParams {
     /// none.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Stops::is_empty"))]
     pub stops: Stops,
+    /// Constant external forces F_i on the masses, N, positive along x (upward, docs/MODEL.md):
+    /// one per mass, or empty for none. They add to the spring and dashpot forces,
+    /// `m_i x_i'' + c_i (x_i' − y') + k_i (x_i − y) = F_i`, e.g. gravity `F_i = −m_i g` on a
+    /// vertical stack (see also [`Simulator::set_external_forces`](crate::Simulator::set_external_forces)
+    /// for forces that vary in time). Default none.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Vec::is_empty"))]
+    pub forces: Vec<f64>,
 }
 
 impl Default for ChainParams {
@@ -96,6 +105,7 @@ impl Default for ChainParams {
             restitution: 0.6,
             excitation: Excitation::default(),
             stops: Stops::default(),
+            forces: Vec::new(),
         }
     }
 }
@@ -169,6 +179,7 @@ impl ChainParams {
             Frequency::OmegaRatio(w) => check_positive("excitation.omega_ratio", w)?,
             Frequency::Hertz(f) => check_positive("excitation.frequency_hz", f)?,
         }
+        self.validate_forces()?;
         self.validate_stops()
     }
 

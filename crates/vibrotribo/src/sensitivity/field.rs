@@ -9,12 +9,20 @@
 //! ẋ_i = V,   v̇_i = a_G = (−C (V − y') − K (s − y) + F₀) / M     for every i ∈ G,
 //! ```
 //!
-//! `y = A sin ωt`. Off the constraint manifold (members not rigidly offset) `s` and `V` are
+//! `y = A sin ωt`. External forces (docs of [`crate::ChainParams::forces`] and
+//! [`crate::Simulator::set_external_forces`]) add their sum over G to the numerator: the
+//! constant ones through F₀, a time polynomial through the cluster's [`ClusterFlow`], whose
+//! oscillator carries the particular solution it drives (the forcing per unit mass is
+//! recovered from it). They do not depend on the state, so they leave the Jacobian of the
+//! flow unchanged, but they enter the field on both sides of an event.
+//!
+//! Off the constraint manifold (members not rigidly offset) `s` and `V` are
 //! read as the mass-weighted means `s = Σ m_i (x_i − (o_i − o_first)) / M`,
 //! `V = Σ m_i v_i / M`: the extension the simulator itself uses when it merges masses.
 
 use crate::dynamics::ClusterFlow;
 use crate::dynamics::Forcing;
+use crate::dynamics::poly::Poly;
 use crate::model::{ChainParams, StopSide, Stops};
 
 /// Constants of one cluster, masses `first..=last` (0-based).
@@ -28,8 +36,10 @@ pub(crate) struct Cluster {
     pub damping: f64,
     /// K, N/m.
     pub stiffness: f64,
-    /// F₀, N.
+    /// F₀ (with the constant external forces), N.
     pub force: f64,
+    /// The polynomial external force per unit mass, m/s² (zero if none).
+    pub drive: Poly,
 }
 
 impl Cluster {
@@ -53,6 +63,8 @@ pub(crate) struct ChainField {
     pub forcing: Forcing,
     /// The rigid stops.
     pub stops: Stops,
+    /// The constant external forces, N (empty: none).
+    pub forces: Vec<f64>,
 }
 
 impl ChainField {
@@ -71,6 +83,7 @@ impl ChainField {
             restitution: params.restitution,
             forcing: Forcing::new(params.excitation.amplitude, params.omega()),
             stops: params.stops,
+            forces: params.forces.clone(),
         }
     }
 
@@ -89,6 +102,7 @@ impl ChainField {
             damping: 0.0,
             stiffness: 0.0,
             force: 0.0,
+            drive: Poly::ZERO,
         };
         for i in first..=last {
             c.mass += self.masses[i];
@@ -96,13 +110,25 @@ impl ChainField {
             c.stiffness += self.stiffness[i];
             c.force -= self.stiffness[i] * (self.offsets[i] - base);
         }
+        if !self.forces.is_empty() {
+            c.force += self.forces[first..=last].iter().sum::<f64>();
+        }
+        c
+    }
+
+    /// The cluster `cf` of a piece of flow, with its polynomial forcing.
+    pub fn cluster_of_flow(&self, cf: &ClusterFlow) -> Cluster {
+        let mut c = self.cluster(cf.first, cf.last);
+        if !cf.oscillator.is_prescribed() {
+            c.drive = cf.oscillator.driving();
+        }
         c
     }
 
     /// The cluster of `clusters` (a partition, top to bottom) that contains mass `i`.
     pub fn cluster_of(&self, clusters: &[ClusterFlow], i: usize) -> Cluster {
         let c = &clusters[clusters.partition_point(|c| c.last < i)];
-        self.cluster(c.first, c.last)
+        self.cluster_of_flow(c)
     }
 
     /// Mass-weighted coordinate `s` and velocity `V` of cluster `c` at state (`x`, `v`).
@@ -127,13 +153,23 @@ impl ChainField {
     /// `t` (module docs).
     pub fn accel(&self, c: &Cluster, s: f64, vel: f64, t: f64) -> f64 {
         let (y, yd, _) = self.base(t);
-        (-c.damping * (vel - yd) - c.stiffness * (s - y) + c.force) / c.mass
+        let a = (-c.damping * (vel - yd) - c.stiffness * (s - y) + c.force) / c.mass;
+        if c.drive.is_zero() {
+            a
+        } else {
+            a + c.drive.value(t)
+        }
     }
 
-    /// `∂a_G/∂t` at fixed state: `(C y'' + K y') / M`, m/s³.
+    /// `∂a_G/∂t` at fixed state: `(C y'' + K y' + f'(t)) / M`, m/s³.
     pub fn accel_rate(&self, c: &Cluster, t: f64) -> f64 {
         let (_, yd, ydd) = self.base(t);
-        (c.damping * ydd + c.stiffness * yd) / c.mass
+        let r = (c.damping * ydd + c.stiffness * yd) / c.mass;
+        if c.drive.is_zero() {
+            r
+        } else {
+            r + c.drive.value_and_rate(t).1
+        }
     }
 
     /// The position of the stop on `side` at time `t`, m, and its first three derivatives
@@ -157,7 +193,7 @@ impl ChainField {
                 }
                 continue;
             }
-            let c = self.cluster(cf.first, cf.last);
+            let c = self.cluster_of_flow(cf);
             let (s, vel) = self.coordinates(&c, x, v);
             let a = self.accel(&c, s, vel, t);
             for i in c.members() {

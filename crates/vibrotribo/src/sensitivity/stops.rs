@@ -83,7 +83,7 @@ impl WallImpact {
             let y = field.wall(StopSide::Upper, t);
             (find(0), 1.0, StopSide::Upper, [(0, -1.0), (0, 0.0)], 1, y[1])
         };
-        let free = field.cluster(free_flow.first, free_flow.last);
+        let free = field.cluster_of_flow(free_flow);
         let vel: f64 = free.members().map(|i| field.masses[i] * v[i]).sum::<f64>() / free.mass;
         let yd = field.wall(side, t)[1];
         Some(WallImpact {

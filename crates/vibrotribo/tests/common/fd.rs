@@ -16,7 +16,20 @@ pub fn run_with(
     horizon: Horizon,
     options: &SimOptions,
 ) -> Option<(DVector<f64>, Vec<Event>)> {
+    run_prepared(params, z, horizon, options, &|_| Some(()))
+}
+
+/// [`run_with`] with `prepare` applied to the simulator before it runs (e.g. to set external
+/// forces).
+pub fn run_prepared(
+    params: &ChainParams,
+    z: &DVector<f64>,
+    horizon: Horizon,
+    options: &SimOptions,
+    prepare: &dyn Fn(&mut Simulator) -> Option<()>,
+) -> Option<(DVector<f64>, Vec<Event>)> {
     let mut sim = Simulator::new(params, &state_from_vector(z.as_slice()), options.clone()).ok()?;
+    prepare(&mut sim)?;
     let mut log = EventLog::default();
     sim.run_until(horizon.end_time(params), &mut log).ok()?;
     Some((
@@ -46,6 +59,19 @@ pub fn compare_with_fd(
     events: &[Event],
     h_rel: f64,
 ) -> Option<FdComparison> {
+    compare_with_fd_prepared(params, state, horizon, phi, events, h_rel, &|_| Some(()))
+}
+
+/// [`compare_with_fd`] for runs whose simulator is prepared by `prepare` before it runs.
+pub fn compare_with_fd_prepared(
+    params: &ChainParams,
+    state: &ChainState,
+    horizon: Horizon,
+    phi: &DMatrix<f64>,
+    events: &[Event],
+    h_rel: f64,
+    prepare: &dyn Fn(&mut Simulator) -> Option<()>,
+) -> Option<FdComparison> {
     let n = params.len();
     let (l, v) = (length_scale(params), speed_scale(params));
     let scale = |i: usize| if i < n { l } else { v };
@@ -58,7 +84,7 @@ pub fn compare_with_fd(
         for step in [h, -h, 2.0 * h, -2.0 * h] {
             let mut z = z0.clone();
             z[j] += step;
-            let (end, ev) = run(params, &z, horizon)?;
+            let (end, ev) = run_prepared(params, &z, horizon, &SimOptions::default(), prepare)?;
             if signature(&ev) != reference {
                 return None;
             }

@@ -204,6 +204,7 @@ pub fn random_chain(rng: &mut Lcg, n: usize, mu: f64) -> (ChainParams, vibrotrib
             frequency: Frequency::OmegaRatio(rng.range(0.3, 1.2)),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let v = vibrotribo::sensitivity::speed_scale(&params);
     let mut x = vec![0.0; n];
@@ -235,6 +236,7 @@ pub fn grazing_pair(eps: f64) -> (ChainParams, ChainState, f64) {
             frequency: Frequency::OmegaRatio(0.37),
         },
         stops: Default::default(),
+        forces: Vec::new(),
     };
     let initial = ChainState {
         positions: vec![0.0, 0.0],

@@ -60,7 +60,11 @@ impl Simulator {
             xmax.max(self.term_scale) + self.offsets[self.offsets.len() - 1] + p.excitation.amplitude + 1e-9;
         let omega = self.forcing.omega;
         let speed = vmax + (p.excitation.amplitude * omega) + wn2_max.sqrt() * length;
-        let accel = wn2_max * length + speed * wn2_max.sqrt() + p.excitation.amplitude * omega * omega;
+        let mut accel = wn2_max * length + speed * wn2_max.sqrt() + p.excitation.amplitude * omega * omega;
+        if !self.forces.is_empty() {
+            // The external forces are terms of every acceleration the decisions compare.
+            accel += self.forces.accel_scale(&p.masses, self.t);
+        }
         self.pos_tol = TOL * length;
         self.vel_tol = TOL * speed;
         self.acc_tol = ACC_TOL * accel;

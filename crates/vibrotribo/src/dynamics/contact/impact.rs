@@ -122,8 +122,15 @@ impl Simulator {
         }
         let s = self.x[first];
         let v = self.v[first];
-        let a = (-c * (v - yd) - k * (s - y) + f) / m;
-        let j = (-c * (a - ydd) - k * (v - yd)) / m;
+        if self.forces.is_empty() {
+            let a = (-c * (v - yd) - k * (s - y) + f) / m;
+            let j = (-c * (a - ydd) - k * (v - yd)) / m;
+            return (a, j);
+        }
+        // With the external forces on the range and their rate.
+        let (fe, fe_rate) = self.forces.range_at(first, last, self.t);
+        let a = (-c * (v - yd) - k * (s - y) + f + fe) / m;
+        let j = (-c * (a - ydd) - k * (v - yd) + fe_rate) / m;
         (a, j)
     }
 

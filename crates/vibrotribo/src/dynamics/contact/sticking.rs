@@ -40,8 +40,16 @@ impl Simulator {
         }
         // Free accelerations and gap accelerations q_k = a_k − a_{k+1}.
         let p = &self.params;
-        let free =
-            |i: usize| (-p.damping[i] * (self.v[i] - yd) - p.stiffness[i] * (self.x[i] - y)) / p.masses[i];
+        let forced = !self.forces.is_empty();
+        let t = self.t;
+        let free = |i: usize| {
+            let a = (-p.damping[i] * (self.v[i] - yd) - p.stiffness[i] * (self.x[i] - y)) / p.masses[i];
+            if forced {
+                a + self.forces.at(i, t).0 / p.masses[i]
+            } else {
+                a
+            }
+        };
         for k in 0..ncont {
             let q = if self.stop_at(k).is_some() {
                 self.stop_free_gap_accel(k, free)

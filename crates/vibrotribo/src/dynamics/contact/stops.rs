@@ -424,9 +424,10 @@ impl Simulator {
     /// stop, as a [`Signal`], or `None` if j's cluster is free. For the stop's own contact it
     /// is the stop's force on the cluster, `λ = Σ_G F_i − M Ÿ` above and `M Ÿ − Σ_G F_i`
     /// below; inside the cluster it is computed from the part away from the stop, on which
-    /// only the springs, dashpots and that contact act: `N_j = Σ_{i>j} F_i − M_{>j} Ÿ` (stuck
-    /// above) or `M_{≤j} Ÿ − Σ_{i≤j} F_i` (stuck below). `F_i = −c_i(s' − y') −
-    /// k_i(s + o_i − y)` with o_i the member's offset.
+    /// only the springs, dashpots, external forces and that contact act:
+    /// `N_j = Σ_{i>j} F_i − M_{>j} Ÿ` (stuck above) or `M_{≤j} Ÿ − Σ_{i≤j} F_i` (stuck below).
+    /// `F_i = −c_i(s' − y') − k_i(s + o_i − y) + f_i(t)` with o_i the member's offset and f_i
+    /// its external force.
     pub(in crate::dynamics) fn anchored_force_signal(&self, j: usize) -> Option<Signal> {
         let n = self.x.len();
         let g = match self.stop_at(j) {
@@ -459,6 +460,11 @@ impl Simulator {
         sig.add_oscillator(g, &c.oscillator, -sign * kk, -sign * cc, w);
         sig.add_harmonic(sign * cc * a * w, sign * kk * a);
         sig.add_harmonic(0.0, sign * m * w * w * wall);
+        if !self.forces.is_empty() {
+            // The external forces on the part, Σ f_i(t), are among its F_i.
+            sig.add_constant(sign * self.forces.range_constant(range.0, range.1));
+            sig.add_polynomial(&self.forces.range_poly(range.0, range.1), sign);
+        }
         Some(sig)
     }
 

@@ -60,6 +60,13 @@ impl Simulator {
         sig.add_oscillator(g, &c.oscillator, e1, e2, w);
         // − e₁ y − e₂ y' with y = A sin ωt, y' = Aω cos ωt.
         sig.add_harmonic(-e2 * a * w, -e1 * a);
+        if !self.forces.is_empty() {
+            // The external forces: r Σ_G f_i − Σ_{i≤j} f_i (the cluster's share is in F₀ and
+            // in the oscillator's particular polynomial).
+            sig.add_constant(-self.forces.range_constant(c.first, j));
+            sig.add_polynomial(&self.forces.range_poly(c.first, c.last), r);
+            sig.add_polynomial(&self.forces.range_poly(c.first, j), -1.0);
+        }
         sig
     }
 
