@@ -77,10 +77,8 @@ impl<'a> Reference<'a> {
         let (y, yd) = (amp * (w * t).sin(), amp * w * (w * t).cos());
         for i in 0..x.len() {
             let mut f = -p.damping[i] * (v[i] - yd) - p.stiffness[i] * (x[i] - y) + p.force(i);
-            if let Some(j) = piece {
-                if let Some(q) = self.schedule[j].1.get(i) {
-                    f += q.value(t);
-                }
+            if let Some(q) = piece.and_then(|j| self.schedule[j].1.get(i)) {
+                f += q.value(t);
             }
             a[i] = f / p.masses[i];
         }

@@ -44,7 +44,7 @@ impl ExternalForces {
     }
 
     /// Replaces the polynomial forces by `forces` (one per mass of `n`, or none), each taken
-    /// about the common reference time `t_ref`, s.
+    /// about the common reference time `t_ref`, s. On an error nothing changes.
     pub fn set_polynomials(
         &mut self,
         forces: &[ForcePolynomial],
@@ -60,17 +60,19 @@ impl ExternalForces {
             .into());
         }
         for (i, f) in forces.iter().enumerate() {
-            f.validate(&format!("forces[{i}]"))?;
+            if !f.is_valid() {
+                f.validate(&format!("forces[{i}]"))?;
+            }
         }
-        let polys: Vec<Poly> = forces
-            .iter()
-            .map(|f| Poly::new(f.t_ref, &f.coefficients).shifted(t_ref))
-            .collect();
-        self.poly = if polys.iter().all(Poly::is_zero) {
-            Vec::new()
-        } else {
-            polys
-        };
+        self.poly.clear();
+        self.poly.extend(
+            forces
+                .iter()
+                .map(|f| Poly::new(f.t_ref, &f.coefficients).shifted(t_ref)),
+        );
+        if self.poly.iter().all(Poly::is_zero) {
+            self.poly.clear();
+        }
         Ok(())
     }
 

@@ -258,9 +258,7 @@ impl Simulator {
     /// # Ok::<(), vibrotribo::SimError>(())
     /// ```
     pub fn set_external_forces(&mut self, forces: &[ForcePolynomial]) -> Result<(), SimError> {
-        let mut next = self.forces.clone();
-        next.set_polynomials(forces, self.x.len(), self.t)?;
-        self.forces = next;
+        self.forces.set_polynomials(forces, self.x.len(), self.t)?;
         self.rebuild()
     }
 

@@ -51,11 +51,21 @@ impl ForcePolynomial {
         self.coefficients.iter().rev().fold(0.0, |acc, &c| acc * x + c)
     }
 
+    /// Whether [`validate`](Self::validate) passes (without building names).
+    pub(crate) fn is_valid(&self) -> bool {
+        self.t_ref.is_finite()
+            && self.coefficients.len() <= MAX_FORCE_DEGREE + 1
+            && self.coefficients.iter().all(|c| c.is_finite())
+    }
+
     /// Checks degree and finiteness; `name` is how the caller names this polynomial
     /// (`forces[1]`): errors name `forces[1].t_ref` or `forces[1].coefficients[j]`.
     pub fn validate(&self, name: &str) -> Result<(), ParamError> {
-        check_finite(&format!("{name}.t_ref"), self.t_ref)?;
+        if self.is_valid() {
+            return Ok(());
+        }
         let len = self.coefficients.len();
+        check_finite(&format!("{name}.t_ref"), self.t_ref)?;
         check(
             format!("{name}.coefficients"),
             len as f64,
