@@ -314,7 +314,7 @@ impl BreakdownWatch {
     pub fn may_beat(&self, charges: &[f64], gaps: &[f64]) -> bool {
         let worst = self.margin.worst_ratio;
         let points = charges.len();
-        if !(worst > 0.0) || points == 0 || gaps.len() % points != 0 {
+        if worst.is_nan() || worst <= 0.0 || points == 0 || !gaps.len().is_multiple_of(points) {
             return true;
         }
         let n = gaps.len() / points;
@@ -369,7 +369,7 @@ impl BreakdownWatch {
                 }
             }
         }
-        !(top <= threshold)
+        top.is_nan() || top > threshold
     }
 
     /// Maximises the ratio over `[a, b]`, s, by golden-section search, with `eval(t)` giving
@@ -542,7 +542,7 @@ mod tests {
                         top * 0.999,
                         0.5 * top,
                     ] {
-                        if !(worst > 0.0) {
+                        if worst.is_nan() || worst <= 0.0 {
                             continue;
                         }
                         let mut watch = BreakdownWatch::new(&h, 0.0);
