@@ -35,7 +35,7 @@ PARTS = [
 
 def inclusive(path):
     out = subprocess.run(
-        ["callgrind_annotate", "--inclusive=yes", "--threshold=100", path],
+        ["callgrind_annotate", "--inclusive=yes", "--auto=no", "--threshold=100", path],
         capture_output=True, text=True, check=True,
     ).stdout
     total = None

@@ -1,7 +1,7 @@
 //! Outputs of accepted steps from their collocation polynomials: samples, the V–Q cycle, the
 //! storage target crossing, the air-breakdown check.
 
-use super::state::{BREAKDOWN_POINTS, ChargeSolver, LoadModel, RESISTOR_STAGES, Step};
+use super::state::{BREAKDOWN_POINTS, ChargeSolver, LoadModel, MAX_STAGES, RESISTOR_STAGES, Step};
 use crate::electrical::ElectricalError;
 use crate::electrical::radau::Tableau;
 use crate::electrical::waveform::GapWaveform;
@@ -22,19 +22,19 @@ impl ChargeSolver {
 
     /// Outputs of the last accepted step: samples, V–Q points, target crossing, breakdown.
     pub(super) fn record<W: GapWaveform + ?Sized>(&mut self, wave: &W) -> Result<(), ElectricalError> {
-        if self.sampler.is_none()
-            && self.vq.is_none()
-            && self.target_voltage.is_none()
-            && self.breakdown.is_none()
-        {
+        if self.breakdown.is_some() {
+            self.watch_step(wave)?;
+        }
+        let rectifier_target = matches!(
+            (self.target_voltage, self.target_time, self.load),
+            (Some(_), None, LoadModel::Rectifier(_))
+        );
+        if self.sampler.is_none() && self.vq.is_none() && !rectifier_target {
             return Ok(());
         }
         let Some(step) = self.last_step else {
             return Ok(());
         };
-        if self.breakdown.is_some() {
-            self.watch_step(&step, wave)?;
-        }
         let t1 = step.t0 + step.h;
         self.sample_between(step.t0, t1, wave, Some(&step))?;
         if let (Some(target), None, LoadModel::Rectifier(_)) =
@@ -61,14 +61,13 @@ impl ChargeSolver {
         Ok(())
     }
 
-    /// The air-breakdown check over an accepted step: its stage points (whose gaps are still
-    /// in `node_gaps`), refined between the neighbours of one that beats the worst so far.
-    pub(super) fn watch_step<W: GapWaveform + ?Sized>(
-        &mut self,
-        step: &Step,
-        wave: &W,
-    ) -> Result<(), ElectricalError> {
-        let Some(mut watch) = self.breakdown.take() else {
+    /// The air-breakdown check over the last accepted step: its stage points (whose gaps are
+    /// still in `node_gaps`), refined between the neighbours of one that beats the worst so
+    /// far. A step none of whose stage points can beat the worst (a bound over the step,
+    /// [`BreakdownWatch::may_beat`](crate::electrical::breakdown::BreakdownWatch::may_beat))
+    /// is passed over: observing its points would change nothing.
+    pub(super) fn watch_step<W: GapWaveform + ?Sized>(&mut self, wave: &W) -> Result<(), ElectricalError> {
+        let (Some(step), Some(watch)) = (self.last_step.as_ref(), self.breakdown.as_ref()) else {
             return Ok(());
         };
         let n = self.gaps.len();
@@ -78,13 +77,31 @@ impl ChargeSolver {
             &self.tab_rectifier.c
         };
         let node = |i: usize| step.t0 + c[i] * step.h;
+        if node(step.stages - 1) < watch.from() {
+            return Ok(());
+        }
+        let mut charges = [0.0; MAX_STAGES];
+        for (i, q) in charges[..step.stages].iter_mut().enumerate() {
+            *q = step.y0[0] + step.z[0][i] + step.qeq0 + step.dq[i];
+        }
+        if !watch.may_beat(&charges[..step.stages], &self.node_gaps[..step.stages * n]) {
+            return Ok(());
+        }
+        let step = *step;
+        let Some(mut watch) = self.breakdown.take() else {
+            return Ok(());
+        };
+        let c: &[f64] = if step.stages == RESISTOR_STAGES {
+            &self.tab_resistor.c
+        } else {
+            &self.tab_rectifier.c
+        };
+        let node = |i: usize| step.t0 + c[i] * step.h;
         let mut best = None;
-        if node(step.stages - 1) >= watch.from() {
-            for i in 0..step.stages {
-                let q = step.y0[0] + step.z[0][i] + step.qeq0 + step.dq[i];
-                if watch.observe(node(i), q, &self.node_gaps[i * n..(i + 1) * n]) {
-                    best = Some(i);
-                }
+        for i in 0..step.stages {
+            let q = step.y0[0] + step.z[0][i] + step.qeq0 + step.dq[i];
+            if watch.observe(node(i), q, &self.node_gaps[i * n..(i + 1) * n]) {
+                best = Some(i);
             }
         }
         let mut result = Ok(());
@@ -94,7 +111,7 @@ impl ChargeSolver {
             watch.refine(a, b, |t, gaps| match self.eval(t, wave) {
                 Ok(ts) => {
                     gaps.copy_from_slice(&self.gaps[..gaps.len()]);
-                    let (y, _) = self.dense(step, t, ts.equilibrium_charge);
+                    let (y, _) = self.dense(&step, t, ts.equilibrium_charge);
                     Some(y[0] + ts.equilibrium_charge)
                 }
                 Err(e) => {
