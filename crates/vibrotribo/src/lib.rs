@@ -43,6 +43,7 @@ pub mod analysis;
 pub mod attractors;
 #[cfg(feature = "config")]
 pub mod config;
+pub mod coupling;
 pub mod dynamics;
 pub mod electrical;
 mod error;

@@ -5,7 +5,7 @@
 //! allocation, `Copy`) so that an [`Oscillator`](super::Oscillator) can carry one.
 
 /// Highest degree of an external force polynomial.
-pub(crate) const MAX_DEGREE: usize = 8;
+pub(crate) const MAX_DEGREE: usize = 12;
 
 /// Coefficients of a polynomial of degree [`MAX_DEGREE`].
 pub(crate) const TERMS: usize = MAX_DEGREE + 1;

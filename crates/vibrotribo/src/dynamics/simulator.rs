@@ -373,6 +373,19 @@ impl Simulator {
         });
     }
 
+    /// A stored piece of this simulator's flow as a [`Flow`] (the chain's offsets, gaps and
+    /// forcing are this simulator's).
+    pub(crate) fn flow_of<'a>(&'a self, segment: &'a super::observer::Segment) -> Flow<'a> {
+        Flow {
+            t_start: segment.t_start,
+            t_end: segment.t_end,
+            clusters: &segment.clusters,
+            offsets: &self.offsets,
+            gaps: &self.params.gaps,
+            forcing: &self.forcing,
+        }
+    }
+
     /// Moves the clock to `t` and evaluates every mass there (no event applied).
     fn advance_state(&mut self, t: f64) {
         let ph = self.forcing.phase(t);

@@ -74,11 +74,13 @@
 //! polynomial with the transducer evaluated exactly at the sample time.
 
 mod api;
+mod checkpoint;
 mod output;
 mod results;
 mod state;
 mod step;
 
+pub use checkpoint::ChargeCheckpoint;
 pub use results::{
     ChargeOptions, ElectricalSamples, PeriodStats, PowerSummary, SolverStats, power_curve, summarize,
 };

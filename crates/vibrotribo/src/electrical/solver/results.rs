@@ -109,6 +109,18 @@ pub struct ElectricalSamples {
 }
 
 impl ElectricalSamples {
+    /// Keeps the first `n` samples.
+    pub(super) fn truncate(&mut self, n: usize) {
+        self.times.truncate(n);
+        self.charge_c.truncate(n);
+        self.current_a.truncate(n);
+        self.voltage_v.truncate(n);
+        self.capacitance_f.truncate(n);
+        self.voc_v.truncate(n);
+        self.storage_voltage_v.truncate(n);
+        self.energy_j.truncate(n);
+    }
+
     pub(super) fn push(&mut self, t: f64, row: &Row, rectifier: bool) {
         self.times.push(t);
         self.charge_c.push(row.charge);

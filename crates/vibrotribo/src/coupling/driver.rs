@@ -1,0 +1,498 @@
+//! The coupled run: windows of exact mechanics under a polynomial electrostatic force,
+//! relaxed against the charge solver (see the module docs of [`crate::coupling`]).
+
+use std::ops::ControlFlow;
+
+use thiserror::Error;
+
+use super::CouplingOptions;
+use super::window::{ChargePolynomial, DEGREE, NODES, force_polynomial, nodes, significant_degree};
+use crate::dynamics::{Event, Flow, Observer, RunEnd, Segment, Simulator, StateView, Verdict};
+use crate::electrical::{ChargeSolver, ElectricalError, Electrostatics, NoFieldEnergy};
+use crate::error::SimError;
+use crate::model::{ChainState, ForcePolynomial};
+
+/// A coupled run could not go on.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum CouplingError {
+    /// The mechanics stopped.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The charge solver stopped.
+    #[error("charge solver: {0}")]
+    Electrical(#[from] ElectricalError),
+    /// The transducer has no field energy.
+    #[error(transparent)]
+    NoFieldEnergy(#[from] NoFieldEnergy),
+    /// The windows had to shrink below rounding without meeting the tolerance.
+    #[error(
+        "two-way coupling: the window at t = {t} s shrank to {h:e} s without the charge meeting its \
+         tolerance (harvester.coupling_tolerance_m may be too tight)"
+    )]
+    WindowCollapsed {
+        /// Time, s.
+        t: f64,
+        /// Window length reached, s.
+        h: f64,
+    },
+}
+
+/// Work counters of a coupled run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CouplingStats {
+    /// Windows accepted.
+    pub windows: u64,
+    /// Relaxation sweeps (mechanics + charge over a window), accepted or not.
+    pub sweeps: u64,
+    /// Windows redone shorter because the charge polynomial's error estimate was too large.
+    pub shortened: u64,
+    /// Windows cut short by an event.
+    pub cut_by_event: u64,
+}
+
+/// What a coupled run reports to: an [`Observer`] of the accepted motion that also owns the
+/// charge solver the run advances. Its `flow` must not advance that solver again.
+pub trait ChargeHost: Observer {
+    /// The charge solver (advanced by the coupled run, which also rewinds it).
+    fn charge_solver(&mut self) -> &mut ChargeSolver;
+}
+
+/// A [`ChargeHost`] that only holds the solver (no other observer).
+#[derive(Debug, Clone)]
+pub struct SolverOnly(pub ChargeSolver);
+
+impl Observer for SolverOnly {}
+
+impl ChargeHost for SolverOnly {
+    fn charge_solver(&mut self) -> &mut ChargeSolver {
+        &mut self.0
+    }
+}
+
+/// Windows shorter than this many periods carry a constant charge (its variation there is far
+/// below any tolerance, and a polynomial in so short a time would only amplify rounding).
+const CONSTANT_BELOW: f64 = 1e-9;
+
+/// A window shortened for accuracy below this many periods fails the run.
+const MIN_WINDOW: f64 = 1e-12;
+
+/// Redos of one window cut by an event before its end is accepted where the event fell.
+const MAX_CUTS: u32 = 8;
+
+/// The last accepted window's charge, for predicting the next.
+#[derive(Debug, Clone, Copy)]
+struct Previous {
+    t0: f64,
+    charge: ChargePolynomial,
+    /// Whether an event ended it (then the charge's derivatives jump: no extrapolation).
+    cut: bool,
+}
+
+/// The chain and its harvester with the electrostatic force acting on the masses.
+///
+/// ```
+/// use vibrotribo::coupling::{CoupledChain, CouplingOptions, SolverOnly};
+/// use vibrotribo::electrical::{ChargeOptions, ChargeSolver, HarvesterParams, VocModel};
+/// use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator};
+///
+/// let chain = ChainParams::default();
+/// let harvester = HarvesterParams { voc_model: VocModel::Exact, ..HarvesterParams::default() };
+/// let sim = Simulator::new(&chain, &ChainState::at_rest(3), SimOptions::default())?;
+/// let mut host = SolverOnly(ChargeSolver::for_chain(&harvester, &chain, ChargeOptions::default())?);
+/// let mut coupled = CoupledChain::new(sim, &harvester, CouplingOptions::default())?;
+/// coupled.run_until(2.0 * chain.period(), &mut host)?;
+/// assert!(host.0.total_energy() > 0.0);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct CoupledChain {
+    sim: Simulator,
+    statics: Electrostatics,
+    options: CouplingOptions,
+    /// Preferred length of the next window, s.
+    h: f64,
+    previous: Option<Previous>,
+    /// Smallest mass, kg.
+    min_mass: f64,
+    /// Largest natural frequency of a single mass, rad/s.
+    omega_n: f64,
+    /// Smallest stiffness, N/m.
+    min_stiffness: f64,
+    stats: CouplingStats,
+    started: bool,
+    /// Per mass: the force polynomial of the current trial (N/sʲ in t − t₀).
+    forces: Vec<ForcePolynomial>,
+    segments: Vec<Segment>,
+    events: Vec<(Event, Vec<f64>, Vec<f64>)>,
+}
+
+impl CoupledChain {
+    /// Couples `sim` to the harvester `params` (whose solver the host of
+    /// [`run_until`](Self::run_until) owns). Refuses a transducer without field energy (the
+    /// paper's open-circuit voltage law).
+    pub fn new(
+        sim: Simulator,
+        params: &crate::electrical::HarvesterParams,
+        options: CouplingOptions,
+    ) -> Result<Self, CouplingError> {
+        let statics = Electrostatics::new(&params.transducer())?;
+        let n = sim.params().len();
+        let min_mass = sim.params().masses.iter().copied().fold(f64::INFINITY, f64::min);
+        let h = options.max_window_periods * sim.period();
+        let p = sim.params();
+        let omega_n = p
+            .masses
+            .iter()
+            .zip(&p.stiffness)
+            .map(|(m, k)| (k / m).sqrt())
+            .fold(0.0, f64::max);
+        let min_stiffness = p.stiffness.iter().copied().fold(f64::INFINITY, f64::min);
+        Ok(CoupledChain {
+            sim,
+            statics,
+            options,
+            h,
+            previous: None,
+            min_mass,
+            omega_n,
+            min_stiffness,
+            stats: CouplingStats::default(),
+            started: false,
+            forces: vec![ForcePolynomial::zero(); n],
+            segments: Vec::new(),
+            events: Vec::new(),
+        })
+    }
+
+    /// Current time, s.
+    pub fn time(&self) -> f64 {
+        self.sim.time()
+    }
+
+    /// The state of the chain now.
+    pub fn state(&self) -> ChainState {
+        self.sim.state()
+    }
+
+    /// The mechanics (with the force of the last window installed).
+    pub fn simulator(&self) -> &Simulator {
+        &self.sim
+    }
+
+    /// Work counters so far.
+    pub fn stats(&self) -> CouplingStats {
+        self.stats
+    }
+
+    /// Runs to `t_end`, s, reporting the accepted motion to `host` and advancing its charge
+    /// solver. Stops early (at a window's end) when `host` asks to.
+    pub fn run_until<H: ChargeHost + ?Sized>(
+        &mut self,
+        t_end: f64,
+        host: &mut H,
+    ) -> Result<RunEnd, CouplingError> {
+        if t_end.is_nan() || t_end < self.sim.time() {
+            return Err(SimError::Backwards {
+                requested: t_end,
+                current: self.sim.time(),
+            }
+            .into());
+        }
+        if !self.started {
+            self.start(host)?;
+        }
+        let period = self.sim.period();
+        while self.sim.time() < t_end {
+            let t0 = self.sim.time();
+            let mut boundary = ((t0 / period).floor() + 1.0) * period;
+            if boundary <= t0 * (1.0 + 4.0 * f64::EPSILON) {
+                boundary += period;
+            }
+            let limit = t_end.min(boundary);
+            self.window(t0, limit, host)?;
+            self.replay(host);
+            match host.proceed() {
+                Ok(ControlFlow::Continue(())) => {}
+                Ok(ControlFlow::Break(())) => return Ok(RunEnd::Stopped { t: self.sim.time() }),
+                Err(e) => return Err(SimError::Observer(e.to_string()).into()),
+            }
+        }
+        Ok(RunEnd::Reached)
+    }
+
+    /// Starts the solver at the current time (its initial charge) if it has not started.
+    fn start<H: ChargeHost + ?Sized>(&mut self, host: &mut H) -> Result<(), CouplingError> {
+        let t0 = self.sim.time();
+        let state = self.sim.state();
+        let deltas = self.sim.params().gaps.clone();
+        let wave = |_: f64, gaps: &mut [f64], rates: &mut [f64]| {
+            for k in 0..gaps.len() {
+                gaps[k] = deltas[k] - (state.positions[k + 1] - state.positions[k]);
+                rates[k] = -(state.velocities[k + 1] - state.velocities[k]);
+            }
+        };
+        host.charge_solver().advance(t0, t0, &wave)?;
+        self.started = true;
+        Ok(())
+    }
+
+    /// The charge tolerance of a window of length `h`, C, around charge `q0`.
+    fn charge_tolerance(&self, h: f64, q0: f64, scale: f64) -> f64 {
+        let slope: f64 = self
+            .statics
+            .gap_force_polynomials()
+            .map(|(_, c)| c[1].abs() + 2.0 * c[2].abs() * (q0.abs() + scale))
+            .fold(0.0, f64::max);
+        let tol_x = self.options.position_tolerance;
+        let omega = 2.0 * std::f64::consts::PI / self.sim.period();
+        // The force error δF = slope·δQ moves a mass by ∫(h − τ)δF/m ≤ h²·mean|δF|/m and
+        // changes its velocity by ≤ h·mean|δF|/m; the window's estimate bounds mean|δQ|.
+        let by_position = tol_x * self.min_mass / (slope * h * h);
+        let by_velocity = tol_x * omega * self.min_mass / (slope * h);
+        by_position.min(by_velocity).max(1e-15 * scale)
+    }
+
+    /// Installs on `sim` the force polynomials of the charge `q` on a window from `t0`.
+    fn install(
+        &mut self,
+        sim: &mut Simulator,
+        t0: f64,
+        q: &ChargePolynomial,
+        negligible: f64,
+    ) -> Result<(), SimError> {
+        for f in &mut self.forces {
+            f.t_ref = t0;
+            f.coefficients.clear();
+            f.coefficients.resize(super::window::FORCE_DEGREE + 1, 0.0);
+        }
+        for (k, c) in self.statics.gap_force_polynomials() {
+            let g = force_polynomial(q, c);
+            for (j, gj) in g.iter().enumerate() {
+                self.forces[k].coefficients[j] += gj;
+                self.forces[k + 1].coefficients[j] -= gj;
+            }
+        }
+        for f in &mut self.forces {
+            let keep = significant_degree(&f.coefficients, q.h, negligible);
+            f.coefficients.truncate(keep + 1);
+        }
+        sim.set_external_forces(&self.forces)
+    }
+
+    /// The charge polynomial through `values` at the nodes of a window of length `h`, s, cut
+    /// to the highest degree whose force polynomials the engine can integrate without
+    /// amplifying rounding beyond a hundredth of the position tolerance: the particular
+    /// solution of a force term f_j τʲ carries terms up to j!/(ω_n h)ʲ times its static
+    /// effect f_j hʲ/K, which the homogeneous part then cancels. Constant on windows shorter
+    /// than [`CONSTANT_BELOW`] periods.
+    fn fit(&self, values: &[f64; NODES], h: f64) -> ChargePolynomial {
+        let period = self.sim.period();
+        if h < CONSTANT_BELOW * period {
+            return ChargePolynomial::constant(values[0], h);
+        }
+        let full = ChargePolynomial::new(values, h);
+        let x = self.omega_n * h;
+        let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
+        for degree in (1..=DEGREE).rev() {
+            let q = full.truncated(degree);
+            let safe = self.statics.gap_force_polynomials().all(|(_, c)| {
+                let f = force_polynomial(&q, c);
+                let mut amplified = 0.0;
+                let mut factorial = 1.0;
+                for (j, fj) in f.iter().enumerate().skip(1) {
+                    factorial *= j as f64;
+                    let effect = fj.abs() * h.powi(j as i32);
+                    amplified += effect * (factorial / x.powi(j as i32)).max(1.0);
+                }
+                amplified <= budget
+            });
+            if safe {
+                return q;
+            }
+        }
+        full.truncated(0)
+    }
+
+    /// Finds and carries out the next window from `t0` (ending by `limit`, s): on return the
+    /// mechanics and the solver stand at its end and `segments`/`events` hold its motion.
+    fn window<H: ChargeHost + ?Sized>(
+        &mut self,
+        t0: f64,
+        limit: f64,
+        host: &mut H,
+    ) -> Result<(), CouplingError> {
+        let period = self.sim.period();
+        let mut h = self.h.min(limit - t0);
+        let q0 = host.charge_solver().charge();
+        let scale = host.charge_solver().transducer().charge_scale();
+        let mut guess = match self.previous {
+            Some(p) if !p.cut => self.fit(&p.charge.values_at_nodes(t0 - p.t0, h), h),
+            _ => ChargePolynomial::constant(q0, h),
+        };
+        let mut sweeps = 0;
+        let mut cuts = 0;
+        loop {
+            sweeps += 1;
+            self.stats.sweeps += 1;
+            let tol = self.charge_tolerance(h, q0, scale);
+            let negligible = 0.01 * 2.0 * self.options.position_tolerance * self.min_mass / (h * h);
+            let cp = host.charge_solver().checkpoint();
+            let mut trial = self.sim.clone();
+            self.install(&mut trial, t0, &guess, negligible)?;
+            self.segments.clear();
+            self.events.clear();
+            let times = nodes(t0, h);
+            let mut values = [q0; NODES];
+            let mut cut = None;
+            {
+                let mut watcher = Trial {
+                    host: &mut *host,
+                    segments: &mut self.segments,
+                    events: &mut self.events,
+                };
+                for j in 1..NODES {
+                    match trial.run_until(times[j], &mut watcher) {
+                        Ok(RunEnd::Reached) => values[j] = watcher.host.charge_solver().charge(),
+                        Ok(RunEnd::Stopped { t }) => {
+                            cut = Some((j, t));
+                            break;
+                        }
+                        Err(SimError::Observer(_)) => {
+                            let e = watcher.host.charge_solver().status().err();
+                            return Err(match e {
+                                Some(e) => e.into(),
+                                None => SimError::Observer("coupled run".into()).into(),
+                            });
+                        }
+                        Err(e) => return Err(e.into()),
+                    }
+                }
+            }
+            if let Some((j, te)) = cut {
+                // An event inside the window: at its last node (the window ends there, with the
+                // event applied) or before it (redo the window up to the event).
+                let at_end = j == NODES - 1 && (times[j] - te).abs() <= 1e-9 * h;
+                if at_end || cuts >= MAX_CUTS {
+                    values[j] = host.charge_solver().charge();
+                } else {
+                    host.charge_solver().rewind(&cp);
+                    self.stats.cut_by_event += 1;
+                    cuts += 1;
+                    let shorter = te - t0;
+                    if shorter <= 0.0 {
+                        // The event is at the window's start: accept it with no flow.
+                        self.accept(trial, t0, ChargePolynomial::constant(q0, 0.0), true, None);
+                        return Ok(());
+                    }
+                    guess = self.fit(&guess.values_at_nodes(0.0, shorter), shorter);
+                    h = shorter;
+                    continue;
+                }
+            }
+            let sampled = self.fit(&values, h);
+            let misfit = guess
+                .values_at_nodes(0.0, h)
+                .iter()
+                .zip(&values)
+                .map(|(g, v)| (g - v).abs())
+                .fold(0.0, f64::max);
+            let estimate = sampled.error_estimate();
+            if estimate > tol {
+                host.charge_solver().rewind(&cp);
+                self.stats.shortened += 1;
+                let factor = (0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)).clamp(0.1, 0.8);
+                let shorter = h * factor;
+                if shorter <= MIN_WINDOW * period {
+                    return Err(CouplingError::WindowCollapsed { t: t0, h: shorter });
+                }
+                guess = self.fit(&sampled.values_at_nodes(0.0, shorter), shorter);
+                h = shorter;
+                self.h = self.h.min(h);
+                sweeps = 0;
+                continue;
+            }
+            if misfit > tol {
+                host.charge_solver().rewind(&cp);
+                if sweeps >= self.options.max_iterations {
+                    h *= 0.5;
+                    if h <= MIN_WINDOW * period {
+                        return Err(CouplingError::WindowCollapsed { t: t0, h });
+                    }
+                    self.h = self.h.min(h);
+                    sweeps = 0;
+                    guess = self.fit(&sampled.values_at_nodes(0.0, h), h);
+                } else {
+                    guess = sampled;
+                }
+                continue;
+            }
+            let grow = if estimate > 0.0 {
+                (0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)).clamp(0.2, 2.0)
+            } else {
+                2.0
+            };
+            let next = (h * grow).min(self.options.max_window_periods * period);
+            self.accept(trial, t0, sampled, cut.is_some(), Some(next));
+            return Ok(());
+        }
+    }
+
+    fn accept(&mut self, trial: Simulator, t0: f64, charge: ChargePolynomial, cut: bool, next: Option<f64>) {
+        self.sim = trial;
+        self.stats.windows += 1;
+        self.previous = Some(Previous { t0, charge, cut });
+        if let Some(next) = next
+            && (!cut || next < self.h)
+        {
+            self.h = next;
+        }
+    }
+
+    /// Reports the accepted window's motion to `host`.
+    fn replay<H: ChargeHost + ?Sized>(&mut self, host: &mut H) {
+        for seg in &self.segments {
+            host.flow(&self.sim.flow_of(seg));
+        }
+        for (e, x, v) in &self.events {
+            host.event(
+                e,
+                &StateView {
+                    time: e.time,
+                    positions: x,
+                    velocities: v,
+                },
+            );
+        }
+    }
+}
+
+/// The observer of a trial window: advances the host's solver over the flow, records the
+/// flow and events for the host, and stops at the first event.
+struct Trial<'a, H: ?Sized> {
+    host: &'a mut H,
+    segments: &'a mut Vec<Segment>,
+    events: &'a mut Vec<(Event, Vec<f64>, Vec<f64>)>,
+}
+
+impl<H: ChargeHost + ?Sized> Observer for Trial<'_, H> {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        self.host.charge_solver().flow(flow);
+        self.segments.push(flow.to_segment());
+    }
+
+    fn event(&mut self, event: &Event, state: &StateView<'_>) {
+        self.events
+            .push((*event, state.positions.to_vec(), state.velocities.to_vec()));
+    }
+
+    fn proceed(&mut self) -> Verdict {
+        let _ = self.host.charge_solver().proceed()?;
+        if self.events.is_empty() {
+            Ok(ControlFlow::Continue(()))
+        } else {
+            Ok(ControlFlow::Break(()))
+        }
+    }
+}
