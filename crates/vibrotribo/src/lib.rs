@@ -46,6 +46,7 @@ pub mod config;
 pub mod dynamics;
 pub mod electrical;
 mod error;
+pub mod excitation;
 pub mod lyapunov;
 pub mod model;
 pub mod orbits;
