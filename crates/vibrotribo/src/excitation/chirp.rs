@@ -107,13 +107,24 @@ impl Chirp {
         self.amplitude * (w.powi(4) + 6.0 * w * w * p2 + 4.0 * w * p3 + 3.0 * p2 * p2 + p4)
     }
 
+    /// The number of spline intervals [`to_spline`](Self::to_spline) would use for
+    /// `tolerance` (m) (checks the parameters without building).
+    pub fn intervals_needed(&self, tolerance: f64) -> Result<usize, SignalError> {
+        self.validate()?;
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(SignalError::Invalid(format!(
+                "spline tolerance {tolerance} m: must be finite and > 0"
+            )));
+        }
+        intervals_for(self.duration, tolerance, self.fourth_derivative_bound(), 3, "the chirp")
+    }
+
     /// The clamped cubic spline of the chirp on equal knots over `[0, D]`, close enough that
     /// the displacement error is at most `tolerance` (m) by the bound of
     /// [`spline_error_bounds`](super::spline_error_bounds), and the bounds achieved.
     pub fn to_spline(&self, tolerance: f64) -> Result<(PiecewiseCubic, SplineAccuracy), SignalError> {
-        self.validate()?;
+        let n = self.intervals_needed(tolerance)?;
         let m4 = self.fourth_derivative_bound();
-        let n = intervals_for(self.duration, tolerance, m4, 3, "the chirp")?;
         let spline = sample_smooth(|t| self.displacement_velocity(t), self.duration, n)?;
         Ok((spline, SplineAccuracy::new(self.duration / n as f64, m4)))
     }

@@ -216,23 +216,21 @@ impl RandomSpec {
             .collect())
     }
 
-    /// The clamped cubic spline of the displacement over `[0, D]` on equal knots, close
-    /// enough that its error is at most `relative_tolerance` times the RMS displacement
-    /// (bound of [`spline_error_bounds`](super::spline_error_bounds) with M₄ = Σ|A_k|ω_k⁴);
-    /// the values at the knots by an inverse FFT (exact up to rounding), the end slopes by
-    /// direct summation. Also returns the displacement harmonics and the accuracy.
-    pub fn to_spline(
-        &self,
-        relative_tolerance: f64,
-    ) -> Result<(PiecewiseCubic, SplineAccuracy, Vec<Harmonic>), SignalError> {
+    /// The displacement harmonics, the number of spline intervals (an FFT-friendly size
+    /// with at least 2 per period of the highest component) and M₄ for `relative_tolerance`.
+    fn plan(&self, relative_tolerance: f64) -> Result<(Vec<Harmonic>, usize, f64), SignalError> {
+        if !(relative_tolerance.is_finite() && relative_tolerance > 0.0) {
+            return Err(SignalError::Invalid(format!(
+                "spline_tolerance = {relative_tolerance}: must be finite and > 0"
+            )));
+        }
         let harmonics = self.displacement_harmonics()?;
         let d = self.duration;
         let rms = (harmonics.iter().map(|h| h.amplitude * h.amplitude).sum::<f64>() / 2.0).sqrt();
         let m4 = fourth_derivative_bound(&harmonics);
-        let tolerance = relative_tolerance * rms;
         let k_max = (harmonics.last().map_or(0.0, |h| h.omega) * d / TAU).round() as usize;
         let wanted = if m4 > 0.0 {
-            intervals_for(d, tolerance, m4, 2 * k_max + 2, "the random signal")?
+            intervals_for(d, relative_tolerance * rms, m4, 2 * k_max + 2, "the random signal")?
         } else {
             4
         };
@@ -242,6 +240,26 @@ impl RandomSpec {
                 "the random signal would need {n} spline knots (at most {MAX_KNOTS})"
             )));
         }
+        Ok((harmonics, n, m4))
+    }
+
+    /// The number of spline intervals [`to_spline`](Self::to_spline) would use (checks the
+    /// parameters without building).
+    pub fn intervals_needed(&self, relative_tolerance: f64) -> Result<usize, SignalError> {
+        self.plan(relative_tolerance).map(|(_, n, _)| n)
+    }
+
+    /// The clamped cubic spline of the displacement over `[0, D]` on equal knots, close
+    /// enough that its error is at most `relative_tolerance` times the RMS displacement
+    /// (bound of [`spline_error_bounds`](super::spline_error_bounds) with M₄ = Σ|A_k|ω_k⁴);
+    /// the values at the knots by an inverse FFT (exact up to rounding), the end slopes by
+    /// direct summation. Also returns the displacement harmonics and the accuracy.
+    pub fn to_spline(
+        &self,
+        relative_tolerance: f64,
+    ) -> Result<(PiecewiseCubic, SplineAccuracy, Vec<Harmonic>), SignalError> {
+        let (harmonics, n, m4) = self.plan(relative_tolerance)?;
+        let d = self.duration;
         let mut buffer = vec![Complex::new(0.0, 0.0); n];
         for h in &harmonics {
             let k = (h.omega * d / TAU).round() as usize;
