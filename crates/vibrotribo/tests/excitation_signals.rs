@@ -4,6 +4,9 @@
 //! instantaneous frequency from the zero crossings of the built signal, random signals'
 //! spectrum by an FFT of the signal, and the errors of bad records and keys.
 
+// Index loops read as the formulas they implement (Gaussian elimination, spectral bins).
+#![allow(clippy::needless_range_loop)]
+
 use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
 
@@ -55,7 +58,9 @@ fn cubic_projection(f: &dyn Fn(f64) -> f64, length: f64, pieces: usize) -> impl 
 /// Gaussian elimination with partial pivoting, 4×4.
 fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> [f64; 4] {
     for c in 0..4 {
-        let p = (c..4).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap();
+        let p = (c..4)
+            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+            .unwrap();
         a.swap(c, p);
         b.swap(c, p);
         for r in c + 1..4 {
@@ -86,7 +91,9 @@ fn samples(times: Vec<f64>, values: Vec<f64>) -> RecordSamples {
 
 /// A directory of the test's own (inside the target directory) for record files.
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("excitation_signals").join(name);
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("excitation_signals")
+        .join(name);
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -121,7 +128,11 @@ fn spline_of_a_sine_at_200_points_per_period() {
     let mut worst = [[0.0f64; 3]; 2];
     for k in 0..=200_000 {
         let t = times[2000] * k as f64 / 200_000.0;
-        let exact = [a * (w * t).sin(), a * w * (w * t).cos(), -a * w * w * (w * t).sin()];
+        let exact = [
+            a * (w * t).sin(),
+            a * w * (w * t).cos(),
+            -a * w * w * (w * t).sin(),
+        ];
         for (s, spline) in [&clamped, &not_a_knot].into_iter().enumerate() {
             let got = spline.evaluate(t);
             for d in 0..3 {
@@ -132,11 +143,19 @@ fn spline_of_a_sine_at_200_points_per_period() {
     println!("clamped: errors {:?}, bounds {bounds:?}", worst[0]);
     println!("not-a-knot: errors {:?}", worst[1]);
     for d in 0..3 {
-        assert!(worst[0][d] <= bounds[d], "clamped, derivative {d}: {:?}", worst[0]);
+        assert!(
+            worst[0][d] <= bounds[d],
+            "clamped, derivative {d}: {:?}",
+            worst[0]
+        );
     }
     assert!(worst[1][0] <= bounds[0], "not-a-knot: {:?}", worst[1]);
     for s in [&clamped, &not_a_knot] {
-        assert!(s.continuity_defects().iter().all(|&d| d < 1e-12), "{:?}", s.continuity_defects());
+        assert!(
+            s.continuity_defects().iter().all(|&d| d < 1e-12),
+            "{:?}",
+            s.continuity_defects()
+        );
     }
 }
 
@@ -195,9 +214,15 @@ fn triangle_wave_acceleration_integrates_exactly() {
     println!("triangle: worst displacement error {worst:e} m of {scale:e} m");
     assert!(worst < 1e-9 * scale, "{worst:e}");
     let b = report.baseline.unwrap();
-    assert!((b.acceleration_offset - (d0 + p3(0.0)[2])).abs() < 1e-9 * a0, "{b:?}");
+    assert!(
+        (b.acceleration_offset - (d0 + p3(0.0)[2])).abs() < 1e-9 * a0,
+        "{b:?}"
+    );
     let slope_p3 = (p3(length)[2] - p3(0.0)[2]) / length;
-    assert!((b.acceleration_slope - (d1 + slope_p3)).abs() < 1e-9 * a0, "{b:?}");
+    assert!(
+        (b.acceleration_slope - (d1 + slope_p3)).abs() < 1e-9 * a0,
+        "{b:?}"
+    );
     assert!(s.continuity_defects().iter().all(|&d| d < 1e-12));
 }
 
@@ -214,7 +239,12 @@ fn sampled_sine_acceleration_with_drift() {
         .iter()
         .map(|&t| -amp * w * w * (w * t).sin() + 0.3 - 0.2 * t)
         .collect();
-    let (s, _) = record_displacement(&samples(times, acc), Quantity::Acceleration, RecordScaling::Factor(1.0)).unwrap();
+    let (s, _) = record_displacement(
+        &samples(times, acc),
+        Quantity::Acceleration,
+        RecordScaling::Factor(1.0),
+    )
+    .unwrap();
     let y = |t: f64| amp * (w * t).sin();
     let p3 = cubic_projection(&y, length, 2000);
     let raw_bound = length * length / 2.0 * h * h / 8.0 * amp * w.powi(4);
@@ -224,7 +254,10 @@ fn sampled_sine_acceleration_with_drift() {
         let t = length * k as f64 / 4000.0;
         worst = worst.max((s.displacement(t) - (y(t) - p3(t)[0])).abs());
     }
-    println!("sampled sine: error {worst:e} m, bound {:e} m", lebesgue * raw_bound);
+    println!(
+        "sampled sine: error {worst:e} m, bound {:e} m",
+        lebesgue * raw_bound
+    );
     assert!(worst <= lebesgue * raw_bound, "{worst:e}");
 }
 
@@ -323,7 +356,11 @@ fn spectrum(harmonics: &[Harmonic], d: f64, n: usize) -> (Vec<f64>, Vec<f64>) {
         .collect();
     let mut buf: Vec<Complex<f64>> = acc.iter().map(|&a| Complex::new(a, 0.0)).collect();
     FftPlanner::new().plan_fft_forward(n).process(&mut buf);
-    let amp = buf.iter().take(n / 2).map(|z| 2.0 * z.norm() / n as f64).collect();
+    let amp = buf
+        .iter()
+        .take(n / 2)
+        .map(|z| 2.0 * z.norm() / n as f64)
+        .collect();
     (acc, amp)
 }
 
@@ -356,12 +393,18 @@ fn random_signal_rms_band_and_psd() {
     let nominal = rms * rms / (hi - lo);
     for &k in &lines {
         let level = amp[k] * amp[k] / 2.0 * d;
-        assert!((level / nominal - 1.0).abs() <= 1.0 / ((hi - lo) * d) + 1e-9, "bin {k}: {level}");
+        assert!(
+            (level / nominal - 1.0).abs() <= 1.0 / ((hi - lo) * d) + 1e-9,
+            "bin {k}: {level}"
+        );
     }
     // The spline's acceleration is the signal within its bound.
     for j in (0..n).step_by(7) {
         let t = d * j as f64 / n as f64;
-        assert!((s.acceleration(t) - acc[j]).abs() <= acc_bounds.error_bounds[2], "t = {t}");
+        assert!(
+            (s.acceleration(t) - acc[j]).abs() <= acc_bounds.error_bounds[2],
+            "t = {t}"
+        );
     }
     // A table.
     let (fs, vs) = (vec![3.0, 10.0, 30.0], vec![0.0, 0.5, 0.1]);
@@ -491,7 +534,9 @@ fn bad_excitations_are_named() {
         std::fs::write(&p, text).unwrap();
         p.display().to_string()
     };
-    let good: String = (0..=3000).map(|k| format!("{},{}\n", k as f64 * 0.01, (k as f64 * 0.3).sin())).collect();
+    let good: String = (0..=3000)
+        .map(|k| format!("{},{}\n", k as f64 * 0.01, (k as f64 * 0.3).sin()))
+        .collect();
     let good = write("good.csv", &format!("time_s,acceleration_m_s2\n{good}"));
     let record = |file: &str, extra: &str| {
         format!("[excitation]\nkind = \"record\"\nfile = \"{file}\"\nquantity = \"acceleration\"\n{extra}")
@@ -603,7 +648,9 @@ fn bad_excitations_are_named() {
 fn record_paths_are_relative_to_the_configuration() {
     let dir = scratch("relative");
     std::fs::create_dir_all(dir.join("data")).unwrap();
-    let body: String = (0..=400).map(|k| format!("{},{}\n", k as f64 * 0.05, 0.001 * (k as f64 * 0.2).sin())).collect();
+    let body: String = (0..=400)
+        .map(|k| format!("{},{}\n", k as f64 * 0.05, 0.001 * (k as f64 * 0.2).sin()))
+        .collect();
     std::fs::write(dir.join("data/rec.csv"), format!("time_s,displacement_m\n{body}")).unwrap();
     std::fs::write(
         dir.join("run.toml"),

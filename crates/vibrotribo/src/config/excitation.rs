@@ -19,7 +19,9 @@ pub const MAX_HARMONICS: usize = 64;
 /// The default `excitation.spline_tolerance` (relative).
 pub const DEFAULT_SPLINE_TOLERANCE: f64 = 1e-9;
 
-use ExcitationKind::{Chirp as K_CHIRP, Harmonic as K_HARMONIC, Multisine as K_MULTI, Random as K_RANDOM, Record as K_RECORD};
+use ExcitationKind::{
+    Chirp as K_CHIRP, Harmonic as K_HARMONIC, Multisine as K_MULTI, Random as K_RANDOM, Record as K_RECORD,
+};
 
 /// The kind-specific keys of `t` that are given, with the kinds they belong to.
 fn given_keys(t: &ExcitationTable) -> Vec<(&'static str, &'static [ExcitationKind])> {
@@ -30,7 +32,11 @@ fn given_keys(t: &ExcitationTable) -> Vec<(&'static str, &'static [ExcitationKin
         ("f_end_hz", t.f_end_hz.is_some(), &[K_CHIRP]),
         ("sweep", t.sweep.is_some(), &[K_CHIRP]),
         ("duration_s", t.duration_s.is_some(), &[K_CHIRP, K_RANDOM]),
-        ("spline_tolerance", t.spline_tolerance.is_some(), &[K_CHIRP, K_RANDOM]),
+        (
+            "spline_tolerance",
+            t.spline_tolerance.is_some(),
+            &[K_CHIRP, K_RANDOM],
+        ),
         ("rms_acceleration", t.rms_acceleration.is_some(), &[K_RANDOM]),
         ("f_low_hz", t.f_low_hz.is_some(), &[K_RANDOM]),
         ("f_high_hz", t.f_high_hz.is_some(), &[K_RANDOM]),
@@ -144,10 +150,12 @@ pub(super) fn excitation_of(
     Ok(match kind {
         K_HARMONIC => ExcitationSpec::Harmonic,
         K_MULTI => {
-            let entries = t
-                .harmonics
-                .as_ref()
-                .ok_or_else(|| conflict("harmonics", "kind = \"multisine\" needs excitation.harmonics".into()))?;
+            let entries = t.harmonics.as_ref().ok_or_else(|| {
+                conflict(
+                    "harmonics",
+                    "kind = \"multisine\" needs excitation.harmonics".into(),
+                )
+            })?;
             if entries.is_empty() || entries.len() > MAX_HARMONICS {
                 return Err(conflict(
                     "harmonics",
@@ -178,7 +186,11 @@ pub(super) fn excitation_of(
             }
             ExcitationSpec::Chirp {
                 chirp,
-                tolerance: if tolerance > 0.0 { tolerance } else { f64::MIN_POSITIVE },
+                tolerance: if tolerance > 0.0 {
+                    tolerance
+                } else {
+                    f64::MIN_POSITIVE
+                },
             }
         }
         K_RANDOM => {
@@ -190,7 +202,11 @@ pub(super) fn excitation_of(
                 },
                 (Some(f), Some(v), None) => {
                     for key in ["f_low_hz", "f_high_hz"] {
-                        let given = if key == "f_low_hz" { t.f_low_hz } else { t.f_high_hz };
+                        let given = if key == "f_low_hz" {
+                            t.f_low_hz
+                        } else {
+                            t.f_high_hz
+                        };
                         if given.is_some() {
                             return Err(conflict(
                                 key,
@@ -210,10 +226,16 @@ pub(super) fn excitation_of(
                     ));
                 }
                 (Some(_), None, None) => {
-                    return Err(conflict("psd_values", "psd_frequencies_hz needs psd_values".into()));
+                    return Err(conflict(
+                        "psd_values",
+                        "psd_frequencies_hz needs psd_values".into(),
+                    ));
                 }
                 (None, Some(_), None) => {
-                    return Err(conflict("psd_frequencies_hz", "psd_values needs psd_frequencies_hz".into()));
+                    return Err(conflict(
+                        "psd_frequencies_hz",
+                        "psd_values needs psd_frequencies_hz".into(),
+                    ));
                 }
                 (None, None, None) => {
                     return Err(conflict(
@@ -241,10 +263,12 @@ pub(super) fn excitation_of(
             }
         }
         K_RECORD => {
-            let file = t
-                .file
-                .as_ref()
-                .ok_or_else(|| conflict("file", "kind = \"record\" needs excitation.file (a CSV file)".into()))?;
+            let file = t.file.as_ref().ok_or_else(|| {
+                conflict(
+                    "file",
+                    "kind = \"record\" needs excitation.file (a CSV file)".into(),
+                )
+            })?;
             let quantity = required(t.quantity, "quantity", kind)?;
             let scaling = match (t.scale, t.peak_acceleration) {
                 (Some(_), Some(_)) => {

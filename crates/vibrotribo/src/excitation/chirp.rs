@@ -116,7 +116,13 @@ impl Chirp {
                 "spline tolerance {tolerance} m: must be finite and > 0"
             )));
         }
-        intervals_for(self.duration, tolerance, self.fourth_derivative_bound(), 3, "the chirp")
+        intervals_for(
+            self.duration,
+            tolerance,
+            self.fourth_derivative_bound(),
+            3,
+            "the chirp",
+        )
     }
 
     /// The clamped cubic spline of the chirp on equal knots over `[0, D]`, close enough that

@@ -37,7 +37,10 @@ pub fn evaluate_sum(harmonics: &[Harmonic], t: f64) -> [f64; 3] {
 
 /// A bound on |y''''| of the sum of `harmonics`, m/s⁴: Σ |A| ω⁴.
 pub fn fourth_derivative_bound(harmonics: &[Harmonic]) -> f64 {
-    harmonics.iter().map(|h| h.amplitude.abs() * h.omega.powi(4)).sum()
+    harmonics
+        .iter()
+        .map(|h| h.amplitude.abs() * h.omega.powi(4))
+        .sum()
 }
 
 /// What sampling a smooth signal into a spline achieved.
@@ -70,7 +73,13 @@ pub const MAX_KNOTS: usize = 20_000_000;
 /// The number of equal intervals over `[0, end]` (s) that keeps the clamped spline of a signal
 /// with |y''''| ≤ `m4` (m/s⁴) within `tolerance` (m), at least `min` of them. An error (in
 /// the words of `what`) if more than [`MAX_KNOTS`] would be needed.
-pub(crate) fn intervals_for(end: f64, tolerance: f64, m4: f64, min: usize, what: &str) -> Result<usize, SignalError> {
+pub(crate) fn intervals_for(
+    end: f64,
+    tolerance: f64,
+    m4: f64,
+    min: usize,
+    what: &str,
+) -> Result<usize, SignalError> {
     let h = if m4 > 0.0 {
         knot_spacing(tolerance, m4)
     } else {
@@ -154,7 +163,10 @@ mod tests {
             }
         }
         for d in 0..3 {
-            assert!(worst[d] <= acc.error_bounds[d], "derivative {d}: {worst:?} vs {acc:?}");
+            assert!(
+                worst[d] <= acc.error_bounds[d],
+                "derivative {d}: {worst:?} vs {acc:?}"
+            );
         }
     }
 }

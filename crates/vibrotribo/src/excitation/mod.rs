@@ -227,10 +227,7 @@ impl BaseMotion {
                 out.push(("duration_s".into(), format!("{:e}", s.displacement.end())));
                 if let Some(a) = &s.accuracy {
                     out.push(("knot_spacing_s".into(), format!("{:e}", a.knot_spacing)));
-                    out.push((
-                        "spline_error_bound_m".into(),
-                        format!("{:e}", a.error_bounds[0]),
-                    ));
+                    out.push(("spline_error_bound_m".into(), format!("{:e}", a.error_bounds[0])));
                     out.push((
                         "spline_velocity_error_bound_m_s".into(),
                         format!("{:e}", a.error_bounds[1]),
@@ -251,10 +248,7 @@ impl BaseMotion {
                             "baseline_acceleration_slope_m_s3".into(),
                             format!("{:e}", b.acceleration_slope),
                         ));
-                        out.push((
-                            "baseline_relative_size".into(),
-                            format!("{:e}", b.relative_size),
-                        ));
+                        out.push(("baseline_relative_size".into(), format!("{:e}", b.relative_size)));
                         out.push((
                             "baseline_removed_displacement_m".into(),
                             format!("{:e}", b.removed_displacement),

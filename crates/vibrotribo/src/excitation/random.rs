@@ -8,7 +8,9 @@ use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;
 
 use super::error::SignalError;
-use super::harmonics::{Harmonic, MAX_KNOTS, SplineAccuracy, evaluate_sum, fourth_derivative_bound, intervals_for};
+use super::harmonics::{
+    Harmonic, MAX_KNOTS, SplineAccuracy, evaluate_sum, fourth_derivative_bound, intervals_for,
+};
 use super::spline::{EndCondition, PiecewiseCubic};
 use crate::random::SplitMix64;
 
@@ -94,9 +96,12 @@ impl Psd {
                 f_high_hz,
             } => {
                 if !(rms.is_finite() && *rms >= 0.0) {
-                    return Err(SignalError::Invalid(format!("rms_acceleration = {rms}: must be finite and ≥ 0")));
+                    return Err(SignalError::Invalid(format!(
+                        "rms_acceleration = {rms}: must be finite and ≥ 0"
+                    )));
                 }
-                if !(f_low_hz.is_finite() && *f_low_hz > 0.0 && f_high_hz.is_finite() && f_high_hz > f_low_hz) {
+                if !(f_low_hz.is_finite() && *f_low_hz > 0.0 && f_high_hz.is_finite() && f_high_hz > f_low_hz)
+                {
                     return Err(SignalError::Invalid(format!(
                         "f_low_hz = {f_low_hz}, f_high_hz = {f_high_hz}: need 0 < f_low_hz < f_high_hz, finite"
                     )));
@@ -160,7 +165,9 @@ impl RandomSpec {
         self.psd.validate()?;
         let d = self.duration;
         if !(d.is_finite() && d > 0.0) {
-            return Err(SignalError::Invalid(format!("duration = {d} s: must be finite and > 0")));
+            return Err(SignalError::Invalid(format!(
+                "duration = {d} s: must be finite and > 0"
+            )));
         }
         let (lo, hi) = self.psd.band();
         let k0 = (lo * d).ceil().max(1.0);
@@ -230,7 +237,13 @@ impl RandomSpec {
         let m4 = fourth_derivative_bound(&harmonics);
         let k_max = (harmonics.last().map_or(0.0, |h| h.omega) * d / TAU).round() as usize;
         let wanted = if m4 > 0.0 {
-            intervals_for(d, relative_tolerance * rms, m4, 2 * k_max + 2, "the random signal")?
+            intervals_for(
+                d,
+                relative_tolerance * rms,
+                m4,
+                2 * k_max + 2,
+                "the random signal",
+            )?
         } else {
             4
         };
@@ -288,7 +301,7 @@ fn smooth_size(n: usize) -> usize {
     loop {
         let mut r = m;
         for p in [2, 3, 5] {
-            while r % p == 0 {
+            while r.is_multiple_of(p) {
                 r /= p;
             }
         }

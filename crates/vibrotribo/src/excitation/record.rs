@@ -78,7 +78,10 @@ pub fn parse_record(text: &str, path: &str) -> Result<RecordSamples, SignalError
     let (_, header) = lines
         .next()
         .ok_or_else(|| at(1, "empty file: expected a header `time_s,<value>`".into()))?;
-    let names: Vec<&str> = header.split(',').map(|c| c.trim().trim_start_matches('\u{feff}')).collect();
+    let names: Vec<&str> = header
+        .split(',')
+        .map(|c| c.trim().trim_start_matches('\u{feff}'))
+        .collect();
     if names.len() < 2 || names[0] != "time_s" {
         return Err(at(
             1,
@@ -93,7 +96,10 @@ pub fn parse_record(text: &str, path: &str) -> Result<RecordSamples, SignalError
         }
         let cells: Vec<&str> = text.split(',').map(str::trim).collect();
         if cells.len() < 2 {
-            return Err(at(line, format!("expected 2 cells (time_s, {}), got {text:?}", names[1])));
+            return Err(at(
+                line,
+                format!("expected 2 cells (time_s, {}), got {text:?}", names[1]),
+            ));
         }
         let number = |i: usize| -> Result<f64, SignalError> {
             let x: f64 = cells[i]
@@ -111,7 +117,9 @@ pub fn parse_record(text: &str, path: &str) -> Result<RecordSamples, SignalError
             let what = if t == last { "repeated" } else { "out of order" };
             return Err(at(
                 line,
-                format!("time_s = {t} is {what}: the previous sample is at {last} (times must increase strictly)"),
+                format!(
+                    "time_s = {t} is {what}: the previous sample is at {last} (times must increase strictly)"
+                ),
             ));
         }
         times.push(t);
@@ -190,14 +198,18 @@ pub fn record_displacement(
     let t = &samples.times;
     let mut spline = match quantity {
         Quantity::Displacement => PiecewiseCubic::interpolate(t, &samples.values, EndCondition::NotAKnot)?,
-        Quantity::Acceleration => PiecewiseCubic::integrate_linear_acceleration(t, &samples.values, 0.0, 0.0)?,
+        Quantity::Acceleration => {
+            PiecewiseCubic::integrate_linear_acceleration(t, &samples.values, 0.0, 0.0)?
+        }
     };
     let peak = peak_acceleration(&spline);
     let factor = match scaling {
         RecordScaling::Factor(f) => f,
         RecordScaling::PeakAcceleration(p) => {
             if peak == 0.0 {
-                return Err(whole("the acceleration is zero throughout: it cannot be scaled to a peak".into()));
+                return Err(whole(
+                    "the acceleration is zero throughout: it cannot be scaled to a peak".into(),
+                ));
             }
             p / peak
         }
@@ -206,7 +218,8 @@ pub fn record_displacement(
         return Err(whole(format!("scale factor {factor} is not finite")));
     }
     spline.scale(factor);
-    let baseline = (quantity == Quantity::Acceleration).then(|| correct_baseline(&mut spline, peak * factor.abs()));
+    let baseline =
+        (quantity == Quantity::Acceleration).then(|| correct_baseline(&mut spline, peak * factor.abs()));
     Ok((
         spline.clone(),
         RecordReport {
@@ -220,7 +233,11 @@ pub fn record_displacement(
 /// The largest |y''| at the knots (y'' of a C² piecewise cubic is piecewise linear, so this
 /// is its maximum), m/s².
 fn peak_acceleration(s: &PiecewiseCubic) -> f64 {
-    let peak = s.coefficients().iter().map(|c| (2.0 * c[2]).abs()).fold(0.0, f64::max);
+    let peak = s
+        .coefficients()
+        .iter()
+        .map(|c| (2.0 * c[2]).abs())
+        .fold(0.0, f64::max);
     peak.max(s.acceleration(s.end()).abs())
 }
 
@@ -305,11 +322,17 @@ mod tests {
         assert!(err("t,a\n0,1\n").contains("line 1: bad header"));
         assert!(err("time_s\n0\n").contains("bad header"));
         let e = err("time_s,a\n0,1\n0.1,x\n");
-        assert!(e.contains("r.csv, line 3") && e.contains("a = \"x\" is not a number"), "{e}");
+        assert!(
+            e.contains("r.csv, line 3") && e.contains("a = \"x\" is not a number"),
+            "{e}"
+        );
         let e = err("time_s,a\n0,1\n0.1,nan\n");
         assert!(e.contains("line 3") && e.contains("not finite"), "{e}");
         let e = err("time_s,a\n0,1\ninf,1\n");
-        assert!(e.contains("line 3") && e.contains("time_s = inf is not finite"), "{e}");
+        assert!(
+            e.contains("line 3") && e.contains("time_s = inf is not finite"),
+            "{e}"
+        );
         let e = err("time_s,a\n0,1\n0.2,1\n0.1,1\n0.3,1\n");
         assert!(e.contains("line 4") && e.contains("out of order"), "{e}");
         let e = err("time_s,a\n0,1\n0.2,1\n0.2,1\n0.3,1\n");

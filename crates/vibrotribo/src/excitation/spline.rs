@@ -71,7 +71,10 @@ impl PiecewiseCubic {
             )));
         }
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(SignalError::Invalid(format!("value {i} is not finite: {}", values[i])));
+            return Err(SignalError::Invalid(format!(
+                "value {i} is not finite: {}",
+                values[i]
+            )));
         }
         let slopes = spline_slopes(times, values, ends);
         Self::hermite(times, values, &slopes)
@@ -216,7 +219,13 @@ impl PiecewiseCubic {
                 }
             }
         }
-        std::array::from_fn(|d| if scale[d] > 0.0 { jump[d] / scale[d] } else { jump[d] })
+        std::array::from_fn(|d| {
+            if scale[d] > 0.0 {
+                jump[d] / scale[d]
+            } else {
+                jump[d]
+            }
+        })
     }
 
     /// Multiplies the displacement by `factor`.
@@ -276,7 +285,10 @@ pub(crate) fn check_times(times: &[f64], min: usize) -> Result<(), SignalError> 
         )));
     }
     if let Some(i) = times.iter().position(|t| !t.is_finite()) {
-        return Err(SignalError::Invalid(format!("knot {i} is not finite: {}", times[i])));
+        return Err(SignalError::Invalid(format!(
+            "knot {i} is not finite: {}",
+            times[i]
+        )));
     }
     if let Some(i) = times.windows(2).position(|w| w[1] <= w[0]) {
         return Err(SignalError::Invalid(format!(
