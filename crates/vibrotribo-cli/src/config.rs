@@ -16,13 +16,16 @@ pub struct ConfigArgs {
 }
 
 impl ConfigArgs {
-    /// Reads the file (or the defaults) and applies the overrides in order.
+    /// Reads the file (or the defaults) and applies the overrides in order; an error for an
+    /// `excitation.kind` the engine cannot run yet.
     pub fn load(&self) -> Result<Config> {
         let mut config = match &self.config {
             Some(path) => Config::from_path(path)?,
             None => Config::default(),
         };
         apply_overrides(&mut config, &self.set).context("--set")?;
+        // Every command simulates: refuse base motions the engine cannot run yet.
+        config.check_engine_support()?;
         Ok(config)
     }
 }

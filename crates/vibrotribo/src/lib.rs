@@ -47,6 +47,7 @@ pub mod coupling;
 pub mod dynamics;
 pub mod electrical;
 mod error;
+pub mod excitation;
 pub mod lyapunov;
 pub mod model;
 pub mod orbits;

@@ -48,6 +48,10 @@ pub enum ConfigError {
     /// A `key=value` override or a key is malformed.
     #[error("{0}")]
     Malformed(String),
+    /// A valid configuration the engine cannot run yet (`excitation.kind` other than
+    /// harmonic until issue 14's engine hookup).
+    #[error("{0}")]
+    Unsupported(String),
     /// Setting a key made another key bad (a derived key such as `mass_ratio` sets
     /// `oscillator.masses`; new masses may not fit the given gaps).
     #[error("{key}: {error}")]

@@ -14,8 +14,10 @@
 
 mod document;
 mod error;
+mod excitation;
 mod keys;
 
 pub use document::Config;
 pub use error::ConfigError;
+pub use excitation::{DEFAULT_SPLINE_TOLERANCE, MAX_HARMONICS};
 pub use keys::{DERIVED_KEYS, apply_overrides, known_keys, parse_override, parse_value};
