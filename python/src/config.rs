@@ -187,9 +187,13 @@ impl PyConfig {
     }
 }
 
-/// The configuration `obj` stands for: a `Config`, a dict, a path, or `None` (the defaults).
+/// The configuration `obj` stands for (a `Config`, a dict, a path, or `None`: the defaults),
+/// to be run: refused, naming the reason, if the engine cannot run it (as the command line
+/// refuses it).
 pub fn config_of(obj: &Bound<'_, PyAny>) -> PyResult<Config> {
-    PyConfig::read(Some(obj))
+    let config = PyConfig::read(Some(obj))?;
+    config.check_engine_support().map_err(config_error)?;
+    Ok(config)
 }
 
 #[pymethods]

@@ -735,7 +735,7 @@ fn bad_forces_are_refused_with_their_names() {
     let z = ForcePolynomial::zero();
     let err = sim.set_external_forces(&[z.clone(), z.clone()]).unwrap_err();
     assert!(err.to_string().contains("forces"), "{err}");
-    let high = ForcePolynomial::new(0.0, vec![1.0; 10]);
+    let high = ForcePolynomial::new(0.0, vec![1.0; vibrotribo::model::MAX_FORCE_DEGREE + 2]);
     let err = sim
         .set_external_forces(&[z.clone(), high, z.clone()])
         .unwrap_err();
