@@ -102,3 +102,37 @@ fn the_paper_voltage_law_is_refused() {
     let err = CoupledChain::new(sim, &HarvesterParams::default(), CouplingOptions::default()).unwrap_err();
     assert!(err.to_string().contains("voc_model = \"exact\""), "{err}");
 }
+
+/// The run layer's two-way mode (`harvester.coupling = "two_way"`) is the coupled chain:
+/// the same power to the last bit, and complete electrical samples.
+#[test]
+fn the_run_layer_runs_the_coupled_chain() {
+    use vibrotribo::coupling::Coupling;
+    use vibrotribo::study::{Harvester, RunSpec, simulate};
+    let chain = ChainParams::default();
+    let harvester = HarvesterParams {
+        coupling: Coupling::TwoWay,
+        ..exact_harvester(Load::Resistor { resistance: 1e5 })
+    };
+    let mut spec = RunSpec::new(chain.clone(), 12);
+    spec.transient_periods = 6;
+    spec.harvester = Some(Harvester::new(harvester.clone(), ChargeOptions::default()));
+    let outcome = simulate(&spec, &mut ()).unwrap();
+    let via_study = outcome.electrical.unwrap().power.unwrap().average_power_w;
+    let (_, solver) = coupled_run(&chain, &harvester, 12.0, harvester.coupling_tolerance);
+    let direct = solver.summary(6).unwrap().average_power_w;
+    assert_eq!(via_study.to_bits(), direct.to_bits(), "{via_study:e} vs {direct:e}");
+}
+
+/// Configuration: the key reads, and two-way coupling with the paper's voltage law is
+/// refused naming the key.
+#[test]
+fn the_coupling_key() {
+    use vibrotribo::config::Config;
+    let c = Config::from_toml_str("[harvester]\ncoupling = \"two_way\"\nvoc_model = \"exact\"\n").unwrap();
+    assert_eq!(c.harvester().coupling, vibrotribo::coupling::Coupling::TwoWay);
+    let err = Config::from_toml_str("[harvester]\ncoupling = \"two_way\"\n").unwrap_err().to_string();
+    assert!(err.contains("coupling") && err.contains("voc_model"), "{err}");
+    let err = Config::from_toml_str("[harvester]\ncoupling = \"both\"\n").unwrap_err().to_string();
+    assert!(err.contains("coupling"), "{err}");
+}

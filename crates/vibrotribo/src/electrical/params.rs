@@ -1,6 +1,7 @@
 //! Physical parameters of the triboelectric transducer and its load (the `[harvester]` table of
 //! a configuration file), and their validation.
 
+use crate::coupling::Coupling;
 use super::diode::Diode;
 use super::transducer::{ContactSeparation, Freestanding, Transducer};
 use crate::error::{ParamError, check_finite, check_non_negative, check_positive};
@@ -214,6 +215,15 @@ pub struct HarvesterParams {
     /// Charge transferred between the electrodes at the start, C (`harvester.initial_charge`).
     /// `None` (default): electrostatic equilibrium `Q(0) = C(0)·V_oc(0)`.
     pub initial_charge: Option<f64>,
+    /// Whether the charges act back on the masses (`harvester.coupling`): `"one_way"`
+    /// (default, the paper's model) or `"two_way"` (the electrostatic force on the plates,
+    /// [`crate::coupling`]; needs `voc_model = "exact"` in freestanding mode).
+    pub coupling: Coupling,
+    /// Two-way coupling: the displacement error, m, that the charge's representation over one
+    /// window may cause (`harvester.coupling_tolerance`, see
+    /// [`CouplingOptions::position_tolerance`](crate::coupling::CouplingOptions::position_tolerance)).
+    /// Default 1e-11 m.
+    pub coupling_tolerance: f64,
 }
 
 impl Default for HarvesterParams {
@@ -228,6 +238,8 @@ impl Default for HarvesterParams {
             relative_permittivity: [2.0, 2.0],
             load: Load::default(),
             initial_charge: None,
+            coupling: Coupling::OneWay,
+            coupling_tolerance: crate::coupling::CouplingOptions::default().position_tolerance,
         }
     }
 }
@@ -255,6 +267,16 @@ impl HarvesterParams {
         }
         if let Some(q) = self.initial_charge {
             check_finite("initial_charge", q)?;
+        }
+        check_positive("coupling_tolerance", self.coupling_tolerance)?;
+        if self.coupling == Coupling::TwoWay
+            && self.mode == TransducerMode::Freestanding
+            && self.voc_model == VocModel::Paper
+        {
+            return Err(ParamError::Conflict {
+                name: "coupling".into(),
+                message: super::energy::NoFieldEnergy::PaperVoc.to_string(),
+            });
         }
         match &self.load {
             Load::Resistor { resistance } => check_positive("load_resistance", *resistance),

@@ -9,6 +9,7 @@
 
 use super::diode::Diode;
 use super::params::{HarvesterParams, Load, LoadKind, Rectifier, TransducerMode, VocModel};
+use crate::coupling::Coupling;
 use crate::error::ParamError;
 
 /// The flat `[harvester]` table (see the module docs). Every field is a key; defaults are
@@ -45,6 +46,12 @@ pub struct HarvesterTable {
     pub target_voltage: Option<f64>,
     /// Initial transferred charge, C (absent: electrostatic equilibrium).
     pub initial_charge: Option<f64>,
+    /// `"one_way"` (default) or `"two_way"`: whether the electrostatic force of the charges
+    /// acts on the masses.
+    pub coupling: Coupling,
+    /// Two-way coupling: displacement error a window's charge representation may cause, m.
+    /// Default 1e-11.
+    pub coupling_tolerance: f64,
     /// Rectifier diodes: saturation current, A. Default 2.52e-9.
     pub diode_saturation_current: f64,
     /// Rectifier diodes: ideality factor. Default 1.752.
@@ -82,6 +89,8 @@ impl From<HarvesterParams> for HarvesterTable {
             storage_initial_voltage: r.storage_initial_voltage,
             target_voltage: r.target_voltage,
             initial_charge: h.initial_charge,
+            coupling: h.coupling,
+            coupling_tolerance: h.coupling_tolerance,
             diode_saturation_current: r.diode.saturation_current,
             diode_ideality: r.diode.ideality,
             diode_series_resistance: r.diode.series_resistance,
@@ -126,6 +135,8 @@ impl TryFrom<HarvesterTable> for HarvesterParams {
             relative_permittivity: t.relative_permittivity,
             load,
             initial_charge: t.initial_charge,
+            coupling: t.coupling,
+            coupling_tolerance: t.coupling_tolerance,
         })
     }
 }

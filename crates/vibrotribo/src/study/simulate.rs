@@ -9,6 +9,7 @@ use thiserror::Error;
 use super::observer::{ElectricalSample, RunObserver, Sample};
 use super::settings::{ElectricalFailure, RunSpec, Sampling};
 use crate::analysis::RunStats;
+use crate::coupling::{ChargeHost, CoupledChain, Coupling, CouplingError, CouplingOptions};
 use crate::dynamics::{Event, Flow, Observer, RunEnd, Simulator, StateView, Verdict};
 use crate::electrical::breakdown::BreakdownMargin;
 use crate::electrical::{
@@ -141,7 +142,7 @@ impl RunOutcome {
 pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Result<RunOutcome, StudyError> {
     let chain = &spec.chain;
     let period = chain.period();
-    let mut sim = Simulator::new(chain, &spec.initial, spec.options.clone())?;
+    let sim = Simulator::new(chain, &spec.initial, spec.options.clone())?;
     let transient_time = spec.transient_periods as f64 * period;
     let solver = match &spec.harvester {
         Some(h) => {
@@ -177,17 +178,39 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
             .as_ref()
             .is_some_and(|h| h.on_failure == ElectricalFailure::StopRun),
         samples,
+        solver_driven: false,
+        pending: ElectricalSamples::default(),
     };
     let mut done = 0;
     let mut ending = Ending::Completed;
+    let two_way = spec
+        .harvester
+        .as_ref()
+        .filter(|h| h.params.coupling == Coupling::TwoWay);
+    let mut mechanics = Mechanics::Plain(sim);
     for p in 1..=spec.periods {
-        match sim.run_until(p as f64 * period, &mut rec) {
+        if let (Some(h), Mechanics::Plain(plain)) = (two_way, &mechanics)
+            && plain.time() >= rec.electrical_from
+        {
+            // From the harvester's start on, the charges act on the masses.
+            let options = CouplingOptions {
+                position_tolerance: h.params.coupling_tolerance,
+                ..CouplingOptions::default()
+            };
+            let coupled = match CoupledChain::new(plain.clone(), &h.params, options) {
+                Ok(c) => c,
+                Err(e) => return Err(coupling_error(e)),
+            };
+            mechanics = Mechanics::Coupled(Box::new(coupled));
+            rec.solver_driven = true;
+        }
+        match mechanics.run_until(p as f64 * period, &mut rec) {
             Ok(RunEnd::Reached) => {}
             Ok(RunEnd::Stopped { .. }) => {
                 ending = Ending::Stopped;
                 break;
             }
-            Err(SimError::Observer(_)) => {
+            Err(StudyError::Sim(SimError::Observer(_))) => {
                 let e = rec
                     .electrical_error()
                     .expect("only the charge solver fails a run");
@@ -195,14 +218,14 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
                 break;
             }
             Err(e) => {
-                ending = Ending::Failed(e.into());
+                ending = Ending::Failed(e);
                 break;
             }
         }
         done = p;
-        let state = sim.state();
+        let state = mechanics.state();
         let view = StateView {
-            time: sim.time(),
+            time: mechanics.time(),
             positions: &state.positions,
             velocities: &state.velocities,
         };
@@ -231,8 +254,8 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         ending,
         stats: rec.stats,
         electrical,
-        final_state: sim.state(),
-        final_time: sim.time(),
+        final_state: mechanics.state(),
+        final_time: mechanics.time(),
     })
 }
 
@@ -276,7 +299,7 @@ impl SampleGrid {
         flow: &Flow<'_>,
         electrical: Option<&ElectricalSamples>,
         user: &mut O,
-    ) {
+    ) -> usize {
         let mut cursor = 0;
         loop {
             let t = self.time(self.next);
@@ -291,6 +314,12 @@ impl SampleGrid {
             let (base, _) = flow.base_at(t);
             for (k, d) in self.d.iter_mut().enumerate() {
                 *d = self.gaps[k] - (self.x[k + 1] - self.x[k]);
+            }
+            // Electrical samples before this one have no mechanical sample: pass over them.
+            if let Some(s) = electrical {
+                while s.times.get(cursor).is_some_and(|&ts| ts < t) {
+                    cursor += 1;
+                }
             }
             let e = electrical.filter(|s| s.times.get(cursor).is_some_and(|&ts| ts == t));
             let sample = e.map(|s| {
@@ -318,6 +347,7 @@ impl SampleGrid {
             });
             self.next += 1;
         }
+        cursor
     }
 }
 
@@ -329,6 +359,11 @@ struct Recorder<'o, O: ?Sized> {
     electrical_from: f64,
     stop_on_electrical_failure: bool,
     samples: Option<SampleGrid>,
+    /// Two-way coupling: the coupled run advances the solver; `flow` must not.
+    solver_driven: bool,
+    /// Electrical samples taken from the solver and not yet matched to a piece of flow (a
+    /// coupled window's samples arrive before its pieces are reported).
+    pending: ElectricalSamples,
 }
 
 impl<O: RunObserver + ?Sized> Recorder<'_, O> {
@@ -341,13 +376,21 @@ impl<O: RunObserver + ?Sized> Observer for Recorder<'_, O> {
     fn flow(&mut self, flow: &Flow<'_>) {
         if let Some(s) = &mut self.solver
             && flow.t_start >= self.electrical_from
+            && !self.solver_driven
         {
             s.flow(flow);
         }
         self.user.flow(flow);
         if let Some(grid) = &mut self.samples {
-            let fresh = self.solver.as_mut().map(ChargeSolver::take_samples);
-            grid.emit(flow, fresh.as_ref(), &mut *self.user);
+            let electrical = match self.solver.as_mut() {
+                Some(s) => {
+                    self.pending.append(s.take_samples());
+                    Some(&self.pending)
+                }
+                None => None,
+            };
+            let used = grid.emit(flow, electrical, &mut *self.user);
+            self.pending.drain_front(used);
         }
     }
 
@@ -361,5 +404,53 @@ impl<O: RunObserver + ?Sized> Observer for Recorder<'_, O> {
             Some(s) if self.stop_on_electrical_failure => s.proceed(),
             _ => Ok(ControlFlow::Continue(())),
         }
+    }
+}
+
+impl<O: RunObserver + ?Sized> ChargeHost for Recorder<'_, O> {
+    fn charge_solver(&mut self) -> &mut ChargeSolver {
+        self.solver.as_mut().expect("a coupled run has a harvester")
+    }
+}
+
+/// The mechanics of a run: the plain engine, or (two-way coupling, once the harvester is
+/// connected) the engine coupled to the charge solver.
+enum Mechanics {
+    Plain(Simulator),
+    Coupled(Box<CoupledChain>),
+}
+
+impl Mechanics {
+    fn run_until<O: RunObserver + ?Sized>(&mut self, t: f64, rec: &mut Recorder<'_, O>) -> Result<RunEnd, StudyError> {
+        match self {
+            Mechanics::Plain(sim) => Ok(sim.run_until(t, rec)?),
+            Mechanics::Coupled(c) => c.run_until(t, rec).map_err(coupling_error),
+        }
+    }
+
+    fn state(&self) -> ChainState {
+        match self {
+            Mechanics::Plain(sim) => sim.state(),
+            Mechanics::Coupled(c) => c.state(),
+        }
+    }
+
+    fn time(&self) -> f64 {
+        match self {
+            Mechanics::Plain(sim) => sim.time(),
+            Mechanics::Coupled(c) => c.time(),
+        }
+    }
+}
+
+/// A coupled run's failure as a run's.
+fn coupling_error(e: CouplingError) -> StudyError {
+    match e {
+        CouplingError::Sim(e) => StudyError::Sim(e),
+        CouplingError::Electrical(e) => StudyError::Electrical(e),
+        other => StudyError::Param(ParamError::Conflict {
+            name: "harvester.coupling".into(),
+            message: other.to_string(),
+        }),
     }
 }

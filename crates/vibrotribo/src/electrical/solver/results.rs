@@ -109,6 +109,37 @@ pub struct ElectricalSamples {
 }
 
 impl ElectricalSamples {
+    /// Appends `other`'s samples.
+    pub fn append(&mut self, mut other: ElectricalSamples) {
+        if self.times.is_empty() {
+            *self = other;
+            return;
+        }
+        self.times.append(&mut other.times);
+        self.charge_c.append(&mut other.charge_c);
+        self.current_a.append(&mut other.current_a);
+        self.voltage_v.append(&mut other.voltage_v);
+        self.capacitance_f.append(&mut other.capacitance_f);
+        self.voc_v.append(&mut other.voc_v);
+        self.storage_voltage_v.append(&mut other.storage_voltage_v);
+        self.energy_j.append(&mut other.energy_j);
+    }
+
+    /// Drops the first `n` samples.
+    pub fn drain_front(&mut self, n: usize) {
+        fn cut(v: &mut Vec<f64>, n: usize) {
+            v.drain(..n.min(v.len()));
+        }
+        cut(&mut self.times, n);
+        cut(&mut self.charge_c, n);
+        cut(&mut self.current_a, n);
+        cut(&mut self.voltage_v, n);
+        cut(&mut self.capacitance_f, n);
+        cut(&mut self.voc_v, n);
+        cut(&mut self.storage_voltage_v, n);
+        cut(&mut self.energy_j, n);
+    }
+
     /// Keeps the first `n` samples.
     pub(super) fn truncate(&mut self, n: usize) {
         self.times.truncate(n);
