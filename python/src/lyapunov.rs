@@ -7,7 +7,7 @@ use pyo3::types::PyDict;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::lyapunov_spectrum;
 
-use crate::config::config_of;
+use crate::config::{config_error, config_of};
 use crate::convert::{array1, array2};
 use crate::interrupt::Signals;
 
@@ -26,6 +26,7 @@ pub fn lyapunov<'py>(
         return Err(PyValueError::new_err("periods: must be at least 1"));
     }
     let config = config_of(config)?;
+    config.check_uncoupled("lyapunov").map_err(config_error)?;
     let mut spec = config.run_spec(true);
     spec.periods = transient
         .checked_add(periods)

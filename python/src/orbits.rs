@@ -116,6 +116,7 @@ pub fn periodic<'py>(
     max_iterations: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config_of(config)?;
+    config.check_uncoupled("periodic").map_err(config_error)?;
     let options = shooting(&config, tolerance, max_iterations);
     let chain = config.chain().clone();
     let orbit = match guess {
@@ -297,6 +298,7 @@ pub fn continue_<'py>(
     max_step: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let base = config_of(config)?;
+    base.check_uncoupled("continue_").map_err(config_error)?;
     for v in [start, stop] {
         base.with(&param, toml::Value::Float(v)).map_err(config_error)?;
     }

@@ -82,6 +82,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         bail!("--from and --to must be finite and different");
     }
     let config = args.input.load()?;
+    config.check_uncoupled("continue")?;
     let mass = args.mass.unwrap_or(if config.chain().len() > 1 { 2 } else { 1 });
     if mass == 0 || mass > config.chain().len() {
         bail!("--mass must be between 1 and {}", config.chain().len());

@@ -60,6 +60,7 @@ pub fn run(args: &LyapunovArgs) -> Result<()> {
         bail!("--plot needs --out DIR");
     }
     let config = args.input.load()?;
+    config.check_uncoupled("lyapunov")?;
     let mut spec = config.run_spec(true);
     spec.transient_periods = args.transient;
     spec.periods = args.transient + args.periods;

@@ -55,6 +55,7 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
         bail!("--period must be at least 1");
     }
     let config = args.input.load()?;
+    config.check_uncoupled("periodic")?;
     let options = ShootingOptions {
         sim: config.sim_options().clone(),
         ..ShootingOptions::default()

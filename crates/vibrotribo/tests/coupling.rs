@@ -121,7 +121,11 @@ fn the_run_layer_runs_the_coupled_chain() {
     let via_study = outcome.electrical.unwrap().power.unwrap().average_power_w;
     let (_, solver) = coupled_run(&chain, &harvester, 12.0, harvester.coupling_tolerance);
     let direct = solver.summary(6).unwrap().average_power_w;
-    assert_eq!(via_study.to_bits(), direct.to_bits(), "{via_study:e} vs {direct:e}");
+    assert_eq!(
+        via_study.to_bits(),
+        direct.to_bits(),
+        "{via_study:e} vs {direct:e}"
+    );
 }
 
 /// Configuration: the key reads, and two-way coupling with the paper's voltage law is
@@ -131,8 +135,12 @@ fn the_coupling_key() {
     use vibrotribo::config::Config;
     let c = Config::from_toml_str("[harvester]\ncoupling = \"two_way\"\nvoc_model = \"exact\"\n").unwrap();
     assert_eq!(c.harvester().coupling, vibrotribo::coupling::Coupling::TwoWay);
-    let err = Config::from_toml_str("[harvester]\ncoupling = \"two_way\"\n").unwrap_err().to_string();
+    let err = Config::from_toml_str("[harvester]\ncoupling = \"two_way\"\n")
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("coupling") && err.contains("voc_model"), "{err}");
-    let err = Config::from_toml_str("[harvester]\ncoupling = \"both\"\n").unwrap_err().to_string();
+    let err = Config::from_toml_str("[harvester]\ncoupling = \"both\"\n")
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("coupling"), "{err}");
 }

@@ -354,6 +354,19 @@ impl Config {
         }
     }
 
+    /// An error if `tool` (a command that follows the mechanics on its own: periodic orbits,
+    /// continuation, Lyapunov exponents, basins, attractors) would ignore
+    /// `harvester.coupling = "two_way"`.
+    pub fn check_uncoupled(&self, tool: &str) -> Result<(), ConfigError> {
+        if self.harvester().coupling == crate::coupling::Coupling::TwoWay {
+            return Err(ConfigError::Unsupported(format!(
+                "{tool} follows the uncoupled mechanics: harvester.coupling = \"two_way\" is not \
+                 supported by it yet (simulate, sweep, map and load-sweep take it)"
+            )));
+        }
+        Ok(())
+    }
+
     /// The charge solver's settings (`[electrical]`).
     pub fn charge_options(&self) -> &ChargeOptions {
         &self.electrical

@@ -1,9 +1,9 @@
 //! Physical parameters of the triboelectric transducer and its load (the `[harvester]` table of
 //! a configuration file), and their validation.
 
-use crate::coupling::Coupling;
 use super::diode::Diode;
 use super::transducer::{ContactSeparation, Freestanding, Transducer};
+use crate::coupling::Coupling;
 use crate::error::{ParamError, check_finite, check_non_negative, check_positive};
 
 /// Vacuum permittivity ε₀, F/m (CODATA 2018).

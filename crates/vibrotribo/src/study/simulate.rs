@@ -421,7 +421,11 @@ enum Mechanics {
 }
 
 impl Mechanics {
-    fn run_until<O: RunObserver + ?Sized>(&mut self, t: f64, rec: &mut Recorder<'_, O>) -> Result<RunEnd, StudyError> {
+    fn run_until<O: RunObserver + ?Sized>(
+        &mut self,
+        t: f64,
+        rec: &mut Recorder<'_, O>,
+    ) -> Result<RunEnd, StudyError> {
         match self {
             Mechanics::Plain(sim) => Ok(sim.run_until(t, rec)?),
             Mechanics::Coupled(c) => c.run_until(t, rec).map_err(coupling_error),
