@@ -187,7 +187,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         .harvester
         .as_ref()
         .filter(|h| h.params.coupling == Coupling::TwoWay);
-    let mut mechanics = Mechanics::Plain(sim);
+    let mut mechanics = Mechanics::Plain(Box::new(sim));
     for p in 1..=spec.periods {
         if let (Some(h), Mechanics::Plain(plain)) = (two_way, &mechanics)
             && plain.time() >= rec.electrical_from
@@ -197,7 +197,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
                 position_tolerance: h.params.coupling_tolerance,
                 ..CouplingOptions::default()
             };
-            let coupled = match CoupledChain::new(plain.clone(), &h.params, options) {
+            let coupled = match CoupledChain::new((**plain).clone(), &h.params, options) {
                 Ok(c) => c,
                 Err(e) => return Err(coupling_error(e)),
             };
@@ -416,7 +416,7 @@ impl<O: RunObserver + ?Sized> ChargeHost for Recorder<'_, O> {
 /// The mechanics of a run: the plain engine, or (two-way coupling, once the harvester is
 /// connected) the engine coupled to the charge solver.
 enum Mechanics {
-    Plain(Simulator),
+    Plain(Box<Simulator>),
     Coupled(Box<CoupledChain>),
 }
 
