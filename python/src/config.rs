@@ -188,11 +188,11 @@ impl PyConfig {
 }
 
 /// The configuration `obj` stands for (a `Config`, a dict, a path, or `None`: the defaults),
-/// to be run: refused, naming the reason, if the engine cannot run it (as the command line
-/// refuses it).
+/// to be run: refused, naming the reason, if its base motion cannot drive its chain
+/// (`Config::check_runnable`, as the command line refuses it).
 pub fn config_of(obj: &Bound<'_, PyAny>) -> PyResult<Config> {
     let config = PyConfig::read(Some(obj))?;
-    config.check_engine_support().map_err(config_error)?;
+    config.check_runnable().map_err(config_error)?;
     Ok(config)
 }
 

@@ -27,6 +27,9 @@ pub fn lyapunov<'py>(
     }
     let config = config_of(config)?;
     config.check_uncoupled("lyapunov").map_err(config_error)?;
+    config
+        .check_periodic("Lyapunov exponents")
+        .map_err(crate::config::config_error)?;
     let mut spec = config.run_spec(true);
     spec.periods = transient
         .checked_add(periods)

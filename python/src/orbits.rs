@@ -117,6 +117,7 @@ pub fn periodic<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config_of(config)?;
     config.check_uncoupled("periodic").map_err(config_error)?;
+    config.check_periodic("periodic orbits").map_err(config_error)?;
     let options = shooting(&config, tolerance, max_iterations);
     let chain = config.chain().clone();
     let orbit = match guess {
@@ -299,6 +300,8 @@ pub fn continue_<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let base = config_of(config)?;
     base.check_uncoupled("continue_").map_err(config_error)?;
+    base.check_periodic("continuation of periodic orbits")
+        .map_err(config_error)?;
     for v in [start, stop] {
         base.with(&param, toml::Value::Float(v)).map_err(config_error)?;
     }

@@ -44,10 +44,13 @@ impl PointSettings {
                 )));
             }
         };
+        // Under a base motion that is not periodic there is no periodic motion to settle to
+        // or classify: each point runs exactly `transient + recorded` periods.
+        let periodic = base.is_periodic();
         let options = PointOptions {
             period_tolerance: self.period_tolerance,
-            settle,
-            classify: true,
+            settle: if periodic { settle } else { SettleMode::Fixed },
+            classify: periodic,
             ..PointOptions::from_run(base.run(), self.transient, self.recorded)
         };
         if options.recorded_periods == 0 {
@@ -165,7 +168,13 @@ pub fn sweep<'py>(
         settle,
         settle_cap,
     };
-    let runner = settings_of.runner(config_of(config)?)?;
+    let base = config_of(config)?;
+    if continuation != Continuation::None {
+        // Each value starts at t = 0 from the previous one's final state: the same phase of
+        // the base motion only if it is periodic.
+        base.check_periodic("sweep continuation").map_err(config_error)?;
+    }
+    let runner = settings_of.runner(base)?;
     let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
     check_points(&runner, &points)?;
     let mut table = SweepColumns::new(&["param"], runner.masses(), runner.contacts(), true);

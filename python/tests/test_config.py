@@ -50,6 +50,17 @@ def test_round_trips():
     assert eval(repr(c), {"Config": vt.Config}) == c
 
 
+def test_a_record_path_is_resolved_once(tmp_path, monkeypatch):
+    """A record's path relative to its configuration file is stored resolved, so that the
+    dict, the TOML text and a pickle (what Dask sends to a worker) read the same record from
+    any working directory."""
+    c = vt.Config(CONFIGS / "record_default.toml")
+    monkeypatch.chdir(tmp_path)
+    assert vt.Config(c.to_dict()) == c
+    assert vt.Config.from_toml(c.to_toml()) == c
+    assert pickle.loads(pickle.dumps(c)) == c
+
+
 def raises(exc, *fragments):
     """A context that expects `exc` whose message contains every fragment."""
 

@@ -101,6 +101,7 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     base.check_uncoupled("attractors")?;
+    base.check_periodic("attractor census (`attractors`)")?;
     let options = AttractorOptions {
         period_tolerance: args.section_tolerance,
         match_tolerance: args.match_tolerance,

@@ -227,6 +227,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     base.check_uncoupled("basins")?;
+    base.check_periodic("basins of attraction (`basins`)")?;
     let masses = base.chain().len();
     check_key("--x", &args.x, masses)?;
     check_key("--y", &args.y, masses)?;

@@ -16,16 +16,17 @@ pub struct ConfigArgs {
 }
 
 impl ConfigArgs {
-    /// Reads the file (or the defaults) and applies the overrides in order; an error for an
-    /// `excitation.kind` the engine cannot run yet.
+    /// Reads the file (or the defaults) and applies the overrides in order; an error, naming
+    /// the reason, for a base motion that cannot drive the chain
+    /// ([`Config::check_runnable`]).
     pub fn load(&self) -> Result<Config> {
         let mut config = match &self.config {
             Some(path) => Config::from_path(path)?,
             None => Config::default(),
         };
         apply_overrides(&mut config, &self.set).context("--set")?;
-        // Every command simulates: refuse base motions the engine cannot run yet.
-        config.check_engine_support()?;
+        // Every command simulates: refuse base motions that cannot drive the chain, naming why.
+        config.check_runnable()?;
         Ok(config)
     }
 }

@@ -83,6 +83,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     }
     let config = args.input.load()?;
     config.check_uncoupled("continue")?;
+    config.check_periodic("continuation of periodic orbits (`continue`)")?;
     let mass = args.mass.unwrap_or(if config.chain().len() > 1 { 2 } else { 1 });
     if mass == 0 || mass > config.chain().len() {
         bail!("--mass must be between 1 and {}", config.chain().len());

@@ -152,9 +152,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
             cycles.push((r, c.charge_c.clone(), c.voltage_v.clone()));
         }
         vq.flush()?;
-        write_json(
-            &dir.join("load_sweep.json"),
-            &json!({
+        let mut manifest = json!({
                 "optimum": best,
                 "optimum_at_edge": sweep.optimum_at_edge,
                 "configured_load_ohm": configured,
@@ -166,8 +164,11 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
                 "transient_periods": spec.transient_periods,
                 "harvester": harvester,
                 "settings": config.table(),
-            }),
-        )?;
+        });
+        if let Some(b) = vibrotribo::report::base_motion_json(&config, &spec) {
+            manifest["base_motion"] = b;
+        }
+        write_json(&dir.join("load_sweep.json"), &manifest)?;
         if args.plot {
             let xs: Vec<f64> = sweep.points.iter().map(|p| p.resistance_ohm.log10()).collect();
             let ys: Vec<f64> = sweep.points.iter().map(|p| p.average_power_w).collect();

@@ -61,6 +61,7 @@ pub fn run(args: &LyapunovArgs) -> Result<()> {
     }
     let config = args.input.load()?;
     config.check_uncoupled("lyapunov")?;
+    config.check_periodic("Lyapunov exponents (`lyapunov`)")?;
     let mut spec = config.run_spec(true);
     spec.transient_periods = args.transient;
     spec.periods = args.transient + args.periods;

@@ -163,6 +163,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         settings["floquet"] = json!(true);
     }
     crate::sweep::add_settle_settings(&mut settings, o);
+    crate::sweep::add_base_motion(&mut settings, runner.base());
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),

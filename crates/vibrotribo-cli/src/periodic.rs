@@ -56,6 +56,7 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
     }
     let config = args.input.load()?;
     config.check_uncoupled("periodic")?;
+    config.check_periodic("periodic orbits (`periodic`)")?;
     let options = ShootingOptions {
         sim: config.sim_options().clone(),
         ..ShootingOptions::default()

@@ -179,6 +179,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let started = Instant::now();
     let mut run_motion = RunMotion::new(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
     let mode = args.settle.mode(args.settle_cap);
+    if matches!(mode, SettleMode::Auto(_)) {
+        config.check_periodic("simulate --settle auto (settling to a periodic motion)")?;
+    }
     run_motion.options_mut().settle = mode;
     let settled = match &mode {
         SettleMode::Auto(auto) => {
@@ -206,7 +209,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         None => simulate(&spec, &mut (&mut watch, run_motion.observer()))?,
     };
     watch.progress.finish();
-    let motion = (outcome.ending == Ending::Completed)
+    // A motion under a base motion that is not periodic is not classified (no period).
+    let motion = (outcome.ending == Ending::Completed && config.is_periodic())
         .then(|| run_motion.finish(&spec, &outcome.final_state, settled.as_ref()));
     let elapsed = started.elapsed().as_secs_f64();
     let failure = failure_error(&outcome);
@@ -224,6 +228,13 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     print_summary(&spec, &outcome, elapsed, args.out.as_deref());
+    let base = vibrotribo::report::base_motion_lines(&config, &spec);
+    if !base.is_empty() {
+        println!("  base motion:");
+        for (k, v) in &base {
+            println!("    {k}: {v}");
+        }
+    }
     if let Some(m) = &motion {
         print_motion(m);
     }

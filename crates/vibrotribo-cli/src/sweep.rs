@@ -210,13 +210,23 @@ impl RunArgs {
         if self.settle_cap == 0 {
             bail!("--settle-cap must be at least 1");
         }
+        if self.floquet {
+            base.check_periodic("--floquet (Floquet multipliers)")?;
+        }
+        // Under a base motion that is not periodic there is no periodic motion to settle to
+        // or classify: each point runs exactly `transient + recorded` periods.
+        let periodic = base.is_periodic();
         let options = PointOptions {
             transient_periods: transient,
             recorded_periods: recorded,
             period_tolerance: self.period_tolerance,
             floquet: self.floquet,
-            settle: self.settle.mode(self.settle_cap),
-            classify: true,
+            settle: if periodic {
+                self.settle.mode(self.settle_cap)
+            } else {
+                vibrotribo::study::SettleMode::Fixed
+            },
+            classify: periodic,
             ..PointOptions::default()
         };
         Ok(PointRunner::new(base, options, self.mechanics_only))
@@ -432,11 +442,20 @@ fn settings_json(
         settings["floquet"] = json!(true);
     }
     add_settle_settings(&mut settings, o);
+    add_base_motion(&mut settings, runner.base());
     if args.lyapunov {
         // Only with the option, so that other sweeps' manifests stay as they were.
         settings["lyapunov"] = json!(true);
     }
     settings
+}
+
+/// Records the base motion of `config` in a manifest (`base_motion`, when it is not the
+/// chain's own harmonic: kind, how it was run, spline accuracy, record scaling).
+pub fn add_base_motion(settings: &mut serde_json::Value, config: &vibrotribo::config::Config) {
+    if let Some(b) = vibrotribo::report::base_motion_json(config, &config.run_spec(true)) {
+        settings["base_motion"] = b;
+    }
 }
 
 /// Records the settling of `options` in a manifest (`sweep.json`, `map.json`): `settle`
@@ -506,6 +525,14 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
+    if args.lyapunov {
+        base.check_periodic("--lyapunov (Lyapunov exponents)")?;
+    }
+    if args.continuation != Continuation::None {
+        // Each value starts at t = 0 from the previous one's final state: that is the same
+        // phase of the base motion only if the motion is periodic.
+        base.check_periodic("sweep --continuation")?;
+    }
     let mut runner = args.run.runner(base)?;
     if args.lyapunov {
         let options = PointOptions {

@@ -103,6 +103,9 @@ pub fn run_summary(
         obj.insert("harvester".into(), json!(h.params));
         obj.insert("electrical_solver".into(), json!(format!("{:?}", e.solver)));
     }
+    if let Some(base) = base_motion_json(config, spec) {
+        obj.insert("base_motion".into(), base);
+    }
     obj.insert("nondimensional".into(), json!(params.nondimensional()));
     obj.insert("parameters".into(), json!(params));
     obj.insert("settings".into(), json!(config.table()));
@@ -110,6 +113,49 @@ pub fn run_summary(
     obj.insert("interrupted".into(), json!(outcome.ending == Ending::Stopped));
     obj.insert("error".into(), json!(failure_text(outcome)));
     out
+}
+
+/// What a run of `spec` (read from `config`) states about its base motion when it is not
+/// the chain's own `A sin ωt` (empty then), as (name, value) lines: `kind`, `run_as` (how
+/// the engine ran it), the lines of [`BaseMotion::summary`](crate::excitation::BaseMotion::summary)
+/// (spline knots and error bounds, record scaling and baseline correction) and, for a
+/// multisine sampled into a spline, `multisine_spline_error_bound_m`. summary.json holds
+/// them as its `base_motion` object.
+pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String)> {
+    use crate::excitation::BaseMotion;
+    let Some(b) = &spec.base_motion else {
+        return Vec::new();
+    };
+    let mut out = vec![(
+        "kind".to_string(),
+        config.excitation().kind().as_str().to_string(),
+    )];
+    let run_as = match &**b {
+        BaseMotion::Harmonics(h) if crate::study::as_chain_harmonic(h, &spec.chain).is_some() => {
+            "the harmonic excitation A sin ωt (closed form)".to_string()
+        }
+        BaseMotion::Harmonics(h) => {
+            out.push((
+                "multisine_spline_error_bound_m".into(),
+                format!("{:e}", crate::study::multisine_tolerance(h)),
+            ));
+            "a clamped cubic spline of the multisine, exact per-interval cubic forces k_i y + c_i y' \
+             (a closed-form multisine in the engine is a later step)"
+                .to_string()
+        }
+        BaseMotion::Spline(_) => "exact per-interval cubic forces k_i y + c_i y' of the spline".to_string(),
+    };
+    out.push(("run_as".into(), run_as));
+    out.extend(b.summary());
+    out
+}
+
+/// [`base_motion_lines`] as a JSON object (`None` under the chain's own harmonic): the
+/// `base_motion` object of summary.json, sweep.json and map.json.
+pub fn base_motion_json(config: &Config, spec: &RunSpec) -> Option<serde_json::Value> {
+    let lines = base_motion_lines(config, spec);
+    (!lines.is_empty())
+        .then(|| serde_json::Value::Object(lines.into_iter().map(|(k, v)| (k, json!(v))).collect()))
 }
 
 /// summary.json's `motion` object (null for a run that did not complete): `motion`,

@@ -465,26 +465,27 @@ fn config_error(text: &str) -> String {
 }
 
 #[test]
-fn the_record_default_configuration_reads_and_waits_for_the_engine() {
+fn the_record_default_configuration_reads_and_runs() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/record_default.toml");
     let c = Config::from_path(&path).unwrap();
     assert_eq!(c.excitation().kind(), ExcitationKind::Record);
-    let e = c.check_engine_support().unwrap_err().to_string();
-    assert_eq!(e, "excitation kind record: engine hookup pending");
+    c.check_runnable().unwrap();
+    assert!(!c.is_periodic());
     let motion = c.base_motion().unwrap();
     let BaseMotion::Spline(s) = &motion else {
         panic!("{motion:?}")
     };
     assert!((s.displacement.end() - 29.99).abs() < 1e-9);
     let report = s.record.unwrap();
-    // Scaled to the stated peak: the largest |a| at the samples is 98 m/s² before the
+    // Scaled to the stated peak: the largest |a| at the samples is 9.8 m/s² before the
     // (small) baseline correction.
-    assert!((report.scale_factor * 1.0 - 98.0).abs() < 1e-9, "{report:?}");
+    assert!((report.scale_factor * 1.0 - 9.8).abs() < 1e-9, "{report:?}");
     let b = report.baseline.unwrap();
     assert!(b.relative_size < 0.01, "{b:?}");
-    assert!((report.peak_acceleration / 98.0 - 1.0).abs() < b.relative_size + 1e-12);
-    // Harmonic configurations pass the check.
-    assert!(Config::default().check_engine_support().is_ok());
+    assert!((report.peak_acceleration / 9.8 - 1.0).abs() < b.relative_size + 1e-12);
+    // Harmonic configurations pass the checks.
+    assert!(Config::default().check_runnable().is_ok());
+    assert!(Config::default().check_periodic("x").is_ok());
 }
 
 #[test]
@@ -498,10 +499,9 @@ fn multisine_resolves_its_frequencies() {
     };
     assert_eq!(h[0].omega, 0.7 * (120.0f64 / 0.048).sqrt());
     assert_eq!((h[1].omega, h[1].phase), (TAU * 3.0, 0.5));
-    assert_eq!(
-        c.check_engine_support().unwrap_err().to_string(),
-        "excitation kind multisine: engine hookup pending"
-    );
+    // Two harmonics: runnable, not periodic with T.
+    c.check_runnable().unwrap();
+    assert!(!c.is_periodic());
 }
 
 #[test]

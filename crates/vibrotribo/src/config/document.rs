@@ -1,6 +1,7 @@
 //! [`Config`]: a configuration document read into the library's types.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
@@ -153,9 +154,9 @@ pub struct Config {
     harvester: HarvesterParams,
     electrical: ChargeOptions,
     excitation: ExcitationSpec,
-    /// The directory relative record paths are read from (the file's; `None`: the working
-    /// directory).
-    base_dir: Option<PathBuf>,
+    /// The base motion built, for every kind but `harmonic` (shared: configurations are
+    /// cloned often).
+    base: Option<Arc<BaseMotion>>,
 }
 
 impl Default for Config {
@@ -202,7 +203,13 @@ impl Config {
     }
 
     /// [`from_table`](Self::from_table) with relative record paths relative to `base_dir`.
-    pub fn from_table_in(table: Table, base_dir: Option<PathBuf>) -> Result<Self, ConfigError> {
+    /// The path is stored resolved (absolute) in the configuration's tree, so that the tree
+    /// alone (`to_toml`, a pickled Python `Config` sent to another process) reads the same
+    /// record wherever it is read again.
+    pub fn from_table_in(mut table: Table, base_dir: Option<PathBuf>) -> Result<Self, ConfigError> {
+        if let Some(dir) = base_dir.as_deref() {
+            resolve_record_path(&mut table, dir);
+        }
         let doc: Document = serde_path_to_error::deserialize(Value::Table(table.clone())).map_err(|e| {
             // A key the schema lacks is named as one (the deserialiser calls it a field).
             if let Some(key) = keys::unknown_key_in(&table) {
@@ -238,7 +245,15 @@ impl Config {
                 .map_err(|e| e.within("harvester"))?;
         }
         doc.electrical.validate().map_err(|e| e.within("electrical"))?;
-        let excitation = super::excitation::excitation_of(&doc, &chain, base_dir.as_deref())?;
+        let excitation = super::excitation::excitation_of(&doc, &chain)?;
+        let base = match excitation.kind() {
+            ExcitationKind::Harmonic => None,
+            kind => Some(Arc::new(
+                excitation
+                    .build(chain_harmonic(&chain))
+                    .map_err(|e| super::excitation::named(kind, e))?,
+            )),
+        };
         Ok(Config {
             table,
             chain,
@@ -248,7 +263,7 @@ impl Config {
             harvester,
             electrical: doc.electrical,
             excitation,
-            base_dir,
+            base,
         })
     }
 
@@ -283,7 +298,7 @@ impl Config {
             keys::set_key(&mut table, key, value).map_err(|e| tell(&[(shown.clone(), key)], e))?;
             set.push((shown, key));
         }
-        *self = Self::from_table_in(table, self.base_dir.clone()).map_err(|e| tell(&set, e))?;
+        *self = Self::from_table(table).map_err(|e| tell(&set, e))?;
         Ok(())
     }
 
@@ -325,32 +340,25 @@ impl Config {
         &self.excitation
     }
 
-    /// The base motion built ([`ExcitationSpec::build`]; chirps and random signals are
-    /// sampled into splines here, which can take a while: build once per run).
+    /// The base motion built ([`ExcitationSpec::build`]; chirps, random signals and records
+    /// are sampled into splines when the configuration is read).
     pub fn base_motion(&self) -> Result<BaseMotion, ConfigError> {
-        let harmonic = Harmonic {
-            amplitude: self.chain.excitation.amplitude,
-            omega: self.chain.omega(),
-            phase: 0.0,
-        };
-        self.excitation
-            .build(harmonic)
-            .map_err(|e| super::excitation::named(self.excitation.kind(), e))
+        match &self.base {
+            Some(b) => Ok((**b).clone()),
+            None => self
+                .excitation
+                .build(chain_harmonic(&self.chain))
+                .map_err(|e| super::excitation::named(self.excitation.kind(), e)),
+        }
     }
 
-    /// Whether the engine can run this configuration's base motion: an error for every kind
-    /// but `harmonic` until the engine takes the other kinds. The one place that says so:
-    /// the command line calls it on every configuration it loads.
-    // TODO(issue 14): hook the engine up to `base_motion()` (harmonics: a particular
-    // solution each; splines: the per-mass polynomial force k_i y + c_i y' per interval),
-    // then remove this check.
-    pub fn check_engine_support(&self) -> Result<(), ConfigError> {
-        match self.excitation.kind() {
-            ExcitationKind::Harmonic => Ok(()),
-            kind => Err(ConfigError::Unsupported(format!(
-                "excitation kind {}: engine hookup pending",
-                kind.as_str()
-            ))),
+    /// Whether the base motion is periodic with the reference period T: the harmonic kind,
+    /// or a multisine of one harmonic that is exactly it.
+    pub fn is_periodic(&self) -> bool {
+        match (self.excitation.kind(), self.base.as_deref()) {
+            (ExcitationKind::Harmonic, _) => true,
+            (_, Some(BaseMotion::Harmonics(h))) => crate::study::as_chain_harmonic(h, &self.chain).is_some(),
+            _ => false,
         }
     }
 
@@ -365,6 +373,46 @@ impl Config {
             )));
         }
         Ok(())
+    }
+
+    /// Whether the engine can run this configuration: an error naming the reason if its
+    /// base motion cannot drive its chain (rigid stops with `frame = "base"` follow the
+    /// harmonic A sin ωt only) or ends before `run.periods` × T. The command line and the
+    /// Python package call it on every configuration they run.
+    pub fn check_runnable(&self) -> Result<(), ConfigError> {
+        let Some(base) = &self.base else {
+            return Ok(());
+        };
+        let kind = self.excitation.kind().as_str();
+        crate::study::check_base_motion(&self.chain, base)
+            .map_err(|m| ConfigError::Unsupported(format!("excitation kind {kind}: {m}")))?;
+        if let Some(end) = base.end() {
+            let run_end = self.run.periods as f64 * self.chain.period();
+            if run_end > end * (1.0 + 1e-12) {
+                return Err(ConfigError::Unsupported(format!(
+                    "excitation kind {kind}: the base motion ends at t = {end} s, before the run's end at {run_end} s \
+                     (run.periods = {} of T = {} s): shorten the run or lengthen the signal",
+                    self.run.periods,
+                    self.chain.period()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether `tool` (a stroboscopic or periodic-orbit tool: periodic orbits, continuation,
+    /// Floquet multipliers, Lyapunov exponents, basins, attractors) can run: it needs a base
+    /// motion periodic with the reference period T; an error naming the tool and the reason
+    /// otherwise.
+    pub fn check_periodic(&self, tool: &str) -> Result<(), ConfigError> {
+        if self.is_periodic() {
+            return Ok(());
+        }
+        Err(ConfigError::Unsupported(format!(
+            "{tool} needs a base motion periodic with the reference period T (a stroboscopic map); \
+             excitation kind {} is not periodic (use kind = \"harmonic\")",
+            self.excitation.kind().as_str()
+        )))
     }
 
     /// The charge solver's settings (`[electrical]`).
@@ -385,6 +433,7 @@ impl Config {
             transient_periods: self.run.transient(),
             sampling: None,
             breakdown_check: false,
+            base_motion: self.base.clone(),
         }
     }
 
@@ -394,6 +443,31 @@ impl Config {
             sampling: Some(Sampling::PerPeriod(self.run.samples_per_period)),
             ..self.run_spec(mechanics_only)
         }
+    }
+}
+
+/// Replaces a relative `excitation.file` of `table` by its path under `dir`, made absolute
+/// (against the working directory when `dir` is relative).
+fn resolve_record_path(table: &mut Table, dir: &Path) {
+    let Some(Value::Table(excitation)) = table.get_mut("excitation") else {
+        return;
+    };
+    let Some(Value::String(file)) = excitation.get_mut("file") else {
+        return;
+    };
+    if Path::new(file.as_str()).is_relative() {
+        let joined = dir.join(file.as_str());
+        let resolved = std::path::absolute(&joined).unwrap_or(joined);
+        *file = resolved.display().to_string();
+    }
+}
+
+/// The chain's own harmonic `A sin ωt` (phase 0).
+fn chain_harmonic(chain: &ChainParams) -> Harmonic {
+    Harmonic {
+        amplitude: chain.excitation.amplitude,
+        omega: chain.omega(),
+        phase: 0.0,
     }
 }
 

@@ -48,8 +48,9 @@ pub enum ConfigError {
     /// A `key=value` override or a key is malformed.
     #[error("{0}")]
     Malformed(String),
-    /// A valid configuration the engine cannot run yet (`excitation.kind` other than
-    /// harmonic until issue 14's engine hookup).
+    /// A valid configuration the engine or a tool cannot run, the reason named (rigid stops
+    /// moving with the base under a non-harmonic base motion, a signal shorter than the run,
+    /// a stroboscopic tool under a base motion that is not periodic).
     #[error("{0}")]
     Unsupported(String),
     /// Setting a key made another key bad (a derived key such as `mass_ratio` sets

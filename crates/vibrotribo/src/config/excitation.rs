@@ -1,7 +1,7 @@
 //! The `[excitation]` table read into an [`ExcitationSpec`]: which keys belong to which
 //! kind, defaults, validation (every error names its key), and a record read from its file.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::document::{Document, ExcitationTable, HarmonicEntry};
@@ -101,11 +101,7 @@ pub(super) fn named(kind: ExcitationKind, e: SignalError) -> ConfigError {
 }
 
 /// The `[excitation]` of `doc` (chain already read and valid) as an [`ExcitationSpec`].
-pub(super) fn excitation_of(
-    doc: &Document,
-    chain: &ChainParams,
-    base_dir: Option<&Path>,
-) -> Result<ExcitationSpec, ConfigError> {
+pub(super) fn excitation_of(doc: &Document, chain: &ChainParams) -> Result<ExcitationSpec, ConfigError> {
     let t = &doc.excitation;
     let kind = t.kind.unwrap_or_default();
     for (key, kinds) in given_keys(t) {
@@ -286,10 +282,9 @@ pub(super) fn excitation_of(
                 (None, Some(p)) => RecordScaling::PeakAcceleration(positive(p, "peak_acceleration")?),
                 (None, None) => RecordScaling::Factor(1.0),
             };
-            let path = match base_dir {
-                Some(dir) if Path::new(file).is_relative() => dir.join(file),
-                _ => PathBuf::from(file),
-            };
+            // Relative to the working directory; a file's own relative paths were resolved
+            // against its directory when it was read (`Config::from_table_in`).
+            let path = PathBuf::from(file);
             let samples = read_record(&path).map_err(|e| conflict("file", e.to_string()))?;
             if samples.duration() < run_length {
                 return Err(conflict(

@@ -1,4 +1,5 @@
-//! Base motion beyond one sine (issue 14): the signal side.
+//! Base motion beyond one sine (issue 14): the signal side. The engine side, which runs
+//! these motions exactly, is [`BaseDrive`](crate::study::BaseDrive).
 //!
 //! The chain's base moves as y(t) (m); mass i feels it through its spring and damper, the
 //! force k_i y + c_i y'. Today's engine drives it with `y = A sin ωt`

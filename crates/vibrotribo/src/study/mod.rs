@@ -5,6 +5,7 @@
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
+mod drive;
 mod loads;
 mod lyapunov;
 mod motion;
@@ -18,12 +19,16 @@ mod settings;
 mod settle;
 mod simulate;
 
+pub use drive::{
+    BaseDisplacement, BaseDrive, MULTISINE_RELATIVE_TOLERANCE, as_chain_harmonic, check_base_motion,
+    driven_chain, multisine_tolerance,
+};
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
 pub use motion::{Motion, MotionReport, Window, classify, exponent_sign};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
-pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point};
+pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point, run_point_driven};
 pub use record::{EventColumns, Recording, SampleColumns};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use run_motion::RunMotion;

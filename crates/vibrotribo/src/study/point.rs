@@ -9,6 +9,8 @@
 //! whether chatter, sticking or grazing occurred, the average power of a harvester if one is
 //! given, and the final state (for continuation to the next parameter value).
 
+use std::sync::Arc;
+
 use thiserror::Error;
 
 use super::motion::{Motion, MotionReport, WARMUP as MOTION_WARMUP, Window, classify};
@@ -20,6 +22,7 @@ use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, Strobosco
 use crate::dynamics::{Event, EventKind, Observer, StateView};
 use crate::electrical::{ChargeOptions, HarvesterParams};
 use crate::error::SimError;
+use crate::excitation::BaseMotion;
 use crate::lyapunov::{LyapunovError, LyapunovObserver, LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::orbits::{ShootingOptions, find_periodic_orbit};
@@ -256,7 +259,7 @@ pub fn run_point(
                 harvester,
                 options,
                 (options.transient_periods, 0),
-                options.lyapunov.as_ref(),
+                (options.lyapunov.as_ref(), None),
             )?;
             if options.classify {
                 let spectrum = r.lyapunov.as_ref().and_then(|s| s.as_ref().ok());
@@ -306,7 +309,7 @@ pub fn run_point(
             harvester,
             options,
             (warmup, settled.periods),
-            lyapunov,
+            (lyapunov, None),
         )?;
         if options.classify {
             let spectrum = r.lyapunov.as_ref().and_then(|s| s.as_ref().ok());
@@ -338,11 +341,57 @@ pub fn run_point(
     }
 }
 
+/// [`run_point`] under the base motion `base` (`None`: the chain's harmonic). A base motion
+/// that is not periodic with the reference period runs `transient + recorded` periods
+/// ([`SettleMode::Fixed`] whatever `options.settle` says: there is no periodic motion to
+/// settle to), is not classified and has no period; Floquet multipliers and Lyapunov
+/// exponents are refused (they need a periodic map), naming the reason.
+pub fn run_point_driven(
+    params: &ChainParams,
+    initial: &ChainState,
+    sim_options: &SimOptions,
+    harvester: Option<(&HarvesterParams, &ChargeOptions)>,
+    options: &PointOptions,
+    base: Option<&Arc<BaseMotion>>,
+) -> Result<PointResult, PointError> {
+    let Some(base) = base else {
+        return run_point(params, initial, sim_options, harvester, options);
+    };
+    if let BaseMotion::Harmonics(h) = &**base
+        && let Some(a) = super::drive::as_chain_harmonic(h, params)
+    {
+        let mut chain = params.clone();
+        chain.excitation.amplitude = a;
+        return run_point(&chain, initial, sim_options, harvester, options);
+    }
+    let refuse = |what: &str| {
+        Err(PointError::Study(StudyError::BaseMotion(format!(
+            "{what} need a base motion periodic with the reference period T; this one is not"
+        ))))
+    };
+    if options.floquet {
+        return refuse("Floquet multipliers");
+    }
+    if options.lyapunov.is_some() {
+        return refuse("Lyapunov exponents");
+    }
+    record(
+        params,
+        initial,
+        sim_options,
+        harvester,
+        options,
+        (options.transient_periods, 0),
+        (None, Some(base)),
+    )
+}
+
 /// Settling rounds after the first ([`run_point`] with [`SettleMode::Auto`]).
 const MAX_ROUNDS: u32 = 3;
 
 /// Runs `params` from `initial` for `transient + recorded` periods and condenses the
-/// recorded ones, with `lyapunov` the spectrum over them; `offset` periods ran before
+/// recorded ones, with `lyapunov` the spectrum over them (under `base`, the base motion, when
+/// given); `offset` periods ran before
 /// `initial` (added to the period indices and impact times).
 fn record(
     params: &ChainParams,
@@ -351,7 +400,7 @@ fn record(
     harvester: Option<(&HarvesterParams, &ChargeOptions)>,
     options: &PointOptions,
     (transient, offset): (u64, u64),
-    lyapunov: Option<&LyapunovOptions>,
+    (lyapunov, base): (Option<&LyapunovOptions>, Option<&Arc<BaseMotion>>),
 ) -> Result<PointResult, PointError> {
     let n = params.len();
     let period = params.period();
@@ -371,6 +420,7 @@ fn record(
         transient_periods: transient,
         sampling: None,
         breakdown_check: false,
+        base_motion: base.cloned(),
     };
     let strobe = StroboscopicSection::new(
         n,
@@ -417,7 +467,8 @@ fn record(
         None => (None, None),
     };
     let popts = options.period_options();
-    let periodicity = if strobe.len() >= popts.samples_needed() {
+    // Under a base motion that is not periodic there is no period to detect.
+    let periodicity = if base.is_none() && strobe.len() >= popts.samples_needed() {
         detect_period(&strobe.positions, n, &popts).ok()
     } else {
         None

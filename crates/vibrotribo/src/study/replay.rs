@@ -25,7 +25,7 @@ pub fn record_trajectory<O: RunObserver + ?Sized>(
     };
     let from = from_period as f64 * spec.chain.period();
     let mut rec = (
-        Mechanics::starting_at(Trajectory::for_chain(&spec.chain), from),
+        Mechanics::starting_at(Trajectory::for_chain(&super::drive::driven_chain(spec)), from),
         observer,
     );
     let outcome = simulate(&mechanics, &mut rec)?;

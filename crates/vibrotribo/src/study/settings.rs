@@ -147,6 +147,9 @@ pub struct RunSpec {
     pub sampling: Option<Sampling>,
     /// Check the air gaps for breakdown from the end of the transient on (needs a harvester).
     pub breakdown_check: bool,
+    /// The base motion when it is not the chain's own `A sin ωt` (`None`: the chain's
+    /// harmonic), run by [`BaseDrive`](super::BaseDrive).
+    pub base_motion: Option<std::sync::Arc<crate::excitation::BaseMotion>>,
 }
 
 impl RunSpec {
@@ -162,6 +165,7 @@ impl RunSpec {
             transient_periods: 0,
             sampling: None,
             breakdown_check: false,
+            base_motion: None,
         }
     }
 }

@@ -31,6 +31,9 @@ pub enum StudyError {
     /// The charge solver stopped.
     #[error("charge solver: {0}")]
     Electrical(#[from] ElectricalError),
+    /// The base motion cannot drive this run (the reason named).
+    #[error("base motion: {0}")]
+    BaseMotion(String),
 }
 
 /// How a run ended.
@@ -140,7 +143,8 @@ impl RunOutcome {
 /// # Ok::<(), vibrotribo::study::StudyError>(())
 /// ```
 pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Result<RunOutcome, StudyError> {
-    let chain = &spec.chain;
+    let (chain, mut drive) = super::drive::BaseDrive::new(spec)?;
+    let chain = &*chain;
     let period = chain.period();
     let sim = Simulator::new(chain, &spec.initial, spec.options.clone())?;
     let transient_time = spec.transient_periods as f64 * period;
@@ -162,7 +166,10 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         None => None,
     };
     let samples = match spec.sampling {
-        Some(grid) if observer.wants_samples() => Some(SampleGrid::new(grid, period, chain)),
+        Some(grid) if observer.wants_samples() => Some(SampleGrid {
+            base: drive.spline().cloned(),
+            ..SampleGrid::new(grid, period, chain)
+        }),
         _ => None,
     };
     let mut rec = Recorder {
@@ -187,6 +194,15 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         .harvester
         .as_ref()
         .filter(|h| h.params.coupling == Coupling::TwoWay);
+    if two_way.is_some() && drive.spline().is_some() {
+        // Both would set the engine's external forces; combining them is not built yet.
+        return Err(StudyError::Param(ParamError::Conflict {
+            name: "harvester.coupling".into(),
+            message: "two-way coupling runs with harmonic base motion only for now \
+                      (excitation.kind = \"harmonic\", or a one-harmonic multisine)"
+                .into(),
+        }));
+    }
     let mut mechanics = Mechanics::Plain(Box::new(sim));
     for p in 1..=spec.periods {
         if let (Some(h), Mechanics::Plain(plain)) = (two_way, &mechanics)
@@ -204,7 +220,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
             mechanics = Mechanics::Coupled(Box::new(coupled));
             rec.solver_driven = true;
         }
-        match mechanics.run_until(p as f64 * period, &mut rec) {
+        match mechanics.run_until(&mut drive, p as f64 * period, &mut rec) {
             Ok(RunEnd::Reached) => {}
             Ok(RunEnd::Stopped { .. }) => {
                 ending = Ending::Stopped;
@@ -268,6 +284,8 @@ struct SampleGrid {
     v: Vec<f64>,
     d: Vec<f64>,
     gaps: Vec<f64>,
+    /// The base displacement when it is not the chain's harmonic.
+    base: Option<super::drive::BaseDisplacement>,
 }
 
 impl SampleGrid {
@@ -281,6 +299,7 @@ impl SampleGrid {
             v: vec![0.0; n],
             d: vec![0.0; n - 1],
             gaps: chain.gaps.clone(),
+            base: None,
         }
     }
 
@@ -311,7 +330,10 @@ impl SampleGrid {
                 continue;
             }
             flow.state_at(t, &mut self.x, &mut self.v);
-            let (base, _) = flow.base_at(t);
+            let base = self
+                .base
+                .as_ref()
+                .map_or_else(|| flow.base_at(t).0, |b| b.displacement(t));
             for (k, d) in self.d.iter_mut().enumerate() {
                 *d = self.gaps[k] - (self.x[k + 1] - self.x[k]);
             }
@@ -423,11 +445,12 @@ enum Mechanics {
 impl Mechanics {
     fn run_until<O: RunObserver + ?Sized>(
         &mut self,
+        drive: &mut super::drive::BaseDrive,
         t: f64,
         rec: &mut Recorder<'_, O>,
     ) -> Result<RunEnd, StudyError> {
         match self {
-            Mechanics::Plain(sim) => Ok(sim.run_until(t, rec)?),
+            Mechanics::Plain(sim) => Ok(drive.run_until(sim, t, rec)?),
             Mechanics::Coupled(c) => c.run_until(t, rec).map_err(coupling_error),
         }
     }

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::config::{Config, ConfigError};
 use crate::model::ChainState;
-use crate::study::{PointError, PointOptions, PointResult, run_point};
+use crate::study::{PointError, PointOptions, PointResult, run_point_driven};
 
 /// How the points of a one-parameter sweep start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -148,12 +148,14 @@ impl PointRunner {
             _ => config.initial_state(),
         };
         let harvester = (!self.mechanics_only).then(|| (config.harvester(), config.charge_options()));
-        Ok(run_point(
+        let spec = config.run_spec(true);
+        Ok(run_point_driven(
             params,
             initial,
             config.sim_options(),
             harvester,
             &self.options,
+            spec.base_motion.as_ref(),
         )?)
     }
 }
@@ -279,6 +281,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::run_point;
 
     #[test]
     fn grids_end_exactly() {
