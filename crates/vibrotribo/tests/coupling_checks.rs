@@ -25,11 +25,13 @@
 //! solved here by fixed-point iteration (the forces change by ~σ²S/(ε₀(d₀ + D₁ + D₂)) ≈ 6 N/m
 //! per metre of gap against springs of 100 N/m and more: a contraction), to rounding.
 
+use vibrotribo::config::Config;
 use vibrotribo::coupling::{CoupledChain, CouplingOptions, SolverOnly};
 use vibrotribo::electrical::{
     ChargeOptions, ChargeSolver, EPSILON_0, HarvesterParams, Load, TransducerMode, VocModel,
 };
-use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator};
+use vibrotribo::study::{RunObserver, Sample, Sampling, simulate};
+use vibrotribo::{ChainParams, ChainState, Event, Flow, SimOptions, Simulator, StateView};
 
 /// ε₀, F/m (CODATA 2018), written here rather than taken from the library.
 const VACUUM_PERMITTIVITY: f64 = 8.854_187_812_8e-12;
@@ -239,4 +241,495 @@ fn static_equilibrium_contact_separation() {
     let h = harvester(TransducerMode::ContactSeparation, Load::Open, Some(q0));
     let x = check_equilibrium("two masses, contact-separation, open", &two, &h, 30.0);
     assert!(x[0].abs() > 1e-4, "{x:?}");
+}
+
+// ---------------------------------------------------------------------------------------
+// Energy balance over a coupled run.
+// ---------------------------------------------------------------------------------------
+//
+// **The identity.** With E = Σ ½ m_i v_i² + ½ k_i (x_i − y)² as in tests/excitation_energy.rs
+// (whose derivation this extends), the electrostatic force F_i on mass i adds Σ F_i v_i to
+// dE/dt. The gap force G_k acts as +G_k on mass k and −G_k on mass k + 1, and
+// D_k = δ_k − (x_{k+1} − x_k), so Σ F_i v_i = Σ G_k (v_k − v_{k+1}) = Σ G_k dD_k/dt. Along
+// any motion dU/dt = ∂U/∂Q dQ/dt + Σ ∂U/∂D_k dD_k/dt = −V I − Σ G_k dD_k/dt (the voltage
+// is −∂U/∂Q, the gap force −∂U/∂D_k). So Σ F_i v_i = −dU/dt − V I, and over the run
+//
+//     W_base = ΔE + D_damping + L_events + E_load + ΔU,
+//
+// with E_load = ∫ V I dt = ∫ V²/R dt for a resistor (what the charge solver books per period
+// by its collocation quadrature) and ΔU = U(Q, D₁, D₂)(end) − U(start) (U written out in
+// [`field_energy`] below, the charge taken from the run's samples at t = 0 and at the end).
+// W_base, D_damping and L_events are measured as in tests/excitation_energy.rs: Gauss–Legendre
+// quadrature of the closed-form flow, kinetic-energy jumps at events.
+//
+// In one-way mode the masses feel no force, so W_base = ΔE + D + L alone; the load's energy
+// and ΔU are then energy the model creates: the full identity misses by E_load + ΔU.
+
+/// The field energy U(Q, D), J (docs/MODEL.md §2), written out here.
+fn field_energy(h: &HarvesterParams, q: f64, gaps: &[f64]) -> f64 {
+    let sigma_s = h.charge_density * h.area;
+    let d0 = h.dielectric_thickness[0] / h.relative_permittivity[0]
+        + h.dielectric_thickness[1] / h.relative_permittivity[1];
+    let air = match h.mode {
+        TransducerMode::Freestanding => {
+            (q + sigma_s).powi(2) * gaps[h.contact] + (sigma_s - q).powi(2) * gaps[h.contact + 1]
+        }
+        TransducerMode::ContactSeparation => (sigma_s - q).powi(2) * gaps[h.contact],
+    };
+    (q * q * d0 + air) / (2.0 * VACUUM_PERMITTIVITY * h.area)
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on P_n from Chebyshev guesses).
+fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let (mut x, mut w) = (vec![0.0; n], vec![0.0; n]);
+    for i in 0..n {
+        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 0.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, z);
+            for j in 2..=n {
+                let p2 = ((2 * j - 1) as f64 * z * p1 - (j - 1) as f64 * p0) / j as f64;
+                (p0, p1) = (p1, p2);
+            }
+            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
+            let dz = p1 / dp;
+            z -= dz;
+            if dz.abs() < 1e-16 {
+                break;
+            }
+        }
+        x[i] = z;
+        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+    (x, w)
+}
+
+/// A sum with Neumaier's compensation.
+#[derive(Debug, Default, Clone, Copy)]
+struct Sum {
+    s: f64,
+    c: f64,
+}
+
+impl Sum {
+    fn add(&mut self, x: f64) {
+        let t = self.s + x;
+        if self.s.abs() >= x.abs() {
+            self.c += (self.s - t) + x;
+        } else {
+            self.c += (x - t) + self.s;
+        }
+        self.s = t;
+    }
+    fn get(self) -> f64 {
+        self.s + self.c
+    }
+}
+
+/// The mechanical terms of the balance under y = A sin ωt, and the run's samples.
+struct Balance {
+    m: Vec<f64>,
+    k: Vec<f64>,
+    c: Vec<f64>,
+    deltas: Vec<f64>,
+    amplitude: f64,
+    omega: f64,
+    /// Longest quadrature interval, s.
+    h_max: f64,
+    nodes: (Vec<f64>, Vec<f64>),
+    work: Sum,
+    damping: Sum,
+    lost: Sum,
+    /// Energy changes between pieces of flow that no event reports, J.
+    unreported: Sum,
+    events: usize,
+    quadrature_intervals: usize,
+    /// Time, positions, velocities after the last flow or event.
+    last: (f64, Vec<f64>, Vec<f64>),
+    /// (time, charge, gaps) of every sample (one per period boundary).
+    samples: Vec<(f64, f64, Vec<f64>)>,
+}
+
+impl Balance {
+    fn new(chain: &ChainParams) -> Self {
+        assert!(chain.forces.is_empty() && chain.stops.upper.is_none() && chain.stops.lower.is_none());
+        let n = chain.len();
+        let wn = (0..n)
+            .map(|i| (chain.stiffness[i] / chain.masses[i]).sqrt())
+            .fold(chain.omega(), f64::max);
+        Balance {
+            m: chain.masses.clone(),
+            k: chain.stiffness.clone(),
+            c: chain.damping.clone(),
+            deltas: chain.gaps.clone(),
+            amplitude: chain.excitation.amplitude,
+            omega: chain.omega(),
+            // Integrands are products of terms up to the natural frequencies: 12 nodes over
+            // 0.5/(2ω_max) leave a relative error far below rounding.
+            h_max: 0.5 / (2.0 * wn),
+            nodes: gauss_legendre(12),
+            work: Sum::default(),
+            damping: Sum::default(),
+            lost: Sum::default(),
+            unreported: Sum::default(),
+            events: 0,
+            quadrature_intervals: 0,
+            last: (0.0, vec![0.0; n], vec![0.0; n]),
+            samples: Vec::new(),
+        }
+    }
+
+    fn base(&self, t: f64) -> (f64, f64) {
+        let (s, c) = (self.omega * t).sin_cos();
+        (self.amplitude * s, self.amplitude * self.omega * c)
+    }
+
+    /// E = Σ ½ m v² + ½ k (x − y)², J.
+    fn energy(&self, t: f64, x: &[f64], v: &[f64]) -> f64 {
+        let (y, _) = self.base(t);
+        (0..self.m.len())
+            .map(|i| 0.5 * self.m[i] * v[i] * v[i] + 0.5 * self.k[i] * (x[i] - y).powi(2))
+            .sum()
+    }
+
+    fn gaps(&self, x: &[f64]) -> Vec<f64> {
+        (0..self.deltas.len())
+            .map(|k| self.deltas[k] - (x[k + 1] - x[k]))
+            .collect()
+    }
+}
+
+impl RunObserver for Balance {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        let n = self.m.len();
+        let (a, b) = (flow.t_start, flow.t_end);
+        let (mut x, mut v) = (vec![0.0; n], vec![0.0; n]);
+        flow.state_at(a, &mut x, &mut v);
+        assert!(
+            (a - self.last.0).abs() <= 1e-12 * a.max(1.0),
+            "flow at {a}, last {}",
+            self.last.0
+        );
+        let gain = self.energy(a, &x, &v) - self.energy(a, &self.last.1, &self.last.2);
+        self.unreported.add(gain);
+        let (xs, ws) = std::mem::take(&mut self.nodes);
+        let len = b - a;
+        if len > 0.0 {
+            let pieces = (len / self.h_max).ceil().max(1.0) as usize;
+            let h = len / pieces as f64;
+            for j in 0..pieces {
+                let lo = a + j as f64 * h;
+                let hi = if j + 1 == pieces { b } else { lo + h };
+                let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+                let (mut p, mut d) = (0.0, 0.0);
+                for (z, w) in xs.iter().zip(&ws) {
+                    let t = mid + half * z;
+                    flow.state_at(t, &mut x, &mut v);
+                    let (y, yd) = self.base(t);
+                    for i in 0..n {
+                        let f = -self.k[i] * (x[i] - y) - self.c[i] * (v[i] - yd);
+                        p += w * f * yd;
+                        d += w * self.c[i] * (v[i] - yd).powi(2);
+                    }
+                }
+                self.work.add(half * p);
+                self.damping.add(half * d);
+                self.quadrature_intervals += 1;
+            }
+        }
+        self.nodes = (xs, ws);
+        flow.state_at(b, &mut x, &mut v);
+        self.last = (b, x, v);
+    }
+
+    fn event(&mut self, event: &Event, state: &StateView<'_>) {
+        let t = event.time;
+        let before = self.energy(t, &self.last.1, &self.last.2);
+        let after = self.energy(t, state.positions, state.velocities);
+        self.lost.add(before - after);
+        self.events += 1;
+        self.last = (t, state.positions.to_vec(), state.velocities.to_vec());
+    }
+
+    fn wants_samples(&self) -> bool {
+        true
+    }
+
+    fn sample(&mut self, sample: &Sample<'_>) {
+        let e = sample
+            .electrical
+            .expect("an electrical sample at every period boundary");
+        self.samples.push((sample.time, e.charge_c, sample.gaps.to_vec()));
+    }
+}
+
+/// What the balance of one run came to.
+#[derive(Debug, Clone, Copy)]
+struct Closure {
+    /// W − (ΔE + D + L + E_load + ΔU), relative to |W|.
+    full: f64,
+    /// The same, J.
+    full_j: f64,
+    /// |ΔU| + E_load, J: the scale of the electrical terms.
+    electrical_j: f64,
+    /// W − (ΔE + D + L), relative to |W|.
+    mechanical: f64,
+    /// E_load, J.
+    load: f64,
+    /// Average power after the transient, W.
+    power: f64,
+}
+
+/// Runs `text` (a configuration) with the balance observed; prints and returns the terms.
+fn coupled_balance(name: &str, text: &str) -> Closure {
+    let config = Config::from_toml_str(text).unwrap();
+    let mut spec = config.run_spec(false);
+    spec.sampling = Some(Sampling::PerPeriod(1));
+    let h = spec.harvester.as_ref().unwrap().params.clone();
+    let mut obs = Balance::new(&spec.chain);
+    let started = std::time::Instant::now();
+    let outcome = simulate(&spec, &mut obs).unwrap();
+    let elapsed = started.elapsed().as_secs_f64();
+    assert!(outcome.failure().is_none(), "{:?}", outcome.ending);
+    assert_eq!(obs.last.0, outcome.final_time);
+    let electrical = outcome.electrical.as_ref().unwrap();
+    let e_load: f64 = electrical.periods.iter().map(|p| p.energy_j).sum();
+    let power = electrical.power.as_ref().unwrap().average_power_w;
+    // The charge at the start and at the end, from the samples at t = 0 and t = t_end.
+    assert_eq!(
+        obs.samples.len() as u64,
+        outcome.periods + 1,
+        "a sample per boundary"
+    );
+    let (t0, q0, ref g0) = obs.samples[0];
+    let (t1, q1, ref g1) = *obs.samples.last().unwrap();
+    assert_eq!(t0, 0.0);
+    assert!((t1 - outcome.final_time).abs() <= 1e-12 * t1);
+    let n = spec.chain.len();
+    let (x_end, v_end) = (&outcome.final_state.positions, &outcome.final_state.velocities);
+    // The samples at the ends are the run's initial and final states (to rounding).
+    let near = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(p, q)| (p - q).abs() <= 1e-14);
+    assert!(near(g1, &obs.gaps(x_end)), "{g1:?}");
+    assert!(near(g0, &obs.gaps(&spec.initial.positions)), "{g0:?}");
+    let du = field_energy(&h, q1, g1) - field_energy(&h, q0, g0);
+    let de =
+        obs.energy(t1, x_end, v_end) - obs.energy(0.0, &spec.initial.positions, &spec.initial.velocities);
+    let (w, d, l) = (obs.work.get(), obs.damping.get(), obs.lost.get());
+    let mechanical = w - (de + d + l);
+    let full = mechanical - (e_load + du);
+    println!(
+        "{name} ({} masses, {} periods, {:.3} s): run + balance {elapsed:.2} s, {} events, {} quadrature intervals\n  \
+         W_base = {w:.12e} J, ΔE = {de:.6e} J, D = {d:.6e} J, L = {l:.6e} J, E_load = {e_load:.6e} J, \
+         ΔU = {du:.6e} J (Q: {q0:.6e} → {q1:.6e} C)\n  \
+         W − (ΔE + D + L) = {mechanical:.3e} J = {:.3e} of |W|\n  \
+         W − (ΔE + D + L + E_load + ΔU) = {full:.3e} J = {:.3e} of |W|; unreported between flows {:.1e} J; \
+         power after the transient {power:.6e} W",
+        n,
+        outcome.periods,
+        t1,
+        obs.events,
+        obs.quadrature_intervals,
+        mechanical / w.abs(),
+        full / w.abs(),
+        obs.unreported.get(),
+    );
+    assert!(
+        obs.unreported.get().abs() <= 1e-12 * w.abs(),
+        "{}",
+        obs.unreported.get()
+    );
+    Closure {
+        full: full / w.abs(),
+        full_j: full,
+        electrical_j: du.abs() + e_load,
+        mechanical: mechanical / w.abs(),
+        load: e_load,
+        power,
+    }
+}
+
+/// The paper's default case with the exact V_oc and its 100 kΩ, over `periods` from rest.
+fn default_case(coupling: &str, periods: u32, rtol: f64, tolerance: f64) -> String {
+    format!(
+        "[harvester]\nvoc_model = \"exact\"\ncoupling = \"{coupling}\"\ncoupling_tolerance = {tolerance:e}\n\
+         [electrical]\nrtol = {rtol:e}\n[run]\nperiods = {periods}\ntransient_periods = {}\n",
+        periods / 2
+    )
+}
+
+/// Energy balance of a two-way run (the paper's default case, 100 kΩ, 20 periods from rest):
+/// W_base = ΔE + D + L + E_load + ΔU to 1e-8 of W_base; the one-way run of the same case
+/// misses the full identity by E_load + ΔU (what the one-way model leaves out).
+#[test]
+fn energy_balance_two_way_resistor() {
+    let two = coupled_balance(
+        "two-way, default case, 100 kΩ",
+        &default_case("two_way", 20, 1e-10, 1e-11),
+    );
+    let one = coupled_balance(
+        "one-way, default case, 100 kΩ",
+        &default_case("one_way", 20, 1e-10, 1e-11),
+    );
+    println!(
+        "two-way {:.6e} W, one-way {:.6e} W; the full identity: two-way {:.2e}, one-way {:.2e} of |W|",
+        two.power, one.power, two.full, one.full
+    );
+    assert!(two.full.abs() < 1e-8, "{two:?}");
+    // One-way: the mechanics alone closes, the electrical terms are unaccounted for.
+    assert!(one.mechanical.abs() < 1e-8, "{one:?}");
+    assert!(one.full.abs() > 100.0 * 1e-8, "{one:?}");
+    assert!(two.load > 0.0 && one.load > 0.0);
+}
+
+/// Diagnosis of the two-way residual: at every time of a fine grid, the force the accepted
+/// motion was actually driven by, F_eff,i = m_i x_i'' + c_i (x_i' − y') + k_i (x_i − y) (x''
+/// by a central difference of the closed-form velocity over ±0.2 µs), against the force of
+/// the solver's charge at that time, F_i(Q) from [`electrostatic_forces`]. Σ (F_eff − F(Q))·v
+/// summed over the grid is the work the coupling's force representation adds; it should
+/// account for the balance's residual.
+#[derive(Default)]
+struct ForceProbe {
+    step: f64,
+    m: Vec<f64>,
+    k: Vec<f64>,
+    c: Vec<f64>,
+    amplitude: f64,
+    omega: f64,
+    h: Option<HarvesterParams>,
+    /// Grid index → (F_eff per mass, v per mass), waiting for the sample's charge.
+    eff: std::collections::HashMap<u64, (Vec<f64>, Vec<f64>)>,
+    last_event: f64,
+    /// Grid index → time since the last event, s.
+    since: std::collections::HashMap<u64, f64>,
+    /// Σ (F_eff − F(Q))·v·step, J.
+    work: f64,
+    /// Largest |F_eff − F(Q)| (N), its time and the time since the last event (s).
+    worst: (f64, f64, f64),
+    /// `work` by time since the last event: < 0.1 ms, < 1 ms, < 10 ms, < 30 ms, < 100 ms, more.
+    by_since: [f64; 6],
+}
+
+impl RunObserver for ForceProbe {
+    fn flow(&mut self, flow: &Flow<'_>) {
+        let n = self.m.len();
+        let (mut x, mut v, mut vp, mut vm) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let j0 = (flow.t_start / self.step).ceil() as u64;
+        let mut j = j0;
+        loop {
+            let t = j as f64 * self.step;
+            if t > flow.t_end {
+                break;
+            }
+            let d = 2e-7;
+            flow.state_at(t, &mut x, &mut v);
+            flow.state_at(t + d, &mut vec![0.0; n], &mut vp);
+            flow.state_at(t - d, &mut vec![0.0; n], &mut vm);
+            let (s, co) = (self.omega * t).sin_cos();
+            let (y, yd) = (self.amplitude * s, self.amplitude * self.omega * co);
+            let f: Vec<f64> = (0..n)
+                .map(|i| {
+                    self.m[i] * (vp[i] - vm[i]) / (2.0 * d) + self.c[i] * (v[i] - yd) + self.k[i] * (x[i] - y)
+                })
+                .collect();
+            self.eff.insert(j, (f, v.clone()));
+            self.since.insert(j, t - self.last_event);
+            j += 1;
+        }
+    }
+    fn event(&mut self, event: &Event, _state: &StateView<'_>) {
+        self.last_event = event.time;
+    }
+    fn wants_samples(&self) -> bool {
+        true
+    }
+    fn sample(&mut self, sample: &Sample<'_>) {
+        let Some(e) = sample.electrical else { return };
+        let Some((f, v)) = self.eff.remove(&sample.index) else {
+            return;
+        };
+        let since = self.since.remove(&sample.index).unwrap();
+        let n = self.m.len();
+        let g = electrostatic_forces(self.h.as_ref().unwrap(), n, e.charge_c);
+        let mut p = 0.0;
+        for i in 0..n {
+            let df = f[i] - g[i];
+            p += df * v[i];
+            if df.abs() > self.worst.0 {
+                self.worst = (df.abs(), sample.time, since);
+            }
+        }
+        self.work += p * self.step;
+        let bucket = match since {
+            s if s < 1e-4 => 0,
+            s if s < 1e-3 => 1,
+            s if s < 1e-2 => 2,
+            s if s < 3e-2 => 3,
+            s if s < 1e-1 => 4,
+            _ => 5,
+        };
+        self.by_since[bucket] += p * self.step;
+    }
+}
+
+/// The same balance measured against the electrical terms it is about (|ΔU| + E_load, 2.6 mJ
+/// here, against W = 111 J): the force of the charge and the charge's own energy books should
+/// agree far better than the 2·10⁻⁴ they do (5.8e-7 J over 20 periods, 1.2 % of E_load; it
+/// does not shrink with `coupling_tolerance`: 1.4e-6, 5.8e-7, 2.0e-7, −5.4e-7 J at 1e-10,
+/// 1e-11, 1e-12, 1e-13 m). A known defect of the coupling's force representation, see
+/// [`force_error_accounts_for_the_residual`]; this test is to pass once it is fixed.
+#[test]
+#[ignore = "known defect: the coupled force misses the charge by ~2e-4 of the electrostatic work"]
+fn energy_balance_two_way_against_the_electrical_terms() {
+    let two = coupled_balance(
+        "two-way, default case, 100 kΩ",
+        &default_case("two_way", 20, 1e-10, 1e-11),
+    );
+    assert!(
+        two.full_j.abs() < 1e-6 * two.electrical_j,
+        "{:.3e} of the electrical terms",
+        two.full_j / two.electrical_j
+    );
+}
+
+/// The residual of [`energy_balance_two_way_resistor`] is the coupling's force error: the
+/// probe's Σ (F_eff − F(Q))·v reproduces it (to 10 %), and says when it accrues. A diagnostic
+/// (about 10 s): `cargo test --test coupling_checks -- --ignored --nocapture force_error`.
+#[test]
+#[ignore = "diagnostic, ~10 s"]
+fn force_error_accounts_for_the_residual() {
+    let text = default_case("two_way", 20, 1e-10, 1e-11);
+    let residual = coupled_balance("two-way, default case, 100 kΩ", &text).full_j;
+    let config = Config::from_toml_str(&text).unwrap();
+    let mut spec = config.run_spec(false);
+    let step = 1e-6;
+    spec.sampling = Some(Sampling::Uniform { start: 0.0, step });
+    let ch = spec.chain.clone();
+    let mut probe = ForceProbe {
+        step,
+        m: ch.masses.clone(),
+        k: ch.stiffness.clone(),
+        c: ch.damping.clone(),
+        amplitude: ch.excitation.amplitude,
+        omega: ch.omega(),
+        h: Some(spec.harvester.as_ref().unwrap().params.clone()),
+        ..Default::default()
+    };
+    simulate(&spec, &mut probe).unwrap();
+    println!(
+        "Σ (F_eff − F(Q))·v dt = {:.3e} J against the residual {residual:.3e} J; largest |F_eff − F(Q)| = {:.2e} N \
+         at t = {:.6} s, {:.2e} s after an event; by time since the last event (<0.1 ms, <1 ms, <10 ms, <30 ms, \
+         <100 ms, more): {} J",
+        probe.work,
+        probe.worst.0,
+        probe.worst.1,
+        probe.worst.2,
+        list(&probe.by_since, 2)
+    );
+    // The work of the force error has the opposite sign of W − (…): it is what the masses
+    // received beyond what the field gave.
+    assert!(
+        (probe.work + residual).abs() < 0.1 * residual.abs(),
+        "{} vs {residual}",
+        probe.work
+    );
 }
