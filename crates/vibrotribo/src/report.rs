@@ -51,6 +51,7 @@ pub fn run_summary(
         "impacts": after.iter().sum::<u64>(),
         "impacts_per_period": per_contact.iter().sum::<f64>(),
         "impacts_per_period_by_contact": per_contact,
+        "impacts_per_second": per_contact.iter().sum::<f64>() / params.period(),
         "impacts_by_contact": after,
         "impacts_in_each_period": stats.impacts_by_period(done),
         "sticks": stats.sticks,
@@ -81,9 +82,18 @@ pub fn run_summary(
             "peak_voltage_v".into(),
             json!(s.as_ref().map(|s| s.peak_voltage_v)),
         );
+        let se = e.average_power_se(spec.transient_periods);
+        obj.insert("average_power_se_w".into(), json!(se));
+        // A 95 % confidence interval from the 10 batch means (with 10 periods or more):
+        // Student's t with 9 degrees of freedom, t(0.975, 9) = 2.262.
         obj.insert(
-            "average_power_se_w".into(),
-            json!(e.average_power_se(spec.transient_periods)),
+            "average_power_ci95_w".into(),
+            json!(
+                s.as_ref()
+                    .filter(|s| s.periods >= 10)
+                    .zip(se)
+                    .map(|(s, se)| { [s.average_power_w - T_975_9 * se, s.average_power_w + T_975_9 * se] })
+            ),
         );
         obj.insert("power_curve".into(), json!(e.power_curve()));
         obj.insert(
@@ -114,6 +124,10 @@ pub fn run_summary(
     obj.insert("error".into(), json!(failure_text(outcome)));
     out
 }
+
+/// Student's t quantile t(0.975) with 9 degrees of freedom: the 95 % interval of a mean of
+/// 10 batch means is ± this × their standard error.
+const T_975_9: f64 = 2.262_157_162_8;
 
 /// What a run of `spec` (read from `config`) states about its base motion when it is not
 /// the chain's own `A sin ωt` (empty then), as (name, value) lines: `kind`, `run_as` (how

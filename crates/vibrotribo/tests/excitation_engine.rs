@@ -426,3 +426,48 @@ fn a_signal_shorter_than_the_run_is_refused() {
     let err = simulate(&spec, &mut ()).unwrap_err().to_string();
     assert!(err.contains("ends at t = 1 s, before the run's end"), "{err}");
 }
+
+/// `run.start_relative_to_base`: the initial state is the base's y(0), y'(0) plus the given
+/// offsets — for a random signal (y from its spline, evaluated here independently of the
+/// configuration's state) and for the sine (y(0) = 0, y'(0) = Aω in closed form) — and a
+/// state that would then lie beyond a rigid stop is refused, naming the key.
+#[test]
+fn a_run_can_start_at_rest_relative_to_the_base() {
+    let random = "[excitation]\nkind = \"random\"\nrms_acceleration = 20.0\nf_low_hz = 2.0\nf_high_hz = 12.0\nseed = 3\n\
+                  [run]\nperiods = 10\nstart_relative_to_base = true\ninitial_positions = [0.001, 0.0, -0.002]\n";
+    let c = Config::from_toml_str(random).unwrap();
+    let [y0, v0, _] = c.base_motion().unwrap().evaluate(0.0);
+    assert!(
+        y0.abs() > 1e-4 && v0.abs() > 1e-3,
+        "a signal that does not start at rest: {y0} {v0}"
+    );
+    let s = c.initial_state();
+    for (i, dx) in [0.001, 0.0, -0.002].iter().enumerate() {
+        assert_eq!(s.positions[i], y0 + dx);
+        assert_eq!(s.velocities[i], v0);
+    }
+    let absolute = Config::from_toml_str(&random.replace("start_relative_to_base = true\n", "")).unwrap();
+    assert_eq!(absolute.initial_state().positions, vec![0.001, 0.0, -0.002]);
+    let sine = Config::from_toml_str("[run]\nstart_relative_to_base = true\n").unwrap();
+    let chain = sine.chain();
+    let aw = chain.excitation.amplitude * chain.omega();
+    assert_eq!(sine.initial_state().positions, vec![0.0; 3]);
+    assert_eq!(sine.initial_state().velocities, vec![aw; 3]);
+    // A fixed stop at half the base's y(0) on its side (above m1 for y(0) > 0, below m3
+    // otherwise): the start at rest is valid, the start shifted by y(0) lies beyond it.
+    let side = if y0 > 0.0 { "upper" } else { "lower" };
+    let stop = format!(
+        "[oscillator.stops.{side}]\ngap = {:e}\nrestitution = 0.8\n",
+        y0.abs() / 2.0
+    );
+    let shifted = format!(
+        "{stop}{}",
+        random.replace("initial_positions = [0.001, 0.0, -0.002]\n", "")
+    );
+    let e = Config::from_toml_str(&shifted).unwrap_err().to_string();
+    assert!(
+        e.contains("run.start_relative_to_base") && e.contains("stop"),
+        "{e}"
+    );
+    Config::from_toml_str(&shifted.replace("start_relative_to_base = true\n", "")).unwrap();
+}

@@ -14,6 +14,7 @@ use super::mass_ratio::{fig_13, fig_17, figs_14_16, figs_18_19};
 use super::orbits::periodic_orbits;
 use super::report::write_report;
 use super::spacing::{fig_12, figs_7_11};
+use super::vibration::vibration;
 use crate::output::create_dir;
 use crate::progress::check_interrupt;
 use crate::sweep::set_threads;
@@ -70,7 +71,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         failures: std::sync::Mutex::new(Vec::new()),
     };
     let started = Instant::now();
-    let steps: [(&str, Step); 11] = [
+    let steps: [(&str, Step); 12] = [
         ("Figs. 5–6: mass configurations", figs_5_6),
         ("Figs. 7–11: asymmetric spacing R_δ", figs_7_11),
         ("Fig. 12: symmetric spacing δ", fig_12),
@@ -85,6 +86,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
             dynamics,
         ),
         ("beyond the paper: loads and V_oc model", extras),
+        ("beyond the paper: real vibration (record, noise)", vibration),
     ];
     for (what, step) in steps {
         let t0 = Instant::now();

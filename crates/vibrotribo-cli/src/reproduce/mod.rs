@@ -4,7 +4,7 @@
 //! the numbers of this run.
 //!
 //! One file per group of figures (`configurations`, `spacing`, `mass_ratio`, `chatter`,
-//! `orbits`, `dynamics`, `extras`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
+//! `orbits`, `dynamics`, `extras`, `vibration`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
 //! `report` writes REPORT.md.
 
 mod chatter;
@@ -19,5 +19,6 @@ mod orbits;
 mod report;
 mod runs;
 mod spacing;
+mod vibration;
 
 pub use command::{ReproduceArgs, run};

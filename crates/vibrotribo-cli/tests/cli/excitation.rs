@@ -148,3 +148,57 @@ fn stroboscopic_tools_refuse_non_periodic_input() {
         );
     }
 }
+
+/// Under the record (non-periodic input) summary.json gives the average power with its
+/// confidence interval over windows: recomputed here from `energy_in_each_period_j` (the
+/// periods after the transient in 10 consecutive batches, the batch means' standard error
+/// times Student's t(0.975, 9) = 2.262), and the impact rate per second from the impacts per
+/// period and T.
+#[test]
+fn non_periodic_runs_state_power_with_its_interval_and_the_impact_rate() {
+    let dir = tempdir();
+    let d = dir.path().to_str().unwrap();
+    let config = config_file("record_default.toml");
+    let o = vibrotribo(&[
+        "simulate",
+        config.to_str().unwrap(),
+        "--set",
+        "excitation.peak_acceleration=98",
+        "--set",
+        "run.periods=40",
+        "--set",
+        "run.transient_periods=10",
+        "--out",
+        d,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+    let period = s["excitation_period_s"].as_f64().unwrap();
+    let energies: Vec<f64> = s["energy_in_each_period_j"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_f64().unwrap())
+        .collect();
+    assert_eq!(energies.len(), 40);
+    let powers: Vec<f64> = energies[10..].iter().map(|e| e / period).collect();
+    let mean = powers.iter().sum::<f64>() / 30.0;
+    let batches: Vec<f64> = powers.chunks(3).map(|c| c.iter().sum::<f64>() / 3.0).collect();
+    let var = batches.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / 9.0;
+    let se = (var / 10.0).sqrt();
+    let average = s["average_power_w"].as_f64().unwrap();
+    assert!((average - mean).abs() <= 1e-12 * mean, "{average} vs {mean}");
+    assert!(
+        (s["average_power_se_w"].as_f64().unwrap() - se).abs() <= 1e-9 * se,
+        "{s}"
+    );
+    let ci = s["average_power_ci95_w"].as_array().unwrap();
+    let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+    assert!((lo - (mean - 2.262 * se)).abs() < 1e-3 * se && (hi - (mean + 2.262 * se)).abs() < 1e-3 * se);
+    assert!(se > 0.0, "a seismic record's windows differ");
+    let rate = s["impacts_per_second"].as_f64().unwrap();
+    let per_period = s["impacts_per_period"].as_f64().unwrap();
+    assert!((rate - per_period / period).abs() <= 1e-12 * rate.max(1.0));
+    assert!(per_period > 0.0, "the record at 10 g impacts");
+}

@@ -254,6 +254,27 @@ impl Config {
                     .map_err(|e| super::excitation::named(kind, e))?,
             )),
         };
+        let initial = if doc.run.start_relative_to_base {
+            // The base's displacement and velocity at t = 0 (the sine A sin ωt: 0 and Aω).
+            let [y0, v0, _] = match &base {
+                Some(b) => b.evaluate(0.0),
+                None => [0.0, chain.excitation.amplitude * chain.omega(), 0.0],
+            };
+            let positions: Vec<f64> = initial.positions.iter().map(|x| x + y0).collect();
+            let velocities: Vec<f64> = initial.velocities.iter().map(|v| v + v0).collect();
+            crate::dynamics::initial_state(&chain, Some(&positions), Some(&velocities)).map_err(|e| {
+                ConfigError::Param(crate::error::ParamError::Conflict {
+                    name: "run.start_relative_to_base".into(),
+                    message: format!(
+                        "true shifts the initial state (run.initial_positions, run.initial_velocities) by the \
+                         base's y(0) = {y0:e} m, y'(0) = {v0:e} m/s: {}",
+                        e.renamed(keys::state_key)
+                    ),
+                })
+            })?
+        } else {
+            initial
+        };
         Ok(Config {
             table,
             chain,

@@ -22,6 +22,12 @@ pub struct RunSettings {
     pub initial_positions: Option<Vec<f64>>,
     /// Initial velocities, m/s (`run.initial_velocities`). `None` (default): all 0.
     pub initial_velocities: Option<Vec<f64>>,
+    /// Whether `initial_positions` and `initial_velocities` are relative to the base's
+    /// displacement y(0) and velocity y'(0) (`run.start_relative_to_base`; default false:
+    /// absolute, the paper's start at rest while the base moves). With true and no initial
+    /// state given, the chain starts at rest relative to the base, so that a record or a
+    /// random signal that does not start at y = 0, y' = 0 gives the masses no kick.
+    pub start_relative_to_base: bool,
 }
 
 impl Default for RunSettings {
@@ -32,6 +38,7 @@ impl Default for RunSettings {
             samples_per_period: 200,
             initial_positions: None,
             initial_velocities: None,
+            start_relative_to_base: false,
         }
     }
 }
