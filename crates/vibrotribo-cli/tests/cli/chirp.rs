@@ -27,7 +27,7 @@ const GAP: f64 = 0.05;
 const AMPLITUDE: f64 = 0.01;
 const ZETA: f64 = 0.02;
 /// 1/(ζ ω_n), s: ω_n = √(120/0.05).
-const TAU: f64 = 1.0 / (ZETA * 48.989794855663561);
+const TAU: f64 = 1.0 / (ZETA * 48.989_794_855_663_56);
 
 fn config() -> String {
     config_file("impact_oscillator.toml")
