@@ -3,6 +3,7 @@
 
 mod attractors;
 mod basins;
+mod chirp;
 mod config;
 mod continuation;
 mod export_spice;
@@ -49,6 +50,9 @@ enum Command {
     /// Combine the shards of one sweep, map or basins job (`--shard I/N`) into the unsharded
     /// output.
     Merge(sweep::MergeArgs),
+    /// Frequency-sweep experiment: a slow chirp of the base up and down in Ω, the response
+    /// per cycle (amplitudes, impacts, power), its jumps and the hysteresis between them.
+    Chirp(chirp::ChirpArgs),
     /// Average power, period and impacts per period on a two-parameter grid.
     Map(map::MapArgs),
     /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
@@ -71,7 +75,7 @@ enum Command {
 /// Options of `vibrotribo plot`.
 #[derive(Debug, clap::Args)]
 struct PlotArgs {
-    /// A directory written by `simulate`, `sweep`, `map`, `lyapunov`, `basins` or
+    /// A directory written by `simulate`, `sweep`, `map`, `chirp`, `lyapunov`, `basins` or
     /// `attractors` with `--out`.
     dir: std::path::PathBuf,
     /// PSD of this mass only (1-based; default: every mass).
@@ -91,6 +95,7 @@ fn run() -> anyhow::Result<()> {
         Command::Continue(args) => continuation::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => sweep::merge(&args),
+        Command::Chirp(args) => chirp::run(&args),
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),
         Command::Lyapunov(args) => lyapunov::run(&args),

@@ -38,13 +38,15 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         crate::basins::plot_basins(dir)
     } else if dir.join("attractors.json").exists() {
         crate::attractors::plot_attractors(dir)
+    } else if dir.join("chirp.json").exists() {
+        crate::chirp::plot_chirp(dir)
     } else if dir.join("lyapunov.json").exists() {
         crate::lyapunov::plot_lyapunov(dir)
     } else if dir.join("summary.json").exists() && dir.join("trajectory.csv").exists() {
         analyze_run(dir, psd_mass)
     } else {
         bail!(
-            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json, basins.json, attractors.json or lyapunov.json)",
+            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json, chirp.json, basins.json, attractors.json or lyapunov.json)",
             dir.display()
         )
     }

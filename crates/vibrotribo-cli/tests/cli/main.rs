@@ -2,6 +2,7 @@
 //! One test target; each fixed bug has its own module (`issue_*.rs`) opening with what broke.
 
 mod basins;
+mod chirp;
 mod excitation;
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_motion_classified;

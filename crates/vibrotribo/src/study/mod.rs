@@ -5,6 +5,7 @@
 //! Every front end (the command line, Python) runs through here: none wires the simulator,
 //! the charge solver and the statistics together itself.
 
+mod chirp;
 mod drive;
 mod loads;
 mod lyapunov;
@@ -19,6 +20,10 @@ mod settings;
 mod settle;
 mod simulate;
 
+pub use chirp::{
+    ChirpError, ChirpOptions, ChirpRun, ChirpStudy, Cycle, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE,
+    Direction, Jump, MIN_CYCLES, check_options, chirp_config, chirp_study, largest_jump, run_chirp,
+};
 pub use drive::{
     BaseDisplacement, BaseDrive, MULTISINE_RELATIVE_TOLERANCE, as_chain_harmonic, check_base_motion,
     driven_chain, multisine_tolerance,

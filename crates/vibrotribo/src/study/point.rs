@@ -442,7 +442,7 @@ fn record(
             Impacts {
                 after: transient as f64 * period,
                 grazing_speed: options.grazing_ratio * params.excitation.amplitude * params.omega(),
-                last_rebound: vec![0.0; n - 1],
+                last_rebound: vec![0.0; params.contact_count()],
                 records: Vec::new(),
                 grazing: false,
             },
