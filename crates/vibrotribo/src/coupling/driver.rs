@@ -8,7 +8,7 @@ use thiserror::Error;
 use super::CouplingOptions;
 use super::window::{ChargePolynomial, DEGREE, NODES, force_polynomial, nodes, significant_degree};
 use crate::dynamics::{Event, Flow, Observer, RunEnd, Segment, Simulator, StateView, Verdict};
-use crate::electrical::{ChargeSolver, ElectricalError, Electrostatics, NoFieldEnergy};
+use crate::electrical::{ChargeMoments, ChargeSolver, ElectricalError, Electrostatics, NoFieldEnergy};
 use crate::error::SimError;
 use crate::model::{ChainState, ForcePolynomial};
 
@@ -124,6 +124,9 @@ pub struct CoupledChain {
     started: bool,
     /// Per mass: the force polynomial of the current trial (N/sʲ in t − t₀).
     forces: Vec<ForcePolynomial>,
+    /// Per mass: the impulse and first moment (`∫F dτ`, `∫τ F dτ` over the window, N·s,
+    /// N·s²) of the force of the solver's charge in the last sweep, if measured.
+    target: Vec<[f64; 2]>,
     segments: Vec<Segment>,
     events: Vec<(Event, Vec<f64>, Vec<f64>)>,
 }
@@ -161,6 +164,7 @@ impl CoupledChain {
             stats: CouplingStats::default(),
             started: false,
             forces: vec![ForcePolynomial::zero(); n],
+            target: vec![[0.0; 2]; n],
             segments: Vec::new(),
             events: Vec::new(),
         })
@@ -261,6 +265,7 @@ impl CoupledChain {
         t0: f64,
         q: &ChargePolynomial,
         negligible: f64,
+        matched: bool,
     ) -> Result<(), SimError> {
         for f in &mut self.forces {
             f.t_ref = t0;
@@ -278,7 +283,76 @@ impl CoupledChain {
             let keep = significant_degree(&f.coefficients, q.h, negligible);
             f.coefficients.truncate(keep + 1);
         }
+        if matched {
+            // Add to each mass the linear force α + βτ that gives its polynomial the impulse
+            // and first moment of the force of the solver's charge (measured in the last
+            // sweep): a transient the polynomial cannot follow (the charge's boundary layer
+            // of width R·C after an impact) then reaches the masses with its integral and
+            // its first moment, which is all a window short against the mechanics' time
+            // scales passes on to the positions and velocities at its end.
+            let h = q.h;
+            let x = self.omega_n * h;
+            let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
+            for (f, target) in self.forces.iter_mut().zip(&self.target) {
+                let [i0, i1] = polynomial_moments(&f.coefficients, h);
+                let (d0, d1) = (target[0] - i0, target[1] - i1);
+                let mut alpha = 4.0 * d0 / h - 6.0 * d1 / (h * h);
+                let mut beta = 12.0 * d1 / (h * h * h) - 6.0 * d0 / (h * h);
+                // The linear term's rounding, amplified as in `fit`: beyond the budget only
+                // the impulse is matched.
+                if beta.abs() * h * (1.0 / x).max(1.0) > budget {
+                    alpha = d0 / h;
+                    beta = 0.0;
+                }
+                if f.coefficients.len() < 2 {
+                    f.coefficients.resize(2, 0.0);
+                }
+                f.coefficients[0] += alpha;
+                f.coefficients[1] += beta;
+            }
+        }
         sim.set_external_forces(&self.forces)
+    }
+
+    /// Per mass, the impulse and first moment of the force of the solver's charge over
+    /// `[t_ref, t_ref + span]`, from its charge moments (into `target`).
+    fn measure(&mut self, m: &ChargeMoments, span: f64) {
+        for t in &mut self.target {
+            *t = [0.0; 2];
+        }
+        let [s0, s1, s2, s3] = m.sums;
+        for (k, c) in self.statics.gap_force_polynomials() {
+            // G(q_ref + d) = g0 + g1 d + c₂ d².
+            let q = m.q_ref;
+            let g0 = c[0] + c[1] * q + c[2] * q * q;
+            let g1 = c[1] + 2.0 * c[2] * q;
+            let impulse = g0 * span + g1 * s0 + c[2] * s1;
+            let moment = 0.5 * g0 * span * span + g1 * s2 + c[2] * s3;
+            self.target[k][0] += impulse;
+            self.target[k][1] += moment;
+            self.target[k + 1][0] -= impulse;
+            self.target[k + 1][1] -= moment;
+        }
+    }
+
+    /// How far the installed forces' impulse and first moment over `[0, span]` miss the
+    /// measured ones (`target`), against the tolerances: the displacement error at the end,
+    /// `|∫(span − τ)δF|/m`, against the position tolerance, and the velocity error `|∫δF|/m`
+    /// against the position tolerance times the excitation frequency (as in
+    /// [`charge_tolerance`](Self::charge_tolerance)). ≤ 1 passes.
+    fn moment_error(&self, span: f64) -> f64 {
+        let tol_x = self.options.position_tolerance;
+        let omega = 2.0 * std::f64::consts::PI / self.sim.period();
+        let masses = &self.sim.params().masses;
+        let mut worst: f64 = 0.0;
+        for ((f, target), m) in self.forces.iter().zip(&self.target).zip(masses) {
+            let [i0, i1] = polynomial_moments(&f.coefficients, span);
+            let (d0, d1) = (target[0] - i0, target[1] - i1);
+            let by_position = (span * d0 - d1).abs() / (m * tol_x);
+            let by_velocity = d0.abs() / (m * tol_x * omega);
+            worst = worst.max(by_position).max(by_velocity);
+        }
+        worst
     }
 
     /// The charge polynomial through `values` at the nodes of a window of length `h`, s, cut
@@ -333,14 +407,18 @@ impl CoupledChain {
         };
         let mut sweeps = 0;
         let mut cuts = 0;
+        // Whether `target` holds the force moments measured by the last sweep of this window
+        // (same length): the next trial then matches them.
+        let mut matched = false;
         loop {
             sweeps += 1;
             self.stats.sweeps += 1;
             let tol = self.charge_tolerance(h, q0, scale);
             let negligible = 0.01 * 2.0 * self.options.position_tolerance * self.min_mass / (h * h);
             let cp = host.charge_solver().checkpoint();
+            let tracked = host.charge_solver().start_moments(t0, q0);
             let mut trial = self.sim.clone();
-            self.install(&mut trial, t0, &guess, negligible)?;
+            self.install(&mut trial, t0, &guess, negligible, matched)?;
             self.segments.clear();
             self.events.clear();
             let times = nodes(t0, h);
@@ -383,11 +461,13 @@ impl CoupledChain {
                     let shorter = te - t0;
                     if shorter <= 0.0 {
                         // The event is at the window's start: accept it with no flow.
+                        host.charge_solver().stop_moments();
                         self.accept(trial, t0, ChargePolynomial::constant(q0, 0.0), true, None);
                         return Ok(());
                     }
                     guess = self.fit(&guess.values_at_nodes(0.0, shorter), shorter);
                     h = shorter;
+                    matched = false;
                     continue;
                 }
             }
@@ -399,6 +479,14 @@ impl CoupledChain {
                 .map(|(g, v)| (g - v).abs())
                 .fold(0.0, f64::max);
             let estimate = sampled.error_estimate();
+            let span = host.charge_solver().time() - t0;
+            let moment_error = match host.charge_solver().moments() {
+                Some(m) if tracked && span > 0.0 => {
+                    self.measure(&m, span);
+                    self.moment_error(span)
+                }
+                _ => 0.0,
+            };
             if estimate > tol {
                 host.charge_solver().rewind(&cp);
                 self.stats.shortened += 1;
@@ -411,9 +499,10 @@ impl CoupledChain {
                 h = shorter;
                 self.h = self.h.min(h);
                 sweeps = 0;
+                matched = false;
                 continue;
             }
-            if misfit > tol {
+            if misfit > tol || moment_error > 1.0 {
                 host.charge_solver().rewind(&cp);
                 if sweeps >= self.options.max_iterations {
                     h *= 0.5;
@@ -423,8 +512,10 @@ impl CoupledChain {
                     self.h = self.h.min(h);
                     sweeps = 0;
                     guess = self.fit(&sampled.values_at_nodes(0.0, h), h);
+                    matched = false;
                 } else {
                     guess = sampled;
+                    matched = tracked;
                 }
                 continue;
             }
@@ -434,6 +525,7 @@ impl CoupledChain {
                 2.0
             };
             let next = (h * grow).min(self.options.max_window_periods * period);
+            host.charge_solver().stop_moments();
             self.accept(trial, t0, sampled, cut.is_some(), Some(next));
             return Ok(());
         }
@@ -466,6 +558,18 @@ impl CoupledChain {
             );
         }
     }
+}
+
+/// `[∫₀ʰ f, ∫₀ʰ τ f]` of the polynomial `f(τ) = Σ f_j τʲ`.
+fn polynomial_moments(f: &[f64], h: f64) -> [f64; 2] {
+    let (mut i0, mut i1) = (0.0, 0.0);
+    let mut p = h;
+    for (j, fj) in f.iter().enumerate() {
+        i0 += fj * p / (j + 1) as f64;
+        i1 += fj * p * h / (j + 2) as f64;
+        p *= h;
+    }
+    [i0, i1]
 }
 
 /// The observer of a trial window: advances the host's solver over the flow, records the

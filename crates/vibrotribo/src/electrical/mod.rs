@@ -58,8 +58,8 @@ pub use params::{
     BOLTZMANN_OVER_CHARGE, EPSILON_0, HarvesterParams, Load, LoadKind, Rectifier, TransducerMode, VocModel,
 };
 pub use solver::{
-    ChargeCheckpoint, ChargeOptions, ChargeSolver, ElectricalSamples, PeriodStats, PowerSummary, SolverStats,
-    power_curve, summarize,
+    ChargeCheckpoint, ChargeMoments, ChargeOptions, ChargeSolver, ElectricalSamples, PeriodStats,
+    PowerSummary, SolverStats, power_curve, summarize,
 };
 pub use sweep::{LoadPoint, LoadSweep, load_sweep, log_spaced};
 pub use table::HarvesterTable;

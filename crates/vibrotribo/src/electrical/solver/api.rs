@@ -4,7 +4,9 @@
 use super::results::{
     ChargeOptions, ElectricalSamples, PeriodStats, PowerSummary, SolverStats, power_curve, summarize,
 };
-use super::state::{ChargeSolver, Grid, LoadModel, MAX_STAGES, NOISE, NOISE_CHARGE, RectifierLoad, Row};
+use super::state::{
+    ChargeMoments, ChargeSolver, Grid, LoadModel, MAX_STAGES, NOISE, NOISE_CHARGE, RectifierLoad, Row,
+};
 use crate::dynamics::{Flow, GapPolynomial, Observer, Trajectory, Verdict};
 use crate::electrical::ElectricalError;
 use crate::electrical::breakdown::{BreakdownMargin, BreakdownWatch};
@@ -94,6 +96,7 @@ impl ChargeSolver {
             poly: GapPolynomial::default(),
             harvester: params.clone(),
             breakdown: None,
+            moments: None,
         })
     }
 
@@ -284,6 +287,34 @@ impl ChargeSolver {
             Some(e) => Err(e.clone()),
             None => Ok(()),
         }
+    }
+
+    /// Starts accumulating the charge's time integrals ([`ChargeMoments`]) from now, with
+    /// reference time `t_ref` (s) and charge `q_ref` (C); restarts them if already running.
+    /// False (and nothing accumulated) for an open or short circuit, whose charge is not
+    /// integrated by steps. A [`checkpoint`](Self::checkpoint) saves them, a rewind restores
+    /// them.
+    pub fn start_moments(&mut self, t_ref: f64, q_ref: f64) -> bool {
+        if matches!(self.load, LoadModel::Open | LoadModel::Short) {
+            self.moments = None;
+            return false;
+        }
+        self.moments = Some(ChargeMoments {
+            t_ref,
+            q_ref,
+            sums: [0.0; 4],
+        });
+        true
+    }
+
+    /// The charge's time integrals since [`start_moments`](Self::start_moments), if running.
+    pub fn moments(&self) -> Option<ChargeMoments> {
+        self.moments
+    }
+
+    /// Stops accumulating the charge's time integrals.
+    pub fn stop_moments(&mut self) {
+        self.moments = None;
     }
 
     /// Current time, s.

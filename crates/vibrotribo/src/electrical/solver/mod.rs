@@ -84,4 +84,4 @@ pub use checkpoint::ChargeCheckpoint;
 pub use results::{
     ChargeOptions, ElectricalSamples, PeriodStats, PowerSummary, SolverStats, power_curve, summarize,
 };
-pub use state::ChargeSolver;
+pub use state::{ChargeMoments, ChargeSolver};

@@ -211,6 +211,22 @@ pub struct ChargeSolver {
     pub(super) harvester: HarvesterParams,
     /// The air-breakdown check, if requested.
     pub(super) breakdown: Option<BreakdownWatch>,
+    /// Charge moments accumulated over the accepted steps, if requested (two-way coupling).
+    pub(super) moments: Option<ChargeMoments>,
+}
+
+/// Time integrals of the charge over the steps accepted since
+/// [`ChargeSolver::start_moments`], by the collocation quadrature of each step (the same
+/// quadrature that books the energy): with `d = Q − q_ref` and `τ = t − t_ref`,
+/// `[∫d, ∫d², ∫τ d, ∫τ d²]` (C·s, C²·s, C·s², C²·s²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChargeMoments {
+    /// Reference time, s.
+    pub t_ref: f64,
+    /// Reference charge, C.
+    pub q_ref: f64,
+    /// The integrals.
+    pub sums: [f64; 4],
 }
 
 /// Points per piece at which an open or short circuit (no steps) is checked for air

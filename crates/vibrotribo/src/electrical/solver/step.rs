@@ -70,6 +70,23 @@ impl ChargeSolver {
                 f64::INFINITY
             };
             if err <= 1.0 {
+                if let Some(m) = self.moments.as_mut() {
+                    // The step's collocation quadrature (weights b = the last row of A) of the
+                    // charge at its stages.
+                    let mut sums = [0.0; 4];
+                    for j in 0..S {
+                        let d = self.y[0] + trial.z[0][j] + nodes[j].equilibrium_charge - m.q_ref;
+                        let tau = times[j] - m.t_ref;
+                        let w = tab.a[S - 1][j];
+                        sums[0] += w * d;
+                        sums[1] += w * d * d;
+                        sums[2] += w * tau * d;
+                        sums[3] += w * tau * d * d;
+                    }
+                    for (acc, s) in m.sums.iter_mut().zip(sums) {
+                        *acc += h * s;
+                    }
+                }
                 self.accept(t, t1, &trial, nodes[S - 1]);
                 self.smooth_since_last_step = true;
                 self.record(wave)?;
