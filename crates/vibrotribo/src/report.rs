@@ -133,7 +133,8 @@ const T_975_9: f64 = 2.262_157_162_8;
 /// the chain's own `A sin ωt` (empty then), as (name, value) lines: `kind`, `run_as` (how
 /// the engine ran it), the lines of [`BaseMotion::summary`](crate::excitation::BaseMotion::summary)
 /// (spline knots and error bounds, record scaling and baseline correction) and, for a
-/// multisine sampled into a spline, `multisine_spline_error_bound_m`. summary.json holds
+/// multisine or a random signal, what the engine ran on: `piece_degree`, `piece_intervals`,
+/// `piece_displacement_error_bound_m`, `piece_velocity_error_bound_m_s`. summary.json holds
 /// them as its `base_motion` object.
 pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String)> {
     use crate::excitation::BaseMotion;
@@ -144,18 +145,35 @@ pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String
         "kind".to_string(),
         config.excitation().kind().as_str().to_string(),
     )];
+    let end = (spec.periods as f64 * spec.chain.period()).max(spec.chain.period());
+    let mut pieces = |harmonics: &[crate::excitation::Harmonic], end: f64, tolerance: f64| {
+        if let Ok(a) = crate::excitation::piece_accuracy(harmonics, end, tolerance) {
+            out.push(("piece_degree".into(), crate::excitation::PIECE_DEGREE.to_string()));
+            out.push(("piece_intervals".into(), a.intervals.to_string()));
+            out.push((
+                "piece_displacement_error_bound_m".into(),
+                format!("{:e}", a.displacement_bound),
+            ));
+            out.push((
+                "piece_velocity_error_bound_m_s".into(),
+                format!("{:e}", a.velocity_bound),
+            ));
+        }
+    };
+    let on_pieces = "exact per-interval forces k_i y + c_i y' of degree-7 Chebyshev interpolants of the \
+                     harmonics' displacement and velocity (a closed-form multisine in the engine is a later step)";
     let run_as = match &**b {
         BaseMotion::Harmonics(h) if crate::study::as_chain_harmonic(h, &spec.chain).is_some() => {
             "the harmonic excitation A sin ωt (closed form)".to_string()
         }
         BaseMotion::Harmonics(h) => {
-            out.push((
-                "multisine_spline_error_bound_m".into(),
-                format!("{:e}", crate::study::multisine_tolerance(h)),
-            ));
-            "a clamped cubic spline of the multisine, exact per-interval cubic forces k_i y + c_i y' \
-             (a closed-form multisine in the engine is a later step)"
-                .to_string()
+            pieces(h, end, crate::study::multisine_tolerance(h));
+            on_pieces.to_string()
+        }
+        BaseMotion::Spline(s) if !s.harmonics.is_empty() && s.accuracy.is_some() => {
+            let a = s.accuracy.expect("checked");
+            pieces(&s.harmonics, s.displacement.end(), a.error_bounds[0]);
+            on_pieces.to_string()
         }
         BaseMotion::Spline(_) => "exact per-interval cubic forces k_i y + c_i y' of the spline".to_string(),
     };

@@ -13,6 +13,8 @@
 //!
 //! Files: `spline.rs` (the piecewise cubic, interpolating splines, the Hall–Meyer error
 //! bounds), `harmonics.rs` (harmonics, multisines, sampling a smooth signal into a spline),
+//! `pieces.rs` (sums of harmonics as degree-7 Chebyshev interpolants, far fewer intervals
+//! than a spline: what the engine runs multisines and random signals on),
 //! `chirp.rs`, `random.rs` (random-phase multisine from a PSD), `record.rs` (CSV records,
 //! exact integration with baseline correction), `error.rs`.
 //!
@@ -24,6 +26,7 @@
 mod chirp;
 mod error;
 mod harmonics;
+mod pieces;
 mod random;
 mod record;
 mod spline;
@@ -35,6 +38,7 @@ pub use error::SignalError;
 pub use harmonics::{
     Harmonic, MAX_KNOTS, SplineAccuracy, evaluate_sum, fourth_derivative_bound, harmonics_to_spline,
 };
+pub use pieces::{HarmonicPieces, PIECE_DEGREE, PieceAccuracy, PieceCoefficients, piece_accuracy};
 pub use random::{MAX_COMPONENTS, Psd, RandomSpec};
 pub use record::{
     BaselineCorrection, MIN_SAMPLES, Quantity, RecordReport, RecordSamples, RecordScaling, parse_record,

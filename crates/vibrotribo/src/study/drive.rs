@@ -10,10 +10,14 @@
 //!
 //! A sum of harmonics that is exactly the chain's harmonic (one harmonic at the reference
 //! frequency, phase 0) runs as the harmonic run itself, bit for bit. Any other sum of
-//! harmonics is sampled into a clamped spline ([`harmonics_to_spline`]) with displacement
-//! error at most [`multisine_tolerance`] (stated in the outputs).
+//! harmonics (a multisine, and the random-phase multisine behind a random signal) runs on
+//! piecewise polynomials of degree 7 ([`HarmonicPieces`]: Chebyshev interpolants of the
+//! displacement and of the velocity, with stated remainder bounds): about 8 intervals per
+//! cycle of the fastest harmonic where a cubic spline within the same error needs ~1500, and
+//! every interval end restarts the event search. A multisine's displacement error is at most
+//! [`multisine_tolerance`]; a random signal's is the bound its spline was built to.
 // TODO(issue 14): a closed-form multisine in the engine (one particular solution per
-// harmonic) would remove the spline's error for multisines; this is a later step.
+// harmonic, no intervals at all) would remove the remaining interpolation error.
 
 use std::borrow::Cow;
 use std::sync::Arc;
@@ -22,7 +26,7 @@ use super::settings::RunSpec;
 use super::simulate::StudyError;
 use crate::dynamics::{Observer, RunEnd, Simulator};
 use crate::error::SimError;
-use crate::excitation::{BaseMotion, Harmonic, PiecewiseCubic, SplineMotion, harmonics_to_spline};
+use crate::excitation::{BaseMotion, Harmonic, HarmonicPieces, PiecewiseCubic, SplineMotion};
 use crate::model::{ChainParams, ForcePolynomial, StopFrame};
 
 /// Bound on the displacement error of the spline a multisine is sampled into, relative to
@@ -79,26 +83,57 @@ pub struct BaseDisplacement(Source);
 
 #[derive(Debug, Clone)]
 enum Source {
-    /// A [`BaseMotion::Spline`] (never [`BaseMotion::Harmonics`]).
+    /// A [`BaseMotion::Spline`] (never [`BaseMotion::Harmonics`]) run on its cubic.
     Given(Arc<BaseMotion>),
-    Sampled(Arc<PiecewiseCubic>),
+    /// A sum of harmonics as piecewise polynomials.
+    Pieces(Arc<HarmonicPieces>),
 }
 
 impl BaseDisplacement {
-    /// The piecewise cubic, m.
-    pub fn cubic(&self) -> &PiecewiseCubic {
+    /// The piecewise cubic, m, when the drive runs on one.
+    pub fn cubic(&self) -> Option<&PiecewiseCubic> {
         match &self.0 {
             Source::Given(b) => match &**b {
-                BaseMotion::Spline(s) => &s.displacement,
-                BaseMotion::Harmonics(_) => unreachable!("a harmonic base motion is sampled first"),
+                BaseMotion::Spline(s) => Some(&s.displacement),
+                BaseMotion::Harmonics(_) => None,
             },
-            Source::Sampled(p) => p,
+            Source::Pieces(_) => None,
+        }
+    }
+
+    /// The piecewise polynomials, when the drive runs on them.
+    pub fn pieces(&self) -> Option<&HarmonicPieces> {
+        match &self.0 {
+            Source::Pieces(p) => Some(p),
+            Source::Given(_) => None,
         }
     }
 
     /// The base displacement at `t` (s), m.
     pub fn displacement(&self, t: f64) -> f64 {
-        self.cubic().displacement(t)
+        match (self.cubic(), self.pieces()) {
+            (Some(c), _) => c.displacement(t),
+            (_, Some(p)) => p.evaluate(t)[0],
+            _ => unreachable!("a drive runs on a cubic or on pieces"),
+        }
+    }
+
+    /// The interval ends, s.
+    fn knots(&self) -> &[f64] {
+        match (self.cubic(), self.pieces()) {
+            (Some(c), _) => c.knots(),
+            (_, Some(p)) => p.knots(),
+            _ => unreachable!("a drive runs on a cubic or on pieces"),
+        }
+    }
+
+    /// The interval holding `t` (s).
+    fn interval(&self, t: f64) -> usize {
+        match (self.cubic(), self.pieces()) {
+            (Some(c), _) => c.interval(t),
+            (_, Some(p)) => p.interval(t),
+            _ => unreachable!("a drive runs on a cubic or on pieces"),
+        }
     }
 }
 
@@ -145,9 +180,27 @@ impl BaseDrive {
                 if as_chain_harmonic(h, &spec.chain).is_some() {
                     return Ok((chain, harmonic));
                 }
-                let (s, _) = harmonics_to_spline(h, end.max(spec.chain.period()), multisine_tolerance(h))
+                let p = HarmonicPieces::new(h, end.max(spec.chain.period()), multisine_tolerance(h))
                     .map_err(|e| fail(format!("multisine: {e}")))?;
-                Source::Sampled(Arc::new(s))
+                Source::Pieces(Arc::new(p))
+            }
+            BaseMotion::Spline(SplineMotion {
+                displacement,
+                accuracy: Some(accuracy),
+                harmonics,
+                ..
+            }) if !harmonics.is_empty() => {
+                // A random signal: its harmonics, to the bound its spline was built to.
+                let p = HarmonicPieces::new(harmonics, displacement.end(), accuracy.error_bounds[0])
+                    .map_err(|e| fail(format!("random signal: {e}")))?;
+                if end > p.end() * (1.0 + 1e-12) {
+                    return Err(fail(format!(
+                        "the base motion ends at t = {} s, before the run's end at {} s",
+                        p.end(),
+                        end
+                    )));
+                }
+                Source::Pieces(Arc::new(p))
             }
             BaseMotion::Spline(SplineMotion { displacement, .. }) => {
                 // A relative slack of 1e-12 for the rounding of periods·T.
@@ -198,13 +251,13 @@ impl BaseDrive {
             return sim.run_until(t_end, observer);
         };
         loop {
-            let i = s.motion.cubic().interval(sim.time());
+            let i = s.motion.interval(sim.time());
             if s.current != Some(i) {
                 s.set(i);
                 sim.set_external_forces(&s.forces)?;
                 s.current = Some(i);
             }
-            let knots = s.motion.cubic().knots();
+            let knots = s.motion.knots();
             let stop = if i + 2 < knots.len() {
                 knots[i + 1].min(t_end)
             } else {
@@ -219,9 +272,21 @@ impl BaseDrive {
 }
 
 impl Spline {
-    /// The forces `k_i y + c_i y'` of interval `i`, N, as polynomials in `t − knot_i`.
+    /// The forces `k_i y + c_i y'` of interval `i`, N, as polynomials in `t − knot_i` (a
+    /// cubic) or `t − t_mid` (pieces).
     fn set(&mut self, i: usize) {
-        let (t0, [c0, c1, c2, c3]) = self.motion.cubic().piece(i);
+        if let Some(p) = self.motion.pieces() {
+            let (mid, y, v) = p.piece(i);
+            for (m, f) in self.forces.iter_mut().enumerate() {
+                let (k, c) = (self.stiffness[m], self.damping[m]);
+                f.t_ref = mid;
+                f.coefficients.clear();
+                f.coefficients.extend(y.iter().zip(v).map(|(y, v)| k * y + c * v));
+            }
+            return;
+        }
+        let cubic = self.motion.cubic().expect("a drive runs on a cubic or on pieces");
+        let (t0, [c0, c1, c2, c3]) = cubic.piece(i);
         for (m, f) in self.forces.iter_mut().enumerate() {
             let (k, c) = (self.stiffness[m], self.damping[m]);
             f.t_ref = t0;
