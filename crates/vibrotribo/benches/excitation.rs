@@ -54,16 +54,21 @@ fn configs() -> Vec<(&'static str, Config)> {
          {{amplitude = 0.015, ratio = 2.3, phase = 0.4}}]\n[run]\nperiods = {PERIODS}\ntransient_periods = 0\n"
     ))
     .unwrap();
-    let real = Config::from_path(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/record_default.toml"))
-        .unwrap()
-        .with("excitation.peak_acceleration", 98.0.into())
-        .unwrap()
-        .with("run.periods", 160.into())
-        .unwrap();
+    let real = Config::from_path(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/record_default.toml"),
+    )
+    .unwrap()
+    .with("excitation.peak_acceleration", 98.0.into())
+    .unwrap()
+    .with("run.periods", 160.into())
+    .unwrap();
     let sine_160 = Config::from_toml_str("[run]\nperiods = 160\n").unwrap();
     vec![
         ("harmonic, 1000 periods", harmonic),
-        ("harmonic as a record (200 knots per period), 1000 periods", record),
+        (
+            "harmonic as a record (200 knots per period), 1000 periods",
+            record,
+        ),
         ("multisine, 2 harmonics, 1000 periods", multisine),
         ("harmonic, 160 periods", sine_160),
         ("BW.RJOB record at 98 m/s² peak, 160 periods", real),
