@@ -14,9 +14,9 @@ use vibrotribo::electrical::{EPSILON_0, log_spaced};
 use vibrotribo::study::simulate;
 
 use super::context::Ctx;
-use super::draw::lines;
+use super::draw::both;
 use crate::output::si;
-use crate::plot::{Figure, Scale};
+use crate::plot::{self, Figure, Scale, Series};
 
 /// The chatter case of Sect. 4.4 (m1 = m3 = 50 g, R_m = 3, δ = 5 mm).
 const CHATTER: [(&str, &str); 2] = [
@@ -267,7 +267,7 @@ pub(super) fn coupling(ctx: &mut Ctx) -> Result<()> {
     ctx.extras
         .push(sweep_text(&loads, sweep, &optima, &case_pairs[0], long));
     ctx.extras.push(format!(
-        "**Cost of the coupling.** This step ran {} one-way and {} two-way simulations in {:.0} s on the clock; their run times add up to {:.1} s one-way and {:.1} s two-way ({:.0}× as long a run on average). The default case's 100 periods took {:.3} s one-way and {:.2} s two-way ({:.0}×).",
+        "**Cost of the coupling.** This step ran {} one-way and {} two-way simulations in {:.0} s on the clock, as many at a time as there are worker threads; their run times add up to {:.1} s one-way and {:.1} s two-way ({:.0}× as long a run on average). The default case's 100 periods took {:.3} s one-way and {:.2} s two-way ({:.0}×).",
         jobs.len() / 2 + optima[0].runs,
         jobs.len() / 2 + optima[1].runs,
         started.elapsed().as_secs_f64(),
@@ -375,24 +375,36 @@ fn refine(loads: &[f64], sweep: &[[Done; 2]], two_way: bool) -> Optimum {
 }
 
 fn scan_figure(ctx: &Ctx, omegas: &[f64], scan: &[[Done; 2]]) -> Result<String> {
-    let curve = |m: usize| -> (Vec<f64>, Vec<f64>) {
-        omegas
+    let fig = Figure::new("Chatter case: average power against Ω", "Ω", "P_a [W]");
+    two_curves(ctx, "extra_coupling_omega", fig, omegas, scan)
+}
+
+/// Both modes' powers against `xs` on a log scale, lines broken and marks left out where a
+/// run failed (a value with failed neighbours shows as a mark alone).
+fn two_curves(ctx: &Ctx, name: &str, mut fig: Figure, xs: &[f64], pairs: &[[Done; 2]]) -> Result<String> {
+    let curve = |m: usize| -> Vec<f64> {
+        pairs
             .iter()
-            .zip(scan)
-            .filter(|(_, p)| p[m].power().is_finite() && p[m].power() > 0.0)
-            .map(|(w, p)| (*w, p[m].power()))
-            .unzip()
+            .map(|p| Some(p[m].power()).filter(|&w| w > 0.0).unwrap_or(f64::NAN))
+            .collect()
     };
-    let (x0, y0) = curve(0);
-    let (x1, y1) = curve(1);
-    let mut fig = Figure::new("Chatter case: average power against Ω", "Ω", "P_a [W]");
+    let (y0, y1) = (curve(0), curve(1));
     fig.y_scale = Scale::Log;
-    lines(
-        ctx,
-        "extra_coupling_omega",
-        &fig,
-        &[("one-way", &x0, &y0), ("two-way", &x1, &y1)],
-    )
+    both(ctx, name, |path| {
+        plot::lines_and_points(
+            path,
+            &fig,
+            &[
+                Series::new("one-way", xs, &y0).colour(0),
+                Series::new("two-way", xs, &y1).colour(1),
+            ],
+            &[
+                Series::unlabelled(xs, &y0).colour(0),
+                Series::unlabelled(xs, &y1).colour(1),
+            ],
+            5,
+        )
+    })
 }
 
 fn write_scan_csv(ctx: &Ctx, omegas: &[f64], scan: &[[Done; 2]]) -> Result<()> {
@@ -416,6 +428,15 @@ fn write_scan_csv(ctx: &Ctx, omegas: &[f64], scan: &[[Done; 2]]) -> Result<()> {
     }
     let path = ctx.path("extra_coupling_omega.csv");
     std::fs::write(&path, csv).with_context(|| path.display().to_string())
+}
+
+/// "no value", "1 value", "n values".
+fn count(n: usize) -> String {
+    match n {
+        0 => "no value".into(),
+        1 => "1 value".into(),
+        _ => format!("{n} values"),
+    }
 }
 
 fn list(omegas: &[f64]) -> String {
@@ -470,7 +491,7 @@ fn scan_text(omegas: &[f64], scan: &[[Done; 2]], (periods, transient): (u64, u64
         let (lw, lc) = largest.expect("non-empty");
         let _ = write!(
             md,
-            "Where both modes ran ({} values), the median change of the average power is {median:.1} % and the largest {lc:+.1} % (Ω = {lw:.3}); it changes by more than {NOTABLE_PERCENT:.0} % at {} of them{}. ",
+            "Where both modes ran ({} values), the median absolute change of the average power is {median:.1} % and the largest {lc:+.1} % (Ω = {lw:.3}); it changes by more than {NOTABLE_PERCENT:.0} % at {} of them{}. ",
             both.len(),
             notable.len(),
             if notable.is_empty() {
@@ -481,14 +502,14 @@ fn scan_text(omegas: &[f64], scan: &[[Done; 2]], (periods, transient): (u64, u64
         );
         let _ = write!(
             md,
-            "Coupling switches chatter on at {} values{} and off at {}{}. ",
-            switched_on.len(),
+            "Coupling switches chatter on at {}{} and off at {}{}. ",
+            count(switched_on.len()),
             if switched_on.is_empty() {
                 String::new()
             } else {
                 format!(" (Ω = {})", list(&switched_on))
             },
-            switched_off.len(),
+            count(switched_off.len()),
             if switched_off.is_empty() {
                 String::new()
             } else {
@@ -540,28 +561,13 @@ fn short(d: &Done) -> String {
 }
 
 fn sweep_figure(ctx: &Ctx, loads: &[f64], sweep: &[[Done; 2]]) -> Result<String> {
-    let curve = |m: usize| -> (Vec<f64>, Vec<f64>) {
-        loads
-            .iter()
-            .zip(sweep)
-            .filter(|(_, p)| p[m].power().is_finite() && p[m].power() > 0.0)
-            .map(|(r, p)| (r.log10(), p[m].power()))
-            .unzip()
-    };
-    let (x0, y0) = curve(0);
-    let (x1, y1) = curve(1);
-    let mut fig = Figure::new(
+    let xs: Vec<f64> = loads.iter().map(|r| r.log10()).collect();
+    let fig = Figure::new(
         "Default case: average power against the load",
         "log10(R / Ω)",
         "P_a [W]",
     );
-    fig.y_scale = Scale::Log;
-    lines(
-        ctx,
-        "extra_coupling_load",
-        &fig,
-        &[("one-way", &x0, &y0), ("two-way", &x1, &y1)],
-    )
+    two_curves(ctx, "extra_coupling_load", fig, &xs, sweep)
 }
 
 fn sweep_text(
