@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use super::chatter::figs_20_25;
 use super::configurations::figs_5_6;
 use super::context::{Budget, Ctx};
+use super::coupling::coupling;
 use super::dynamics::dynamics;
 use super::extras::extras;
 use super::mass_ratio::{fig_13, fig_17, figs_14_16, figs_18_19};
@@ -71,7 +72,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         failures: std::sync::Mutex::new(Vec::new()),
     };
     let started = Instant::now();
-    let steps: [(&str, Step); 12] = [
+    let steps: [(&str, Step); 13] = [
         ("Figs. 5–6: mass configurations", figs_5_6),
         ("Figs. 7–11: asymmetric spacing R_δ", figs_7_11),
         ("Fig. 12: symmetric spacing δ", fig_12),
@@ -87,6 +88,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         ),
         ("beyond the paper: loads and V_oc model", extras),
         ("beyond the paper: real vibration (record, noise)", vibration),
+        ("beyond the paper: two-way coupling", coupling),
     ];
     for (what, step) in steps {
         let t0 = Instant::now();

@@ -4,13 +4,14 @@
 //! the numbers of this run.
 //!
 //! One file per group of figures (`configurations`, `spacing`, `mass_ratio`, `chatter`,
-//! `orbits`, `dynamics`, `extras`, `vibration`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
+//! `orbits`, `dynamics`, `extras`, `vibration`, `coupling`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
 //! `report` writes REPORT.md.
 
 mod chatter;
 mod command;
 mod configurations;
 mod context;
+mod coupling;
 mod draw;
 mod dynamics;
 mod extras;
