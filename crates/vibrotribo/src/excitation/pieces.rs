@@ -122,18 +122,39 @@ impl HarmonicPieces {
         let nodes: [f64; M] = std::array::from_fn(|i| ((2 * i + 1) as f64 * PI / (2 * M) as f64).cos());
         let to_monomial = monomial_matrix(&nodes);
         let mut pieces = Vec::with_capacity(n);
-        for w in knots.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            let mid = 0.5 * (a + b);
-            let half = 0.5 * (b - a);
+        let h = end / n as f64;
+        let half = 0.5 * h;
+        // sin and cos of ω_j t + φ_j at node i of interval m, advanced from interval to
+        // interval by the rotation through ω_j h (a random signal has hundreds of harmonics
+        // and thousands of intervals), recomputed exactly every RESYNC intervals so that
+        // rounding cannot build up.
+        const RESYNC: usize = 64;
+        let rotation: Vec<(f64, f64)> = harmonics.iter().map(|hm| (hm.omega * h).sin_cos()).collect();
+        let mut phase = vec![(0.0, 0.0); harmonics.len() * M];
+        for m in 0..n {
+            let mid = (m as f64 + 0.5) * h;
+            if m % RESYNC == 0 {
+                for (j, hm) in harmonics.iter().enumerate() {
+                    for (i, z) in nodes.iter().enumerate() {
+                        phase[j * M + i] = (hm.omega * (mid + half * z) + hm.phase).sin_cos();
+                    }
+                }
+            } else {
+                for (j, &(sr, cr)) in rotation.iter().enumerate() {
+                    for p in &mut phase[j * M..(j + 1) * M] {
+                        let (s, c) = *p;
+                        *p = (s * cr + c * sr, c * cr - s * sr);
+                    }
+                }
+            }
             let mut ys = [0.0; M];
             let mut vs = [0.0; M];
-            for (i, z) in nodes.iter().enumerate() {
-                let t = mid + half * z;
-                for h in harmonics {
-                    let (s, c) = (h.omega * t + h.phase).sin_cos();
-                    ys[i] += h.amplitude * s;
-                    vs[i] += h.amplitude * h.omega * c;
+            for (j, hm) in harmonics.iter().enumerate() {
+                let (a, aw) = (hm.amplitude, hm.amplitude * hm.omega);
+                for i in 0..M {
+                    let (s, c) = phase[j * M + i];
+                    ys[i] += a * s;
+                    vs[i] += aw * c;
                 }
             }
             let mut y = [0.0; M];
