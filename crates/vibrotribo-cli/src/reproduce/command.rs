@@ -23,7 +23,7 @@ use crate::sweep::set_threads;
 /// Options of `vibrotribo reproduce`.
 #[derive(Debug, clap::Args)]
 pub struct ReproduceArgs {
-    /// Coarser grids and shorter runs (under two minutes on two cores).
+    /// Coarser grids and shorter runs (a few minutes on two cores).
     #[arg(long)]
     pub quick: bool,
     /// Output directory (REPORT.md, figures, data).
