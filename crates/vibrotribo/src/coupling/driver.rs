@@ -259,11 +259,19 @@ impl CoupledChain {
     }
 
     /// Installs on `sim` the force polynomials of the charge `q` on a window from `t0`.
+    ///
+    /// Every trial of every window starting at `t0` has the same force at `t0`: that of the
+    /// solver's charge there, `q0` (the polynomial's constant term is set to it, and the
+    /// moment-matching correction vanishes at τ = 0). The engine decides the contacts at a
+    /// window's start (stick, release, a touch) with the force there; if it differed from
+    /// trial to trial, an event at the start decided under one trial's force was undone at
+    /// the same instant by the next window's first trial (notes/coupled-stick-loop.md).
     fn install(
         &mut self,
         sim: &mut Simulator,
         t0: f64,
         q: &ChargePolynomial,
+        q0: f64,
         negligible: f64,
         matched: bool,
     ) -> Result<(), SimError> {
@@ -272,43 +280,54 @@ impl CoupledChain {
             f.coefficients.clear();
             f.coefficients.resize(super::window::FORCE_DEGREE + 1, 0.0);
         }
+        let mut at_start = vec![0.0; self.forces.len()];
         for (k, c) in self.statics.gap_force_polynomials() {
             let g = force_polynomial(q, c);
             for (j, gj) in g.iter().enumerate() {
                 self.forces[k].coefficients[j] += gj;
                 self.forces[k + 1].coefficients[j] -= gj;
             }
+            let g0 = c[0] + c[1] * q0 + c[2] * q0 * q0;
+            at_start[k] += g0;
+            at_start[k + 1] -= g0;
         }
-        for f in &mut self.forces {
+        for (f, &f0) in self.forces.iter_mut().zip(&at_start) {
+            // The force at the start is the solver's charge's (the polynomial's value there
+            // differs from it by the fit's truncation and rounding only).
+            f.coefficients[0] = f0;
             let keep = significant_degree(&f.coefficients, q.h, negligible);
             f.coefficients.truncate(keep + 1);
         }
         if matched {
-            // Add to each mass the linear force α + βτ that gives its polynomial the impulse
-            // and first moment of the force of the solver's charge (measured in the last
-            // sweep): a transient the polynomial cannot follow (the charge's boundary layer
-            // of width R·C after an impact) then reaches the masses with its integral and
-            // its first moment, which is all a window short against the mechanics' time
-            // scales passes on to the positions and velocities at its end.
+            // Add to each mass the force βτ + γτ² that gives its polynomial the impulse and
+            // first moment of the force of the solver's charge (measured in the last sweep):
+            // a transient the polynomial cannot follow (the charge's boundary layer of width
+            // R·C after an impact) then reaches the masses with its integral and its first
+            // moment, which is all a window short against the mechanics' time scales passes
+            // on to the positions and velocities at its end. It vanishes at τ = 0, so that
+            // the force at the window's start stays the solver's charge's (see above).
             let h = q.h;
             let x = self.omega_n * h;
             let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
             for (f, target) in self.forces.iter_mut().zip(&self.target) {
                 let [i0, i1] = polynomial_moments(&f.coefficients, h);
                 let (d0, d1) = (target[0] - i0, target[1] - i1);
-                let mut alpha = 4.0 * d0 / h - 6.0 * d1 / (h * h);
-                let mut beta = 12.0 * d1 / (h * h * h) - 6.0 * d0 / (h * h);
-                // The linear term's rounding, amplified as in `fit`: beyond the budget only
-                // the impulse is matched.
-                if beta.abs() * h * (1.0 / x).max(1.0) > budget {
-                    alpha = d0 / h;
-                    beta = 0.0;
+                // ∫βτ + γτ² = βh²/2 + γh³/3 = d0, ∫τ(βτ + γτ²) = βh³/3 + γh⁴/4 = d1.
+                let mut beta = 18.0 * d0 / (h * h) - 24.0 * d1 / (h * h * h);
+                let mut gamma = 36.0 * d1 / (h * h * h * h) - 24.0 * d0 / (h * h * h);
+                // The terms' rounding, amplified as in `fit`: beyond the budget only the
+                // impulse is matched.
+                let amplified =
+                    beta.abs() * h * (1.0 / x).max(1.0) + gamma.abs() * h * h * (2.0 / (x * x)).max(1.0);
+                if amplified > budget {
+                    beta = 2.0 * d0 / (h * h);
+                    gamma = 0.0;
                 }
-                if f.coefficients.len() < 2 {
-                    f.coefficients.resize(2, 0.0);
+                if f.coefficients.len() < 3 {
+                    f.coefficients.resize(3, 0.0);
                 }
-                f.coefficients[0] += alpha;
                 f.coefficients[1] += beta;
+                f.coefficients[2] += gamma;
             }
         }
         sim.set_external_forces(&self.forces)
@@ -418,7 +437,7 @@ impl CoupledChain {
             let cp = host.charge_solver().checkpoint();
             let tracked = host.charge_solver().start_moments(t0, q0);
             let mut trial = self.sim.clone();
-            self.install(&mut trial, t0, &guess, negligible, matched)?;
+            self.install(&mut trial, t0, &guess, q0, negligible, matched)?;
             self.segments.clear();
             self.events.clear();
             let times = nodes(t0, h);

@@ -29,9 +29,17 @@
 //!    or the installed force's impulse or first moment differs from the solver's by more than
 //!    their tolerances (below), the window is redone from its start (the solver is rewound,
 //!    [`ChargeSolver::checkpoint`]) with the new charge as the guess and, on each mass, a
-//!    linear force α + βτ added to the polynomial force so that its impulse and first moment
+//!    force βτ + γτ² added to the polynomial force so that its impulse and first moment
 //!    are those just measured; if the interpolant's own error estimate exceeds the charge
 //!    tolerance, the window is shortened.
+//!
+//! Every trial of a window has at its start the force of the solver's charge there (the
+//! force polynomial's constant term is set to it; the correction vanishes at τ = 0). The
+//! engine decides the contacts at the window's start (stick, release, a touch) with that
+//! force, so every trial and every window from the same instant decides alike. A correction
+//! α + βτ, as before, moved the start force by up to the layer's size and made two-way runs of
+//! the chatter case loop at a release (release under one trial's force, stick under the
+//! next's, at one instant; `notes/coupled-stick-loop.md`).
 //!
 //! The **charge tolerance** of a window of length h is the charge error whose force error,
 //! acting over the window, moves a mass by at most [`CouplingOptions::position_tolerance`]
@@ -54,7 +62,7 @@
 //! tens of µs): the polynomial through 7 nodes does not resolve it, and before the moments
 //! were matched it did not carry its integral either (the window's test looked at the nodes
 //! only), which left a systematic work error at every impact that did not shrink with the
-//! tolerance. The linear correction now carries the layer's impulse and first moment, which
+//! tolerance. The correction now carries the layer's impulse and first moment, which
 //! is what a window short against the mechanics' time scales passes on to the positions and
 //! velocities at its end; the force differs from F(Q) inside the layer (by up to ~5e-5 N on
 //! the default case), and the work that difference does beyond its first two moments is of
@@ -62,9 +70,12 @@
 //!
 //! Measured on the paper's default case (exact V_oc, 100 kΩ, electrical rtol 1e-10, 20
 //! periods; `tests/coupling_checks.rs`): the energy identity W_base = ΔE + D + L + E_load + ΔU
-//! closes to 8.6e-10 J at the default tolerance, 7.8e-12 of W = 111 J and 3.4e-7 of the
+//! closes to −7.5e-10 J at the default tolerance, 6.8e-12 of W = 111 J and 2.9e-7 of the
 //! electrical terms E_load + |ΔU| = 2.6 mJ, and the residual shrinks with the tolerance:
-//! −5.5e-8, 8.6e-10, −1.6e-10, 2.9e-11 J at 1e-10, 1e-11, 1e-12, 1e-13 m.
+//! −9.2e-8, −7.5e-10, 8.7e-11, −1.4e-11 J at 1e-10, 1e-11, 1e-12, 1e-13 m (with the
+//! correction α + βτ it was −5.5e-8, 8.6e-10, −1.6e-10, 2.9e-11 J). On the chatter case in
+//! its sticking regime (Ω = 0.4, 5 periods) it closes to 7.3e-11 of W, 9.0e-8 of the
+//! electrical terms.
 //!
 //! In open and short circuit no moments are measured (the charge is constant, or the
 //! equilibrium charge exactly, with no boundary layer) and only the node tests apply. With a
