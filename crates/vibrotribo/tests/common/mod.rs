@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod fd;
+pub mod quadrature;
 
 use ode_solvers::{DVector, Dop853, OutputType, System};
 use vibrotribo::{ChainParams, ChainState, Excitation, Frequency};
