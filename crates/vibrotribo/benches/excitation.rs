@@ -14,7 +14,8 @@
 //!   samples/s, scaled to the sine's peak acceleration A ω² = 98 m/s²) beside the sine over the
 //!   same 160 periods: the "cost per simulated second" of a recorded input (a different
 //!   motion, with fewer impacts: both the knots and the events count), and band-limited
-//!   noise of the sine's RMS acceleration (4–24 Hz: its harmonics as degree-7 pieces).
+//!   noise of the sine's RMS acceleration (4–24 Hz: its harmonics as degree-7 pieces, built
+//!   when the configuration is read, so not timed here).
 //!
 //! `cargo bench -p vibrotribo --bench excitation`
 

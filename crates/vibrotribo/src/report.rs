@@ -145,21 +145,6 @@ pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String
         "kind".to_string(),
         config.excitation().kind().as_str().to_string(),
     )];
-    let end = (spec.periods as f64 * spec.chain.period()).max(spec.chain.period());
-    let mut pieces = |harmonics: &[crate::excitation::Harmonic], end: f64, tolerance: f64| {
-        if let Ok(a) = crate::excitation::piece_accuracy(harmonics, end, tolerance) {
-            out.push(("piece_degree".into(), crate::excitation::PIECE_DEGREE.to_string()));
-            out.push(("piece_intervals".into(), a.intervals.to_string()));
-            out.push((
-                "piece_displacement_error_bound_m".into(),
-                format!("{:e}", a.displacement_bound),
-            ));
-            out.push((
-                "piece_velocity_error_bound_m_s".into(),
-                format!("{:e}", a.velocity_bound),
-            ));
-        }
-    };
     let on_pieces = "exact per-interval forces k_i y + c_i y' of degree-7 Chebyshev interpolants of the \
                      harmonics' displacement and velocity (a closed-form multisine in the engine is a later step)";
     let run_as = match &**b {
@@ -167,14 +152,14 @@ pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String
             "the harmonic excitation A sin ωt (closed form)".to_string()
         }
         BaseMotion::Harmonics(h) => {
-            pieces(h, end, crate::study::multisine_tolerance(h));
+            // The pieces of a multisine are built for the run's length (BaseDrive).
+            let end = (spec.periods as f64 * spec.chain.period()).max(spec.chain.period());
+            if let Ok(a) = crate::excitation::piece_accuracy(h, end, crate::study::multisine_tolerance(h)) {
+                out.extend(crate::excitation::pieces_summary(&a));
+            }
             on_pieces.to_string()
         }
-        BaseMotion::Spline(s) if !s.harmonics.is_empty() && s.accuracy.is_some() => {
-            let a = s.accuracy.expect("checked");
-            pieces(&s.harmonics, s.displacement.end(), a.error_bounds[0]);
-            on_pieces.to_string()
-        }
+        BaseMotion::Pieces(_) => on_pieces.to_string(),
         BaseMotion::Spline(_) => "exact per-interval cubic forces k_i y + c_i y' of the spline".to_string(),
     };
     out.push(("run_as".into(), run_as));

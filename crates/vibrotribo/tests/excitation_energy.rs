@@ -649,8 +649,10 @@ fn own_drive(spec: &RunSpec, spline: &PiecewiseCubic, tamper: Tamper, obs: &mut 
     }
 }
 
-/// The default chain under the random input of [`energy_balance_default_chain_random`],
-/// driven here: faithfully, the balance closes as through `study::simulate`; with the base
+/// The default chain under the random input of [`energy_balance_default_chain_random`] as
+/// its clamped cubic spline (`RandomSpec::to_spline`; the run layer drives random signals on
+/// piecewise polynomials, records on such splines), driven here interval by interval with
+/// the spline's forces: faithfully, the balance closes; with the base
 /// force of the one interval at t = 5 s (0.17 ms of a 10.8 s run) left out, it misses by
 /// far more than the tolerance. A force update missed at one knot (the previous interval's
 /// cubic held over the next) changes the force by about y⁗ h⁴ ≈ 1e-11 of it, below the
@@ -659,11 +661,15 @@ fn own_drive(spec: &RunSpec, spline: &PiecewiseCubic, tamper: Tamper, obs: &mut 
 fn a_wrong_force_on_one_spline_interval_breaks_the_balance() {
     let config = Config::from_toml_str(DEFAULT_RANDOM).unwrap();
     let spec = config.run_spec(true);
-    let motion = config.base_motion().unwrap();
-    let vibrotribo::excitation::BaseMotion::Spline(s) = &motion else {
-        panic!("{motion:?}")
+    let vibrotribo::excitation::ExcitationSpec::Random {
+        spec: random,
+        relative_tolerance,
+    } = config.excitation()
+    else {
+        panic!("{:?}", config.excitation())
     };
-    let spline = &s.displacement;
+    let (spline, _, _) = random.to_spline(*relative_tolerance).unwrap();
+    let spline = &spline;
     let j = spline.interval(5.0);
     let mut residuals = Vec::new();
     for tamper in [Tamper::Faithful, Tamper::Dropped(j), Tamper::Held(j)] {

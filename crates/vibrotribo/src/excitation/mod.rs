@@ -151,18 +151,15 @@ impl ExcitationSpec {
                     displacement,
                     accuracy: Some(accuracy),
                     record: None,
-                    harmonics: Vec::new(),
                 })
             }
             ExcitationSpec::Random {
                 spec,
                 relative_tolerance,
             } => {
-                let (displacement, accuracy, harmonics) = spec.to_spline(*relative_tolerance)?;
-                BaseMotion::Spline(SplineMotion {
-                    displacement,
-                    accuracy: Some(accuracy),
-                    record: None,
+                let (pieces, harmonics) = spec.to_pieces(*relative_tolerance)?;
+                BaseMotion::Pieces(PiecesMotion {
+                    pieces: Arc::new(pieces),
                     harmonics,
                 })
             }
@@ -172,7 +169,6 @@ impl ExcitationSpec {
                     displacement,
                     accuracy: None,
                     record: Some(report),
-                    harmonics: Vec::new(),
                 })
             }
         })
@@ -184,14 +180,38 @@ impl ExcitationSpec {
 pub struct SplineMotion {
     /// The displacement, m (defined on `[0, displacement.end()]`).
     pub displacement: PiecewiseCubic,
-    /// For a signal sampled from a formula (chirp, random): the spline's error bounds
-    /// against it.
+    /// For a signal sampled from a formula (a chirp): the spline's error bounds against it.
     pub accuracy: Option<SplineAccuracy>,
     /// For a record: its scaling and baseline correction.
     pub record: Option<RecordReport>,
-    /// For a random signal: the exact displacement the spline approximates, as harmonics
-    /// (empty otherwise).
+}
+
+/// A sum of harmonics over a finite duration (a random signal) as the piecewise polynomials
+/// the engine is driven by.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PiecesMotion {
+    /// The displacement and velocity pieces, on `[0, pieces.end()]` (shared: runs and
+    /// configurations are cloned often).
+    pub pieces: Arc<HarmonicPieces>,
+    /// The exact displacement they interpolate, as harmonics.
     pub harmonics: Vec<Harmonic>,
+}
+
+/// The lines stating what piecewise polynomials achieve: `piece_degree`, `piece_intervals`,
+/// `piece_displacement_error_bound_m`, `piece_velocity_error_bound_m_s`.
+pub fn pieces_summary(a: &PieceAccuracy) -> Vec<(String, String)> {
+    vec![
+        ("piece_degree".into(), PIECE_DEGREE.to_string()),
+        ("piece_intervals".into(), a.intervals.to_string()),
+        (
+            "piece_displacement_error_bound_m".into(),
+            format!("{:e}", a.displacement_bound),
+        ),
+        (
+            "piece_velocity_error_bound_m_s".into(),
+            format!("{:e}", a.velocity_bound),
+        ),
+    ]
 }
 
 /// A base motion the exact engine can integrate in closed form.
@@ -199,8 +219,10 @@ pub struct SplineMotion {
 pub enum BaseMotion {
     /// A sum of harmonics, for all t.
     Harmonics(Vec<Harmonic>),
-    /// A C² piecewise cubic displacement, on `[0, end]`.
+    /// A C² piecewise cubic displacement, on `[0, end]` (chirps, records).
     Spline(SplineMotion),
+    /// A sum of harmonics on `[0, end]` as piecewise polynomials (random signals).
+    Pieces(PiecesMotion),
 }
 
 impl BaseMotion {
@@ -209,6 +231,8 @@ impl BaseMotion {
         match self {
             BaseMotion::Harmonics(h) => evaluate_sum(h, t),
             BaseMotion::Spline(s) => s.displacement.evaluate(t),
+            // The exact sum; the pieces are within their stated bounds of it.
+            BaseMotion::Pieces(p) => evaluate_sum(&p.harmonics, t),
         }
     }
 
@@ -217,6 +241,7 @@ impl BaseMotion {
         match self {
             BaseMotion::Harmonics(_) => None,
             BaseMotion::Spline(s) => Some(s.displacement.end()),
+            BaseMotion::Pieces(p) => Some(p.pieces.end()),
         }
     }
 
@@ -227,6 +252,11 @@ impl BaseMotion {
         let mut out = Vec::new();
         match self {
             BaseMotion::Harmonics(h) => out.push(("harmonics".into(), h.len().to_string())),
+            BaseMotion::Pieces(p) => {
+                out.push(("harmonics".into(), p.harmonics.len().to_string()));
+                out.push(("duration_s".into(), format!("{:e}", p.pieces.end())));
+                out.extend(pieces_summary(&p.pieces.accuracy()));
+            }
             BaseMotion::Spline(s) => {
                 out.push(("spline_intervals".into(), s.displacement.intervals().to_string()));
                 out.push(("duration_s".into(), format!("{:e}", s.displacement.end())));

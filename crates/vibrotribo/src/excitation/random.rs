@@ -11,6 +11,7 @@ use super::error::SignalError;
 use super::harmonics::{
     Harmonic, MAX_KNOTS, SplineAccuracy, evaluate_sum, fourth_derivative_bound, intervals_for,
 };
+use super::pieces::HarmonicPieces;
 use super::spline::{EndCondition, PiecewiseCubic};
 use crate::random::SplitMix64;
 
@@ -260,6 +261,23 @@ impl RandomSpec {
     /// parameters without building).
     pub fn intervals_needed(&self, relative_tolerance: f64) -> Result<usize, SignalError> {
         self.plan(relative_tolerance).map(|(_, n, _)| n)
+    }
+
+    /// The displacement as degree-7 piecewise polynomials over `[0, D]` within
+    /// `relative_tolerance` times the RMS displacement ([`HarmonicPieces`], what the engine
+    /// is driven by), and the displacement harmonics they interpolate.
+    pub fn to_pieces(&self, relative_tolerance: f64) -> Result<(HarmonicPieces, Vec<Harmonic>), SignalError> {
+        if !(relative_tolerance.is_finite() && relative_tolerance > 0.0) {
+            return Err(SignalError::Invalid(format!(
+                "spline_tolerance = {relative_tolerance}: must be finite and > 0"
+            )));
+        }
+        let harmonics = self.displacement_harmonics()?;
+        let rms = (harmonics.iter().map(|h| h.amplitude * h.amplitude).sum::<f64>() / 2.0).sqrt();
+        // A zero signal needs one interval, whatever the tolerance.
+        let tolerance = (relative_tolerance * rms).max(f64::MIN_POSITIVE);
+        let pieces = HarmonicPieces::new(&harmonics, self.duration, tolerance)?;
+        Ok((pieces, harmonics))
     }
 
     /// The clamped cubic spline of the displacement over `[0, D]` on equal knots, close

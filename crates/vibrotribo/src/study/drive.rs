@@ -15,7 +15,8 @@
 //! displacement and of the velocity, with stated remainder bounds): about 8 intervals per
 //! cycle of the fastest harmonic where a cubic spline within the same error needs ~1500, and
 //! every interval end restarts the event search. A multisine's displacement error is at most
-//! [`multisine_tolerance`]; a random signal's is the bound its spline was built to.
+//! [`multisine_tolerance`]; a random signal's is `spline_tolerance` times its RMS displacement, built
+//! once with the configuration ([`BaseMotion::Pieces`]); a multisine's are built per run.
 // TODO(issue 14): a closed-form multisine in the engine (one particular solution per
 // harmonic, no intervals at all) would remove the remaining interpolation error.
 
@@ -76,63 +77,74 @@ pub struct BaseDrive {
     spline: Option<Spline>,
 }
 
-/// A base displacement given as a piecewise cubic, shared (cheap to clone): the one of a
-/// [`BaseMotion::Spline`], or the spline a multisine was sampled into.
+/// A base displacement the drive runs on, shared (cheap to clone): the cubic of a
+/// [`BaseMotion::Spline`] (chirps, records), or piecewise polynomials of a sum of harmonics
+/// (a random signal's, or those a multisine is interpolated into for the run).
 #[derive(Debug, Clone)]
 pub struct BaseDisplacement(Source);
 
 #[derive(Debug, Clone)]
 enum Source {
-    /// A [`BaseMotion::Spline`] (never [`BaseMotion::Harmonics`]) run on its cubic.
-    Given(Arc<BaseMotion>),
+    /// A [`BaseMotion::Spline`] (no other variant), run on its cubic.
+    Cubic(Arc<BaseMotion>),
     /// A sum of harmonics as piecewise polynomials.
     Pieces(Arc<HarmonicPieces>),
 }
 
+/// What a [`BaseDisplacement`] runs on, borrowed.
+enum Piecewise<'a> {
+    Cubic(&'a PiecewiseCubic),
+    Pieces(&'a HarmonicPieces),
+}
+
 impl BaseDisplacement {
+    fn view(&self) -> Piecewise<'_> {
+        match &self.0 {
+            Source::Cubic(b) => match &**b {
+                BaseMotion::Spline(s) => Piecewise::Cubic(&s.displacement),
+                _ => unreachable!("Source::Cubic holds a spline"),
+            },
+            Source::Pieces(p) => Piecewise::Pieces(p),
+        }
+    }
+
     /// The piecewise cubic, m, when the drive runs on one.
     pub fn cubic(&self) -> Option<&PiecewiseCubic> {
-        match &self.0 {
-            Source::Given(b) => match &**b {
-                BaseMotion::Spline(s) => Some(&s.displacement),
-                BaseMotion::Harmonics(_) => None,
-            },
-            Source::Pieces(_) => None,
+        match self.view() {
+            Piecewise::Cubic(c) => Some(c),
+            Piecewise::Pieces(_) => None,
         }
     }
 
     /// The piecewise polynomials, when the drive runs on them.
     pub fn pieces(&self) -> Option<&HarmonicPieces> {
-        match &self.0 {
-            Source::Pieces(p) => Some(p),
-            Source::Given(_) => None,
+        match self.view() {
+            Piecewise::Pieces(p) => Some(p),
+            Piecewise::Cubic(_) => None,
         }
     }
 
     /// The base displacement at `t` (s), m.
     pub fn displacement(&self, t: f64) -> f64 {
-        match (self.cubic(), self.pieces()) {
-            (Some(c), _) => c.displacement(t),
-            (_, Some(p)) => p.evaluate(t)[0],
-            _ => unreachable!("a drive runs on a cubic or on pieces"),
+        match self.view() {
+            Piecewise::Cubic(c) => c.displacement(t),
+            Piecewise::Pieces(p) => p.evaluate(t)[0],
         }
     }
 
     /// The interval ends, s.
     fn knots(&self) -> &[f64] {
-        match (self.cubic(), self.pieces()) {
-            (Some(c), _) => c.knots(),
-            (_, Some(p)) => p.knots(),
-            _ => unreachable!("a drive runs on a cubic or on pieces"),
+        match self.view() {
+            Piecewise::Cubic(c) => c.knots(),
+            Piecewise::Pieces(p) => p.knots(),
         }
     }
 
     /// The interval holding `t` (s).
     fn interval(&self, t: f64) -> usize {
-        match (self.cubic(), self.pieces()) {
-            (Some(c), _) => c.interval(t),
-            (_, Some(p)) => p.interval(t),
-            _ => unreachable!("a drive runs on a cubic or on pieces"),
+        match self.view() {
+            Piecewise::Cubic(c) => c.interval(t),
+            Piecewise::Pieces(p) => p.interval(t),
         }
     }
 }
@@ -147,7 +159,7 @@ pub fn driven_chain(spec: &RunSpec) -> Cow<'_, ChainParams> {
     let mut chain = spec.chain.clone();
     chain.excitation.amplitude = match &**base {
         BaseMotion::Harmonics(h) => as_chain_harmonic(h, &spec.chain).unwrap_or(0.0),
-        BaseMotion::Spline(_) => 0.0,
+        BaseMotion::Spline(_) | BaseMotion::Pieces(_) => 0.0,
     };
     Cow::Owned(chain)
 }
@@ -184,23 +196,15 @@ impl BaseDrive {
                     .map_err(|e| fail(format!("multisine: {e}")))?;
                 Source::Pieces(Arc::new(p))
             }
-            BaseMotion::Spline(SplineMotion {
-                displacement,
-                accuracy: Some(accuracy),
-                harmonics,
-                ..
-            }) if !harmonics.is_empty() => {
-                // A random signal: its harmonics, to the bound its spline was built to.
-                let p = HarmonicPieces::new(harmonics, displacement.end(), accuracy.error_bounds[0])
-                    .map_err(|e| fail(format!("random signal: {e}")))?;
-                if end > p.end() * (1.0 + 1e-12) {
+            BaseMotion::Pieces(p) => {
+                if end > p.pieces.end() * (1.0 + 1e-12) {
                     return Err(fail(format!(
                         "the base motion ends at t = {} s, before the run's end at {} s",
-                        p.end(),
+                        p.pieces.end(),
                         end
                     )));
                 }
-                Source::Pieces(Arc::new(p))
+                Source::Pieces(p.pieces.clone())
             }
             BaseMotion::Spline(SplineMotion { displacement, .. }) => {
                 // A relative slack of 1e-12 for the rounding of periods·T.
@@ -213,7 +217,7 @@ impl BaseDrive {
                         spec.chain.period()
                     )));
                 }
-                Source::Given(base.clone())
+                Source::Cubic(base.clone())
             }
         };
         let n = chain.len();
