@@ -59,7 +59,7 @@ impl Forcing {
     /// phase accuracy.
     #[inline]
     pub fn phase(&self, t: f64) -> Phase {
-        let reduced = t.rem_euclid(self.period);
+        let reduced = reduce_period(t, self.period);
         let (sin, cos) = (self.omega * reduced).sin_cos();
         Phase { cos, sin }
     }
@@ -68,6 +68,34 @@ impl Forcing {
     #[inline]
     pub fn base(&self, ph: Phase) -> (f64, f64) {
         (self.amplitude * ph.sin, self.amplitude * self.omega * ph.cos)
+    }
+}
+
+/// `t.rem_euclid(period)`, bit for bit, without the software `fmod` behind `rem_euclid`
+/// (a loop over the quotient's bits, ~8 % of a run's instructions when it was used here).
+///
+/// For t ≥ 0 the remainder `t − n·period` with `n = ⌊t/period⌋` is exactly representable (as
+/// `fmod`'s result always is), so one fused multiply-add with the right `n` returns it exactly.
+/// `t/period` may round `n` one off; the remainder then leaves `[0, period)` and `n` is
+/// corrected. Negative times (rare: none in a forward run) take `rem_euclid` itself.
+#[inline]
+pub(crate) fn reduce_period(t: f64, period: f64) -> f64 {
+    if !(t > 0.0 && t < 9.0e15 * period && period > 0.0 && period.is_finite()) {
+        return t.rem_euclid(period);
+    }
+    let mut n = (t / period).floor();
+    let mut r = (-n).mul_add(period, t);
+    if r < 0.0 || r.is_sign_negative() {
+        n -= 1.0;
+        r = (-n).mul_add(period, t);
+    } else if r >= period {
+        n += 1.0;
+        r = (-n).mul_add(period, t);
+    }
+    if r >= 0.0 && !r.is_sign_negative() && r < period {
+        r
+    } else {
+        t.rem_euclid(period)
     }
 }
 
@@ -503,6 +531,67 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
 
 #[cfg(test)]
 mod tests {
+    /// `reduce_period` is `rem_euclid` bit for bit, over times from 1e-12 s to 1e7 s, at and
+    /// next to multiples of the period, and for the periods of the paper's cases and others.
+    #[test]
+    fn reduce_period_is_rem_euclid() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let periods = [
+            0.6283185307179586,
+            2.0 * std::f64::consts::PI / 70.0,
+            0.1,
+            1.0,
+            3.0,
+            1e-3,
+            7.3e-2,
+        ];
+        for &period in &periods {
+            let check = |t: f64| {
+                let (a, b) = (super::reduce_period(t, period), t.rem_euclid(period));
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "t = {t:e}, period = {period:e}: {a:e} vs {b:e}"
+                );
+            };
+            for _ in 0..20_000 {
+                let t = 10f64.powf(-12.0 + 19.0 * next());
+                check(t);
+                let k = (1e6 * next()).floor();
+                for m in [
+                    k * period,
+                    (k * period).next_up(),
+                    (k * period).next_down(),
+                    (k + 0.5) * period,
+                ] {
+                    check(m);
+                }
+            }
+            for t in [
+                0.0,
+                -0.0,
+                -1e-20,
+                -3.0 * period,
+                f64::MIN_POSITIVE,
+                1e300,
+                f64::INFINITY,
+                f64::NAN,
+            ] {
+                let (a, b) = (super::reduce_period(t, period), t.rem_euclid(period));
+                assert!(
+                    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                    "t = {t:e}"
+                );
+            }
+        }
+    }
+
     use super::*;
 
     /// Near an undamped resonance the forced part is ~1e4 times the motion; the flow must

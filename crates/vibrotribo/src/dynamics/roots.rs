@@ -248,10 +248,21 @@ pub(crate) fn first_positive_root(c: &[f64]) -> f64 {
 
 /// A point beyond `lo` where the polynomial is negative, if the leading coefficient is
 /// negative: beyond every root, by Fujiwara's bound.
+///
+/// The root of the local quadratic model at `lo`, or twice as far, is tried first: where the
+/// polynomial is already ≤ 0 there, it is a much tighter bracket than the bound (and costs no
+/// cube or fourth roots).
 fn upper_bracket(c: &[f64], lo: f64) -> Option<f64> {
     let lead = c[c.len() - 1];
     if lead > 0.0 {
         return None;
+    }
+    if let Some(h) = quadratic_model_step(c, lo, false) {
+        for x in [lo + h, lo + 2.0 * h] {
+            if x > lo && x.is_finite() && horner(c, x) <= 0.0 {
+                return Some(x);
+            }
+        }
     }
     Some(root_bound(c).max(lo) * (1.0 + 1e-12) + f64::MIN_POSITIVE)
 }
@@ -351,12 +362,21 @@ fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
 /// `rtol`. With `safe_left` the result lies on the side of `lo` (never beyond the root).
 fn bracket_root(c: &[f64], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64) -> f64 {
     let before_negative = horner(c, lo) < 0.0;
-    // Start Newton at the end where f·f'' > 0 (Fourier's condition): from there it approaches
-    // the root monotonically when the convexity is constant over the bracket.
-    let mut x = if horner(c, hi) * second_derivative(c, hi) > 0.0 {
-        hi
-    } else {
-        lo
+    // Start Newton at the root of the local quadratic model at `lo` when it falls inside the
+    // bracket (within a step or two of the root when the bracket is wide, as the Fujiwara
+    // bound or a far critical point make it); otherwise at the end where f·f'' > 0
+    // (Fourier's condition), from where it approaches the root monotonically when the
+    // convexity is constant over the bracket. Either start is only a start: the bracket
+    // update below keeps every iterate safe.
+    let mut x = match quadratic_model_step(c, lo, before_negative) {
+        Some(h) if lo + h > lo && lo + h < hi => lo + h,
+        _ => {
+            if horner(c, hi) * second_derivative(c, hi) > 0.0 {
+                hi
+            } else {
+                lo
+            }
+        }
     };
     for _ in 0..100 {
         let (fx, d) = horner_with_derivative(c, x);
@@ -386,11 +406,31 @@ fn bracket_root(c: &[f64], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64)
                 hi = hi.min(xn * (1.0 + rtol));
             }
             x = xn;
+        } else if xn >= hi {
+            // Newton points at or past `hi`: the root is within rounding of `hi` (as when
+            // `hi` came from the quadratic model itself). Probe just inside it, which closes
+            // the bracket at once if the root is there, instead of halving towards it.
+            x = (hi - 0.5 * rtol * hi.abs()).max(0.5 * (lo + hi));
         } else {
             x = 0.5 * (lo + hi);
         }
     }
     if safe_left { lo } else { 0.5 * (lo + hi) }
+}
+
+/// The smallest positive root of the quadratic Taylor model of `c` at `x`,
+/// `p(x) + p'(x)h + p''(x)h²/2` (sign-flipped first when `p(x) < 0`), if it has one.
+fn quadratic_model_step(c: &[f64], x: f64, negative: bool) -> Option<f64> {
+    // p, p' and p''/2 in one Horner pass (the first three coefficients of the Taylor shift).
+    let n = c.len();
+    let (mut p, mut d1, mut half_d2) = (c[n - 1], 0.0, 0.0);
+    for &ci in c[..n - 1].iter().rev() {
+        half_d2 = half_d2 * x + d1;
+        d1 = d1 * x + p;
+        p = p * x + ci;
+    }
+    let s = if negative { -1.0 } else { 1.0 };
+    smallest_positive_quadratic_root(s * p, s * d1, s * half_d2)
 }
 
 /// p(x) and p'(x) in one Horner pass.
@@ -463,6 +503,61 @@ mod tests {
             lo
         };
         assert_safe(&c, root);
+        // Lower bounds met in runs, whose first root is the root of their own quadratic
+        // model to rounding (the bracket's upper end then sits on the root) or lies far inside
+        // a wide bracket: the start and the probe next to `hi` must keep the result safe.
+        for c in [
+            vec![
+                1.4296857498704243e-11,
+                -10.922003136656379,
+                -109.57272620912545,
+                2528.9671589936142,
+                -92896.1214815175,
+            ],
+            vec![
+                7.618231593816644e-14,
+                -7.181090492056494,
+                -166.61381225926002,
+                -11690.44411256956,
+            ],
+            vec![
+                6.542984662268214e-16,
+                -0.4955155012900079,
+                -92.5002433026169,
+                1276.7608389218974,
+                -98244.60760505123,
+            ],
+            vec![
+                0.019999999999996135,
+                0.0,
+                0.34999999999999964,
+                -8020.8695977128555,
+            ],
+            vec![
+                0.2296848864777573,
+                4.804838894790922,
+                -95.59959295323004,
+                -9681.820468984655,
+            ],
+            vec![
+                8.336933049292047e-14,
+                4.30865429523223,
+                -168.5971610618289,
+                -787.9690676214647,
+                -109922.81717606784,
+            ],
+        ] {
+            let hi = (1..60)
+                .map(|k| 1e-17 * 2f64.powi(k))
+                .find(|&h| horner(&c, h) <= 0.0)
+                .unwrap();
+            let (mut lo, mut hi) = (0.0f64, hi);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if horner(&c, mid) > 0.0 { lo = mid } else { hi = mid }
+            }
+            assert_safe(&c, lo);
+        }
     }
 
     #[test]
