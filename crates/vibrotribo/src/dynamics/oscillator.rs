@@ -173,10 +173,24 @@ struct Homogeneous {
 impl Oscillator {
     /// The flow through state (`s0`, `v0`) at time `t0`.
     #[inline]
+    #[cfg(test)]
     pub(crate) fn new(
         k: OscConstants,
         forcing: &Forcing,
         t0: f64,
+        s0: f64,
+        v0: f64,
+    ) -> Result<Self, SimError> {
+        Self::new_at_phase(k, forcing, t0, forcing.phase(t0), s0, v0)
+    }
+
+    /// [`new`](Self::new) with the forcing phase of `t0` already at hand (`ph` must be
+    /// `forcing.phase(t0)`).
+    pub(crate) fn new_at_phase(
+        k: OscConstants,
+        forcing: &Forcing,
+        t0: f64,
+        ph: Phase,
         s0: f64,
         v0: f64,
     ) -> Result<Self, SimError> {
@@ -235,7 +249,6 @@ impl Oscillator {
                 fpoly.particular(m, c, kk)
             },
         };
-        let ph = forcing.phase(t0);
         let (sp, vp) = osc.forced(t0, ph);
         (osc.h0, osc.e0) = two_sum(s0, -sp);
         (osc.h1, osc.e1) = two_sum(v0, -vp);
@@ -329,6 +342,12 @@ impl Oscillator {
     /// `e^{−ατ}c(τ)` and `e^{−ατ}s(τ)` of the module docs.
     #[inline]
     fn propagator(&self, tau: f64) -> (f64, f64) {
+        if tau == 0.0 {
+            // Every regime's exact value at τ = 0 (what the formulas below round to there),
+            // without an exponential and a sine-cosine: every search begins at the start of
+            // its flow.
+            return (1.0, 0.0);
+        }
         let a = self.alpha;
         match self.regime {
             Regime::Under { wd } => {

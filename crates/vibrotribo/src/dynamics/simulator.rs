@@ -16,7 +16,7 @@ use std::ops::ControlFlow;
 use super::contact::Closure;
 use super::forces::ExternalForces;
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
-use super::oscillator::{Forcing, OscConstants, Oscillator};
+use super::oscillator::{Forcing, OscConstants, Oscillator, Phase};
 use super::roots::{Found, Stall, first_root};
 use crate::error::{ParamError, SimError};
 use crate::model::{ChainParams, ChainState, ForcePolynomial, SimOptions};
@@ -96,6 +96,9 @@ pub struct Simulator {
     /// G_i = Σ_{j<i} δ_j: position offset of mass i inside a cluster, relative to its top.
     pub(super) offsets: Vec<f64>,
     pub(super) t: f64,
+    /// The forcing phase at `t` (computed once per time, shared by every search and event
+    /// handler that starts there).
+    pub(super) phase_now: Phase,
     period_index: u64,
     events_in_period: usize,
     pub(super) clusters: Vec<ClusterFlow>,
@@ -169,6 +172,7 @@ impl Simulator {
             options,
             offsets,
             t: t0,
+            phase_now: Forcing::new(params.excitation.amplitude, params.omega()).phase(t0),
             period_index: (t0 / params.period()).floor() as u64,
             events_in_period: 0,
             clusters: Vec::with_capacity(n),
@@ -389,6 +393,7 @@ impl Simulator {
     /// Moves the clock to `t` and evaluates every mass there (no event applied).
     fn advance_state(&mut self, t: f64) {
         let ph = self.forcing.phase(t);
+        self.phase_now = ph;
         for c in &self.clusters {
             let (s, v) = c.oscillator.state(t, ph);
             let base = self.offsets[c.first];
@@ -456,7 +461,7 @@ impl Simulator {
                 self.x[j] = s + (self.offsets[j] - base);
                 self.v[j] = vs;
             }
-            let osc = Oscillator::new(
+            let osc = Oscillator::new_at_phase(
                 OscConstants {
                     mass: k.mass,
                     damping: k.damping,
@@ -466,6 +471,7 @@ impl Simulator {
                 },
                 &self.forcing,
                 self.t,
+                self.phase_now,
                 s,
                 vs,
             )
@@ -485,6 +491,16 @@ impl Simulator {
         }
         self.refresh_tolerances();
         Ok(())
+    }
+
+    /// The forcing phase at `t`: the stored one at the current time, else computed.
+    #[inline]
+    pub(in crate::dynamics) fn phase_at(&self, t: f64) -> Phase {
+        if t == self.t {
+            self.phase_now
+        } else {
+            self.forcing.phase(t)
+        }
     }
 
     /// Index of the cluster containing mass `i`.
@@ -518,7 +534,7 @@ impl Simulator {
                 }
                 _ => (self.force_signal(k), self.t),
             };
-            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w, horizon);
+            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon);
             match first_root(eval, start, horizon) {
                 Ok(Found::Root(te)) if te < horizon => {
                     horizon = te.max(self.t);
@@ -551,7 +567,7 @@ impl Simulator {
         let mut best = None;
         let mut horizon = horizon;
         for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
-            let eval = |t: f64| sig.jet(t, self.forcing.phase(t), &self.clusters, w, horizon);
+            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon);
             match first_root(eval, self.t, horizon) {
                 Ok(Found::Root(te)) if te < horizon => {
                     horizon = te.max(self.t);

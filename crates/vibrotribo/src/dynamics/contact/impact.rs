@@ -109,7 +109,7 @@ impl Simulator {
     /// Free acceleration, m/s², and its rate, m/s³, of the cluster occupying `range` (its
     /// members share velocity; x of its top mass is the cluster coordinate).
     fn cluster_accel(&self, (first, last): (usize, usize)) -> (f64, f64) {
-        let ph = self.forcing.phase(self.t);
+        let ph = self.phase_now;
         let (y, yd) = self.forcing.base(ph);
         let ydd = -self.forcing.omega * self.forcing.omega * y;
         let base = self.offsets[first];

@@ -18,7 +18,7 @@ impl Simulator {
     /// resting contact and adjusts no velocity.
     pub(in crate::dynamics) fn settle(&mut self, exclude: Option<usize>, quiet: bool) -> Vec<usize> {
         let ncont = self.closure.len();
-        let (y, yd) = self.forcing.base(self.forcing.phase(self.t));
+        let (y, yd) = self.forcing.base(self.phase_now);
         let mut any = false;
         for k in 0..ncont {
             let cand = if Some(k) == exclude {

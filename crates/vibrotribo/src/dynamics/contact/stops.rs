@@ -58,7 +58,7 @@ impl Simulator {
     /// `Y, Y', Y'', Y'''` of the stop on `side` at the current time.
     pub(in crate::dynamics) fn wall(&self, side: StopSide) -> [f64; 4] {
         let frame = self.params.stops.get(side).map_or(StopFrame::Fixed, |s| s.frame);
-        let (y, yd) = self.forcing.base(self.forcing.phase(self.t));
+        let (y, yd) = self.forcing.base(self.phase_now);
         ChainParams::frame_motion(frame, y, yd, self.forcing.omega)
     }
 
