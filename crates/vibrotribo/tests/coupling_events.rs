@@ -28,18 +28,16 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::electrostatics::{
-    VACUUM_PERMITTIVITY, electrostatic_forces, equilibrium_charge, gap_forces, terminal_voltage,
-};
+use common::electrostatics::{electrostatic_forces, equilibrium_charge, gap_forces, terminal_voltage};
 use common::{grazing_pair, integrate};
 use ode_solvers::{DVector, System};
-use vibrotribo::coupling::{ChargeHost, CoupledChain, CouplingOptions};
+use vibrotribo::coupling::{ChargeHost, CoupledChain, CouplingOptions, CouplingStats};
 use vibrotribo::electrical::{
     ChargeOptions, ChargeSolver, HarvesterParams, Load, Rectifier, TransducerMode, VocModel,
 };
 use vibrotribo::{
-    ChainParams, ChainState, Event, EventKind, EventLog, Excitation, Flow, Frequency, Observer, SimOptions,
-    Simulator, StateView, Trajectory,
+    ChainParams, ChainState, Event, EventKind, EventLog, Flow, Frequency, Observer, SimOptions, Simulator,
+    StateView, Trajectory,
 };
 
 /// The coupling's displacement tolerance used here, m (the default).
@@ -60,6 +58,8 @@ struct Recorder {
     worst_momentum: f64,
     /// Worst kinetic-energy gain at an event, relative to Σ m v².
     worst_energy: f64,
+    /// The coupled run's work counters.
+    stats: CouplingStats,
 }
 
 impl Recorder {
@@ -74,6 +74,7 @@ impl Recorder {
             v_before: vec![0.0; n],
             worst_momentum: 0.0,
             worst_energy: f64::NEG_INFINITY,
+            stats: CouplingStats::default(),
         }
     }
 
@@ -81,7 +82,10 @@ impl Recorder {
     fn charge_at(&self, t: f64) -> f64 {
         let i = self.charges.partition_point(|c| c.0 < t);
         let (tc, q) = self.charges[i.min(self.charges.len() - 1)];
-        assert!((tc - t).abs() <= 1e-12 * t.max(1.0), "no window ends at {t} (nearest {tc})");
+        assert!(
+            (tc - t).abs() <= 1e-12 * t.max(1.0),
+            "no window ends at {t} (nearest {tc})"
+        );
         q
     }
 }
@@ -160,6 +164,7 @@ fn coupled_run(chain: &ChainParams, initial: &ChainState, h: &HarvesterParams, p
         .run_until(periods * chain.period(), &mut rec)
         .unwrap_or_else(|e| panic!("coupled run failed: {e}"));
     rec.solver.status().unwrap();
+    rec.stats = coupled.stats();
     rec
 }
 
@@ -181,36 +186,42 @@ fn segment(traj: &Trajectory, i: usize) -> Option<Flow<'_>> {
         .filter(|f| f.t_start == s.t_start)
 }
 
-/// The smallest open gap over every stored piece of flow, relative to its δ_k: a grid of
-/// `grid` intervals per piece, every local minimum refined by golden-section search.
-fn scan_stored_flow(traj: &Trajectory, deltas: &[f64], grid: usize) -> (f64, f64) {
-    let mut worst = (f64::INFINITY, 0.0);
+/// The smallest open gap over every stored piece of flow: relative to its δ_k, its time (s),
+/// and in metres. A grid of `grid` intervals per piece (the pieces of a coupled run are
+/// short: a window is cut at the charge's 7 nodes), every interior local minimum refined by
+/// golden-section search.
+fn scan_stored_flow(traj: &Trajectory, deltas: &[f64], grid: usize) -> (f64, f64, f64) {
+    let mut worst = (f64::INFINITY, 0.0, f64::INFINITY);
     let mut gaps = vec![0.0; deltas.len()];
     let mut rates = vec![0.0; deltas.len()];
+    let mut gs = vec![0.0; grid + 1];
     for i in 0..traj.segments().len() {
         let Some(flow) = segment(traj, i) else {
             continue;
         };
-        let open = open_contacts(&flow);
         let (a, b) = (flow.t_start, flow.t_end);
+        let time = |j: usize| {
+            if j == grid {
+                b
+            } else {
+                a + (b - a) * j as f64 / grid as f64
+            }
+        };
         let mut gap = |t: f64, k: usize| {
             flow.gaps_at(t, &mut gaps, &mut rates);
-            gaps[k] / deltas[k]
+            gaps[k]
         };
-        for &k in &open {
-            let ts: Vec<f64> = (0..=grid)
-                .map(|j| if j == grid { b } else { a + (b - a) * j as f64 / grid as f64 })
-                .collect();
-            let gs: Vec<f64> = ts.iter().map(|&t| gap(t, k)).collect();
+        for k in open_contacts(&flow) {
+            for (j, g) in gs.iter_mut().enumerate() {
+                *g = gap(time(j), k);
+            }
             for j in 0..=grid {
-                let left = if j == 0 { f64::INFINITY } else { gs[j - 1] };
-                let right = if j == grid { f64::INFINITY } else { gs[j + 1] };
-                let mut low = (gs[j], ts[j]);
-                if gs[j] <= left && gs[j] <= right && 0 < j && j < grid {
+                let mut low = (gs[j], time(j));
+                if 0 < j && j < grid && gs[j] <= gs[j - 1] && gs[j] <= gs[j + 1] {
                     // Golden-section search for the minimum on [t_{j−1}, t_{j+1}].
-                    let (mut lo, mut hi) = (ts[j - 1], ts[j + 1]);
+                    let (mut lo, mut hi) = (time(j - 1), time(j + 1));
                     let r = 0.5 * (5f64.sqrt() - 1.0);
-                    for _ in 0..80 {
+                    for _ in 0..60 {
                         let (c, d) = (hi - r * (hi - lo), lo + r * (hi - lo));
                         if gap(c, k) < gap(d, k) { hi = d } else { lo = c }
                     }
@@ -220,9 +231,10 @@ fn scan_stored_flow(traj: &Trajectory, deltas: &[f64], grid: usize) -> (f64, f64
                         low = (g, t);
                     }
                 }
-                if low.0 < worst.0 {
-                    worst = low;
+                if low.0 / deltas[k] < worst.0 {
+                    worst = (low.0 / deltas[k], low.1, worst.2);
                 }
+                worst.2 = worst.2.min(low.0);
             }
         }
     }
@@ -265,8 +277,8 @@ impl CoupledOde {
     fn positions(&self, y: &[f64]) -> Vec<f64> {
         let mut x = vec![0.0; self.chain.len()];
         for (c, &(first, last)) in self.clusters.iter().enumerate() {
-            for i in first..=last {
-                x[i] = y[2 * c] + self.offsets[i] - self.offsets[first];
+            for (xi, oi) in x[first..=last].iter_mut().zip(&self.offsets[first..=last]) {
+                *xi = y[2 * c] + oi - self.offsets[first];
             }
         }
         x
@@ -353,13 +365,16 @@ fn check_windows(rec: &Recorder, chain: &ChainParams, h: &HarvesterParams, grid:
         }
         let first = segs.partition_point(|s| s.t_end <= ta);
         let last = segs.partition_point(|s| s.t_end < tb);
-        assert!(segs[first].t_start == ta && segs[last].t_end == tb, "window [{ta}, {tb}]");
+        assert!(
+            segs[first].t_start == ta && segs[last].t_end == tb,
+            "window [{ta}, {tb}]"
+        );
         let flow = (first..=last)
             .find_map(|i| segment(&rec.traj, i))
             .expect("a piece of flow inside the window");
         let clusters: Vec<(usize, usize)> = flow.clusters().iter().map(|c| (c.first, c.last)).collect();
-        for i in first..=last {
-            let other: Vec<(usize, usize)> = segs[i].clusters.iter().map(|c| (c.first, c.last)).collect();
+        for seg in &segs[first..=last] {
+            let other: Vec<(usize, usize)> = seg.clusters.iter().map(|c| (c.first, c.last)).collect();
             assert_eq!(other, clusters, "no event inside a window");
         }
         let open = open_contacts(&flow);
@@ -416,27 +431,39 @@ fn contact_force(
     let (yb, ybd) = (a * (w * t).sin(), a * w * (w * t).cos());
     let es = charge.map_or(vec![0.0; x.len()], |q| electrostatic_forces(h, x.len(), q));
     let force = |i: usize| -chain.stiffness[i] * (x[i] - yb) - chain.damping[i] * (v[i] - ybd) + es[i];
-    let (mu, fu): (f64, f64) = (first..=k).map(|i| (chain.masses[i], force(i))).fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
-    let (ml, fl): (f64, f64) = (k + 1..=last).map(|i| (chain.masses[i], force(i))).fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let (mu, fu): (f64, f64) = (first..=k)
+        .map(|i| (chain.masses[i], force(i)))
+        .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let (ml, fl): (f64, f64) = (k + 1..=last)
+        .map(|i| (chain.masses[i], force(i)))
+        .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
     (mu * fl - ml * fu) / (mu + ml)
 }
 
-/// Contact forces at the sticks and releases of a run.
-#[derive(Debug, Default)]
+/// Contact forces at the sticks and releases of a run, N (positive: pressing).
+#[derive(Debug)]
 struct ContactForces {
     releases: usize,
-    sticks: usize,
-    /// Largest |N| at a release, mechanical + electrostatic, N.
-    release_total: f64,
-    /// Largest |N| at a release with the mechanical forces only, N.
-    release_mechanical: f64,
-    /// Most negative N at a stick (a stick that pulls), N.
-    stick_total: f64,
-    /// Releases at the instant of their stick (no flow in between: not checked).
+    /// Releases at the instant of their stick (no flow in between, not checked).
     instant_releases: usize,
+    /// Smallest and largest contact force at a release, mechanical + electrostatic.
+    release_force: (f64, f64),
+    /// Largest |contact force| at a release with the mechanical forces only.
+    release_mechanical: f64,
+    /// Smallest contact force at the end of the window before a release.
+    before_release: f64,
+    /// Longest time by which a release followed the zero of the contact force (linear
+    /// interpolation over the window that ends at the release), s, and its time.
+    late: (f64, f64),
+    /// Longest time by which a release came before the zero of the contact force (its force
+    /// at the release over its rate over that window), s.
+    early: f64,
+    sticks: usize,
+    /// Smallest contact force just after a stick.
+    stick_force: f64,
+    chatters: usize,
     /// Chatter sequences that ended in a stick later released.
     chatter_stick_release: usize,
-    chatters: usize,
 }
 
 /// The cluster containing contact k in the piece of flow ending at `t` (`None` if it was
@@ -453,22 +480,58 @@ fn cluster_before(traj: &Trajectory, t: f64, k: usize) -> Option<(usize, usize)>
 }
 
 fn contact_forces(rec: &Recorder, chain: &ChainParams, h: &HarvesterParams, charged: bool) -> ContactForces {
-    let mut out = ContactForces::default();
+    let mut out = ContactForces {
+        releases: 0,
+        instant_releases: 0,
+        release_force: (f64::INFINITY, f64::NEG_INFINITY),
+        release_mechanical: 0.0,
+        before_release: f64::INFINITY,
+        late: (0.0, 0.0),
+        early: 0.0,
+        sticks: 0,
+        stick_force: f64::INFINITY,
+        chatters: 0,
+        chatter_stick_release: 0,
+    };
+    let n = chain.len();
+    let (mut x, mut v) = (vec![0.0; n], vec![0.0; n]);
     let events = &rec.log.events;
     for (j, e) in events.iter().enumerate() {
         let (t, k) = (e.event.time, e.event.contact);
+        let charge = |t: f64| charged.then(|| rec.charge_at(t));
         match e.event.kind {
             EventKind::Release => {
                 let Some(cluster) = cluster_before(&rec.traj, t, k) else {
                     out.instant_releases += 1;
                     continue;
                 };
-                let q = charged.then(|| rec.charge_at(t));
-                let total = contact_force(chain, h, cluster, k, t, &e.positions, &e.velocities, q);
+                let total = contact_force(chain, h, cluster, k, t, &e.positions, &e.velocities, charge(t));
                 let mech = contact_force(chain, h, cluster, k, t, &e.positions, &e.velocities, None);
                 out.releases += 1;
-                out.release_total = out.release_total.max(total.abs());
+                out.release_force = (out.release_force.0.min(total), out.release_force.1.max(total));
                 out.release_mechanical = out.release_mechanical.max(mech.abs());
+                // The window before: its start is the end of the previous window with flow.
+                let w = rec.charges.partition_point(|c| c.0 < t);
+                let tp = rec.charges[..w]
+                    .iter()
+                    .rev()
+                    .map(|c| c.0)
+                    .find(|&tp| tp < t)
+                    .unwrap_or(0.0);
+                let flow = rec.traj.flow_at(tp).unwrap();
+                flow.state_at(tp, &mut x, &mut v);
+                let before = contact_force(chain, h, cluster, k, tp, &x, &v, charge(tp));
+                out.before_release = out.before_release.min(before);
+                if total < 0.0 && before > 0.0 {
+                    let late = (t - tp) * (-total) / (before - total);
+                    if late > out.late.0 {
+                        out.late = (late, t);
+                    }
+                } else if total > 0.0 && before > total {
+                    out.early = out.early.max((t - tp) * total / (before - total));
+                } else if total > 0.0 {
+                    out.early = f64::INFINITY;
+                }
             }
             EventKind::Stick => {
                 // The cluster after the stick: the piece of flow starting at t.
@@ -479,10 +542,18 @@ fn contact_forces(rec: &Recorder, chain: &ChainParams, h: &HarvesterParams, char
                 else {
                     continue; // released at the same instant, or the run's end
                 };
-                let q = charged.then(|| rec.charge_at(t));
-                let total = contact_force(chain, h, (c.first, c.last), k, t, &e.positions, &e.velocities, q);
+                let total = contact_force(
+                    chain,
+                    h,
+                    (c.first, c.last),
+                    k,
+                    t,
+                    &e.positions,
+                    &e.velocities,
+                    charge(t),
+                );
                 out.sticks += 1;
-                out.stick_total = out.stick_total.min(total);
+                out.stick_force = out.stick_force.min(total);
             }
             EventKind::Chatter => {
                 out.chatters += 1;
@@ -514,169 +585,276 @@ fn chatter_case(omega_ratio: f64) -> ChainParams {
     c
 }
 
-/// The scenarios of tests/events_vs_bruteforce.rs and the chatter case's sticking regime.
-fn scenarios() -> Vec<(&'static str, ChainParams, f64)> {
+/// The scenarios with sticking and chatter: the chatter case in its chattering (Ω = 0.6) and
+/// sticking (Ω = 0.4) regimes, and tests/events_vs_bruteforce.rs's four-mass stack.
+fn sticking_scenarios() -> Vec<(&'static str, ChainParams, f64)> {
     vec![
-        ("default case", ChainParams::default(), 8.0),
         ("chatter case, Ω = 0.6", chatter_case(0.6), 6.0),
         ("chatter case, Ω = 0.4 (sticking)", chatter_case(0.4), 5.0),
         ("four masses, sticking", common::four_mass_stack(), 6.0),
     ]
 }
 
-/// A charge that is not the equilibrium one, C (−0.2 σS), for the runs to start with.
-fn start_charge(h: &HarvesterParams) -> f64 {
-    -0.2 * h.charge_density * h.area
+/// A start away from electrostatic equilibrium (−0.2 σS, C), so that the charge has a
+/// transient; the rectifier starts at equilibrium (V = 0): −0.2 σS would put ~10 kV across
+/// its diodes at t = 0, which the charge solver refuses (step size underflow, as one-way).
+fn start_charge(h: &HarvesterParams, chain: &ChainParams) -> f64 {
+    match h.load {
+        Load::Rectifier(_) => equilibrium_charge(h, &chain.gaps),
+        _ => -0.2 * h.charge_density * h.area,
+    }
 }
 
-#[test]
-fn probe_windows() {
-    for (name, chain, periods) in scenarios() {
-        for (load_name, load) in loads(1e9) {
-            if matches!(load, Load::Rectifier(_)) {
-                continue;
-            }
-            let mut h = harvester(TransducerMode::Freestanding, load, 0.0);
-            h.initial_charge = Some(start_charge(&h));
-            let started = std::time::Instant::now();
-            let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
-            let run = started.elapsed().as_secs_f64();
-            let w = check_windows(&rec, &chain, &h, 16);
-            let scan = scan_stored_flow(&rec.traj, &chain.gaps, 64);
-            println!(
-                "{name}, {load_name}: run {run:.2} s, check {:.2} s; {} events, {} windows; ODE: min gap/δ {:.2e} at {:.6}, \
-                 max |Δx| {:.2e} m, max |ΔQ|/σS {:.2e}; stored flow min gap/δ {:.2e} at {:.6}",
-                started.elapsed().as_secs_f64() - run,
-                rec.log.events.len(),
-                w.windows,
-                w.worst_gap.0,
-                w.worst_gap.1,
-                w.worst_dx,
-                w.worst_dq,
-                scan.0,
-                scan.1
-            );
-        }
+/// Grid intervals per stored piece of flow in the gap scan.
+const SCAN_GRID: usize = 16;
+
+/// How long after the true zero of its contact force a release may come in the strict
+/// check, s ([`known_coupled_event_timing`]); the main checks allow the window it ends.
+const RELEASE_TIME: f64 = 1e-9;
+
+/// Runs each sticking scenario with `load` and checks the events (see the module docs):
+/// no gap below −[`POSITION_TOLERANCE`] anywhere in the stored flow; momentum kept and no
+/// kinetic energy gained at any event; every chatter sequence ends in a stick, and some of
+/// those sticks are released; every stick presses; every release comes where the contact
+/// force, mechanical + electrostatic, crosses zero: it pressed at the start of the window
+/// that ends at the release, and the release is not before its zero by more than
+/// [`RELEASE_TIME`]; and the electrostatic force matters there (the mechanical force alone
+/// is far from zero).
+fn check_events_with_every_scenario(load_name: &str, load: Load) {
+    for (name, chain, periods) in sticking_scenarios() {
+        let mut h = harvester(TransducerMode::Freestanding, load, 0.0);
+        h.initial_charge = Some(start_charge(&h, &chain));
+        let started = std::time::Instant::now();
+        let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
+        let run = started.elapsed().as_secs_f64();
+        let scan = scan_stored_flow(&rec.traj, &chain.gaps, SCAN_GRID);
+        let cf = contact_forces(&rec, &chain, &h, true);
+        let worst_gap_m = scan.2;
+        println!(
+            "{name}, {load_name}: run {run:.2} s, {} events, {} pieces of flow, {:?}\n  \
+             stored flow: min gap/δ {:.2e} at {:.6} s ({worst_gap_m:.2e} m); events: momentum {:.1e}, energy {:.1e}\n  {cf:?}",
+            rec.log.events.len(),
+            rec.traj.segments().len(),
+            rec.stats,
+            scan.0,
+            scan.1,
+            rec.worst_momentum,
+            rec.worst_energy,
+        );
+        let what = format!("{name}, {load_name}");
+        assert!(
+            worst_gap_m >= -POSITION_TOLERANCE,
+            "{what}: gap {worst_gap_m:e} m"
+        );
+        assert!(
+            rec.worst_momentum <= 256.0 * f64::EPSILON,
+            "{what}: momentum {:e}",
+            rec.worst_momentum
+        );
+        assert!(
+            rec.worst_energy <= 256.0 * f64::EPSILON,
+            "{what}: energy gained {:e}",
+            rec.worst_energy
+        );
+        assert!(
+            cf.chatters > 0 && cf.releases > 0 && cf.chatter_stick_release > 0,
+            "{what}: {cf:?}"
+        );
+        assert!(cf.stick_force > 0.0, "{what}: a stick that pulls: {cf:?}");
+        assert!(
+            cf.before_release >= -1e-12,
+            "{what}: released late by more than a window: {cf:?}"
+        );
+        assert!(
+            cf.early <= RELEASE_TIME,
+            "{what}: released {:e} s early: {cf:?}",
+            cf.early
+        );
+        assert!(
+            cf.release_mechanical > 1e-3,
+            "{what}: the electrostatic force is not in the release: {cf:?}"
+        );
     }
 }
 
 #[test]
-fn probe_contacts() {
-    for (name, chain, periods) in scenarios() {
-        for (load_name, load) in loads(1e5) {
-            let mut h = harvester(TransducerMode::Freestanding, load, 0.0);
-            h.initial_charge = Some(start_charge(&h));
-            let started = std::time::Instant::now();
-            let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
-            let run = started.elapsed().as_secs_f64();
-            let scan = scan_stored_flow(&rec.traj, &chain.gaps, 64);
-            let cf = contact_forces(&rec, &chain, &h, true);
-            println!(
-                "{name}, {load_name}: run {run:.2} s; {} events; stored flow min gap/δ {:.2e}; momentum {:.1e}, energy {:.1e}; {cf:?}",
-                rec.log.events.len(),
-                scan.0,
-                rec.worst_momentum,
-                rec.worst_energy,
-            );
+fn events_with_a_resistor() {
+    check_events_with_every_scenario("100 kΩ", Load::Resistor { resistance: 1e5 });
+}
+
+#[test]
+fn events_with_the_rectifier() {
+    check_events_with_every_scenario("rectifier", Load::Rectifier(Rectifier::default()));
+}
+
+#[test]
+fn events_in_open_circuit() {
+    check_events_with_every_scenario("open", Load::Open);
+}
+
+#[test]
+fn events_in_short_circuit() {
+    check_events_with_every_scenario("short", Load::Short);
+}
+
+/// The independent integrator from every window of `chain`'s run with each load it can
+/// write out (1 GΩ, open, short), `grid` samples per window: the run's state at each
+/// window's end within [`POSITION_TOLERANCE`] of the integrator's, and no open gap of the
+/// integrator's motion below −[`POSITION_TOLERANCE`] where the run saw no event.
+fn check_against_the_integrator(name: &str, chain: &ChainParams, periods: f64, grid: usize) {
+    for (load_name, load) in loads(1e9) {
+        if matches!(load, Load::Rectifier(_)) {
+            continue;
         }
-        // One-way: the contact force of the mechanics alone vanishes at releases.
-        let h = harvester(TransducerMode::Freestanding, Load::Open, 0.0);
-        let solver = ChargeSolver::for_chain(&h, &chain, ChargeOptions::default()).unwrap();
-        let mut rec = Recorder::new(solver, &chain, 0.0);
-        let mut sim = Simulator::new(&chain, &ChainState::at_rest(chain.len()), SimOptions::default()).unwrap();
-        sim.run_until(periods * chain.period(), &mut rec).unwrap();
-        let cf = contact_forces(&rec, &chain, &h, false);
-        println!("{name}, one-way: {cf:?}");
+        let mut h = harvester(TransducerMode::Freestanding, load, 0.0);
+        h.initial_charge = Some(start_charge(&h, chain));
+        let started = std::time::Instant::now();
+        let rec = coupled_run(chain, &ChainState::at_rest(chain.len()), &h, periods);
+        let run = started.elapsed().as_secs_f64();
+        let w = check_windows(&rec, chain, &h, grid);
+        let worst_gap_m = w.worst_gap.0;
+        println!(
+            "{name}, {load_name}: run {run:.2} s, check {:.2} s; {} events, {} windows integrated ({} shorter \
+             than {SHORTEST_WINDOW:e} T skipped); integrator: min open gap {worst_gap_m:.2e} m at {:.6} s, \
+             max |Δx| {:.2e} m, max |ΔQ|/σS {:.2e}",
+            started.elapsed().as_secs_f64() - run,
+            rec.log.events.len(),
+            w.windows,
+            w.skipped,
+            w.worst_gap.1,
+            w.worst_dx,
+            w.worst_dq,
+        );
+        let what = format!("{name}, {load_name}");
+        assert!(w.windows > 100, "{what}: {w:?}");
+        assert!(w.worst_dx <= POSITION_TOLERANCE, "{what}: {w:?}");
+        assert!(
+            worst_gap_m >= -POSITION_TOLERANCE,
+            "{what}: a contact missed: {w:?}"
+        );
+        // The charge: the solver's (rtol 1e-10) against the integrator's.
+        assert!(w.worst_dq <= 1e-8, "{what}: {w:?}");
     }
 }
 
 #[test]
-fn probe_grazing() {
+fn default_case_against_the_integrator() {
+    check_against_the_integrator("default case", &ChainParams::default(), 8.0, 8);
+}
+
+#[test]
+fn chatter_case_against_the_integrator() {
+    check_against_the_integrator("chatter case, Ω = 0.6", &chatter_case(0.6), 4.0, 4);
+}
+
+#[test]
+fn sticking_chatter_case_against_the_integrator() {
+    check_against_the_integrator("chatter case, Ω = 0.4", &chatter_case(0.4), 3.0, 4);
+}
+
+#[test]
+fn four_mass_stack_against_the_integrator() {
+    check_against_the_integrator("four masses", &common::four_mass_stack(), 3.0, 4);
+}
+
+/// tests/special_cases.rs's grazing pair (two undamped masses with equal k/m) in
+/// contact-separation mode, open circuit, Q = −0.2 σS: the electrostatic force G on the gap is
+/// constant, and the relative motion r = x₂ − x₁ from rest with speed v₀ is
+/// r(t) = s(1 − cos ω_n t) + a sin ω_n t, s = −G(1/m₁ + 1/m₂)/ω_n², a = v₀/ω_n, whose
+/// largest value s + √(s² + a²) is set to δ(1 + ε). The first contact is at
+/// ω_n t = acos((s − δ)/ρ) − φ (ρ cos(θ + φ) = s − δ, ρ = √(s² + a²), φ = atan2(a, s)),
+/// with closing speed ω_n (s sin θ + a cos θ): the same tolerances as the one-way test.
+#[test]
+fn grazing_pair_in_open_circuit_against_the_closed_form() {
     for eps in [0.0, 1e-9, 1e-6, 1e-3, -1e-9] {
         let (chain, _, wn) = grazing_pair(eps);
-        let h = harvester(TransducerMode::ContactSeparation, Load::Open, 0.0);
-        let q0 = start_charge(&h);
-        let h = HarvesterParams { initial_charge: Some(q0), ..h };
-        let g: f64 = gap_forces(&h, q0)[0].1;
-        let (ma, mb) = (chain.masses[0], chain.masses[1]);
-        let s = -g * (1.0 / ma + 1.0 / mb) / (wn * wn);
+        let h0 = harvester(TransducerMode::ContactSeparation, Load::Open, 0.0);
+        let q0 = -0.2 * h0.charge_density * h0.area;
+        let h = HarvesterParams {
+            initial_charge: Some(q0),
+            ..h0
+        };
+        let g = gap_forces(&h, q0)[0].1;
+        let (m1, m2) = (chain.masses[0], chain.masses[1]);
+        let s = -g * (1.0 / m1 + 1.0 / m2) / (wn * wn);
         let delta = chain.gaps[0];
         let a = ((delta * (1.0 + eps) - s).powi(2) - s * s).sqrt();
-        let initial = ChainState { positions: vec![0.0, 0.0], velocities: vec![0.0, a * wn] };
-        let rho = s.hypot(a);
-        let phi = a.atan2(s);
+        let initial = ChainState {
+            positions: vec![0.0, 0.0],
+            velocities: vec![0.0, a * wn],
+        };
+        let (rho, phi) = (s.hypot(a), a.atan2(s));
         let theta = ((s - delta) / rho).clamp(-1.0, 1.0).acos() - phi;
         let t_expected = theta / wn;
         let v_expected = wn * (s * theta.sin() + a * theta.cos());
         let t_end = (PI - phi + 0.5) / wn;
         let rec = coupled_run(&chain, &initial, &h, t_end / chain.period());
         let first = rec.log.events.first().map(|e| e.event);
-        println!("ε = {eps:e}: s = {s:.6e} m, expected t = {t_expected:.15e} s, v = {v_expected:.3e}; first {first:?}; {} events; dt = {:?}", rec.log.events.len(), first.map(|e| e.time - t_expected));
-        let _ = VACUUM_PERMITTIVITY;
-        let _ = (Excitation::default(), Frequency::OmegaRatio(1.0));
+        println!(
+            "ε = {eps:e}: s = {s:.6e} m (the pull's share of δ: {:.3}); expected t = {t_expected:.15e} s, \
+             v = {v_expected:.3e} m/s; got {:?}",
+            s / delta,
+            first.map(|e| (e.time, e.velocity_before))
+        );
+        if eps < 0.0 {
+            assert!(rec.log.events.is_empty(), "near miss reported: {first:?}");
+            continue;
+        }
+        let e = first.unwrap_or_else(|| panic!("ε = {eps}: contact missed"));
+        assert_eq!(e.kind, EventKind::Impact);
+        if eps == 0.0 {
+            // A double root: rounding moves it by √(2η/d'') (tests/special_cases.rs).
+            assert!(
+                (e.time - t_expected).abs() < 1e-7,
+                "graze at {} expected {t_expected}",
+                e.time
+            );
+            assert!(e.velocity_before < 1e-6, "grazing speed {}", e.velocity_before);
+        } else {
+            assert!(
+                (e.time - t_expected).abs() < 1e-12 + 1e-14 / v_expected,
+                "ε = {eps}: t = {} expected {t_expected}",
+                e.time
+            );
+            assert!(
+                (e.velocity_before - v_expected).abs() < 1e-6 * v_expected,
+                "ε = {eps}: v = {} expected {v_expected}",
+                e.velocity_before
+            );
+        }
     }
 }
 
+/// The one-way accuracy of the events, not met in two-way runs (notes/coupled-event-accuracy.md):
+/// every gap of the stored flow ≥ −1e-12 of its δ (tests/events_vs_bruteforce.rs's criterion;
+/// one-way runs of these chains reach −2.7e-13 δ at worst), and every release within
+/// [`RELEASE_TIME`] after the zero of its contact force (one-way: 1e-12 s against the closed form,
+/// tests/special_cases.rs).
 #[test]
-fn probe_scan_detail() {
-    for (name, chain, periods) in scenarios() {
-        // One-way
-        let h = harvester(TransducerMode::Freestanding, Load::Open, 0.0);
-        let solver = ChargeSolver::for_chain(&h, &chain, ChargeOptions::default()).unwrap();
-        let mut rec = Recorder::new(solver, &chain, 0.0);
-        let mut sim = Simulator::new(&chain, &ChainState::at_rest(chain.len()), SimOptions::default()).unwrap();
-        sim.run_until(periods * chain.period(), &mut rec).unwrap();
-        let scan = scan_stored_flow(&rec.traj, &chain.gaps, 64);
-        let segs = rec.traj.segments();
-        let i = segs.partition_point(|s| s.t_end < scan.1);
-        let s = &segs[i.min(segs.len() - 1)];
-        let ev: Vec<_> = rec.log.events.iter().filter(|e| (e.event.time - s.t_end).abs() < 1e-12).map(|e| e.event).collect();
-        println!("{name}, one-way: min gap/δ {:.2e} at {:.15}, segment [{:.15}, {:.15}] (t_end − t = {:.2e}); events at its end {ev:?}", scan.0, scan.1, s.t_start, s.t_end, s.t_end - scan.1);
-        let h = harvester(TransducerMode::Freestanding, Load::Open, start_charge(&h));
-        let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
-        let scan = scan_stored_flow(&rec.traj, &chain.gaps, 64);
-        let segs = rec.traj.segments();
-        let i = segs.partition_point(|s| s.t_end < scan.1);
-        let s = &segs[i.min(segs.len() - 1)];
-        let ev: Vec<_> = rec.log.events.iter().filter(|e| (e.event.time - s.t_end).abs() < 1e-12).map(|e| e.event).collect();
-        println!("{name}, two-way open: min gap/δ {:.2e} at {:.15}, segment [{:.15}, {:.15}] (t_end − t = {:.2e}); events at its end {ev:?}", scan.0, scan.1, s.t_start, s.t_end, s.t_end - scan.1);
+#[ignore = "known: two-way events are less accurate than one-way ones (notes/coupled-event-accuracy.md)"]
+fn known_coupled_event_timing() {
+    let mut failures = Vec::new();
+    for (name, chain, periods) in sticking_scenarios() {
+        for (load_name, load) in loads(1e5) {
+            let mut h = harvester(TransducerMode::Freestanding, load, 0.0);
+            h.initial_charge = Some(start_charge(&h, &chain));
+            let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
+            let scan = scan_stored_flow(&rec.traj, &chain.gaps, SCAN_GRID);
+            let cf = contact_forces(&rec, &chain, &h, true);
+            if scan.0 < -1e-12 {
+                failures.push(format!(
+                    "{name}, {load_name}: gap {:.2e} δ at {:.9} s",
+                    scan.0, scan.1
+                ));
+            }
+            if cf.late.0 > RELEASE_TIME {
+                failures.push(format!(
+                    "{name}, {load_name}: release at {:.9} s {:.2e} s after the zero of its force \
+                     ({:.2e} N there)",
+                    cf.late.1, cf.late.0, cf.release_force.0
+                ));
+            }
+        }
     }
-}
-
-#[test]
-fn probe_four_mass_release() {
-    let chain = common::four_mass_stack();
-    let h0 = harvester(TransducerMode::Freestanding, Load::Open, 0.0);
-    let h = harvester(TransducerMode::Freestanding, Load::Open, start_charge(&h0));
-    let q = start_charge(&h0);
-    let rec = coupled_run(&chain, &ChainState::at_rest(4), &h, 6.0);
-    let show = |rec: &Recorder, label: &str| {
-        let scan = scan_stored_flow(&rec.traj, &chain.gaps, 64);
-        println!("{label}: min gap/δ {:.3e} at {:.17}", scan.0, scan.1);
-        for e in rec.log.events.iter().filter(|e| (e.event.time - scan.1).abs() < 1e-9) {
-            let g: Vec<f64> = (0..3).map(|k| chain.gaps[k] - (e.positions[k + 1] - e.positions[k])).collect();
-            println!("  event {:?} at {:.17}: gaps {g:?} v {:?}", e.event.kind, e.event.time, e.velocities);
-        }
-        for s in rec.traj.segments().iter().filter(|s| (s.t_start - scan.1).abs() < 1e-9 || (s.t_end - scan.1).abs() < 1e-9) {
-            let cl: Vec<_> = s.clusters.iter().map(|c| (c.first, c.last)).collect();
-            let f = rec.traj.flow_at(0.5 * (s.t_start + s.t_end)).unwrap();
-            let mut gs = vec![0.0; 3];
-            let mut rs = vec![0.0; 3];
-            f.gaps_at(s.t_start, &mut gs, &mut rs);
-            let mut ge = vec![0.0; 3];
-            f.gaps_at(s.t_end, &mut ge, &mut rs);
-            println!("  segment [{:.17}, {:.17}] clusters {cl:?}: gaps at start {gs:?}, at end {ge:?}", s.t_start, s.t_end);
-        }
-    };
-    show(&rec, "two-way open");
-    // One-way with the same constant forces.
-    let statics = vibrotribo::electrical::Electrostatics::new(&h.transducer()).unwrap();
-    let mut forces = vec![0.0; 4];
-    statics.mass_forces(q, &mut forces);
-    let pushed = ChainParams { forces, ..chain.clone() };
-    let solver = ChargeSolver::for_chain(&h, &chain, ChargeOptions::default()).unwrap();
-    let mut rec1 = Recorder::new(solver, &pushed, q);
-    let mut sim = Simulator::new(&pushed, &ChainState::at_rest(4), SimOptions::default()).unwrap();
-    sim.run_until(6.0 * chain.period(), &mut rec1).unwrap();
-    show(&rec1, "one-way, constant forces");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

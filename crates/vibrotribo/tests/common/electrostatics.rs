@@ -66,9 +66,7 @@ pub fn field_energy(h: &HarvesterParams, q: f64, gaps: &[f64]) -> f64 {
 pub fn terminal_voltage(h: &HarvesterParams, q: f64, gaps: &[f64]) -> f64 {
     let sigma_s = sigma_s(h);
     let air = match h.mode {
-        TransducerMode::Freestanding => {
-            (q + sigma_s) * gaps[h.contact] - (sigma_s - q) * gaps[h.contact + 1]
-        }
+        TransducerMode::Freestanding => (q + sigma_s) * gaps[h.contact] - (sigma_s - q) * gaps[h.contact + 1],
         TransducerMode::ContactSeparation => -(sigma_s - q) * gaps[h.contact],
     };
     -(q * d0(h) + air) / (VACUUM_PERMITTIVITY * h.area)
