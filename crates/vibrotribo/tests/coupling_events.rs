@@ -1,28 +1,31 @@
-//! Two-way coupling keeps the events as reliable as one-way runs (issue 11): impacts,
-//! sticking, release and chatter under the electrostatic force, with every load. The truth
-//! comes from outside the coupling code:
+//! Two-way coupling and the events (issue 11): impacts, sticking, release and chatter under
+//! the electrostatic force, with every load (resistor, rectifier, open, short), in the
+//! scenarios of the one-way event tests. The truth comes from outside the coupling code:
 //!
 //! - **An independent integrator of the coupled equations.** From the start of every window
 //!   of the coupled run (the simulator's state and the solver's charge there), Dop853
 //!   (tests/common) integrates the chain under the electrostatic force written out in
 //!   tests/common/electrostatics.rs together with the circuit (R dQ/dt = V for a resistor,
-//!   Q constant in open circuit, Q = Q_eq(D) in short circuit), and its gaps are sampled on a
-//!   fine grid: no open gap may go negative where the coupled run saw no event (nothing
-//!   missed), and its state at the window's end must be the run's to the coupling's stated
-//!   displacement tolerance.
-//! - **A brute-force scan of the flow the run followed**, for every load (the rectifier
-//!   too): every open gap of every stored piece of flow on a grid, each local minimum refined
-//!   by golden-section search, never below −1e-12 of the gap (tests/events_vs_bruteforce.rs's
-//!   criterion).
-//! - **The contact force from the energy function.** A stuck pair must release where its
-//!   contact force, mechanical plus electrostatic (the forces −∂U/∂D of
-//!   tests/common/electrostatics.rs at the solver's charge), crosses zero, and stick only
-//!   where it presses; it is computed here from the state at the event, not by the engine.
+//!   Q constant in open circuit, Q = Q_eq(D) in short circuit; the bridge is not written
+//!   out), and its gaps are sampled on a grid: no open gap may go below −tol where the coupled
+//!   run saw no event (nothing missed), and its state at the window's end must be the run's
+//!   to tol, the coupling's displacement tolerance (1e-11 m).
+//! - **A brute-force scan of the flow the run followed**, for every load: every open gap of
+//!   every stored piece of flow on a grid, each local minimum refined by golden-section
+//!   search, never below −tol.
+//! - **The contact force from the energy function.** Computed here from the state at the event
+//!   and the forces −∂U/∂D at the solver's charge, not by the engine: every stick presses, and
+//!   every release comes where the contact force, mechanical plus electrostatic, crosses zero,
+//!   within the window that ends at it and not before the zero.
 //! - **A closed form.** In open circuit the force is constant; two masses with equal k/m
 //!   then have a relative motion r(t) = s(1 − cos ω_n t) + a sin ω_n t, whose grazing is
 //!   known exactly (tests/special_cases.rs's grazing pair, with the electrostatic pull).
 //! - **Conservation at events** (tests/reliability.rs): momentum kept, kinetic energy never
 //!   gained.
+//!
+//! The one-way accuracy of the events (stored-flow gaps ≥ −1e-12 δ as in
+//! tests/events_vs_bruteforce.rs, releases within 1e-9 s of the zero of their force) is not met
+//! everywhere: [`known_coupled_event_timing`] (ignored), notes/coupled-event-accuracy.md.
 
 mod common;
 
@@ -596,8 +599,8 @@ fn sticking_scenarios() -> Vec<(&'static str, ChainParams, f64)> {
 }
 
 /// A start away from electrostatic equilibrium (−0.2 σS, C), so that the charge has a
-/// transient; the rectifier starts at equilibrium (V = 0): −0.2 σS would put ~10 kV across
-/// its diodes at t = 0, which the charge solver refuses (step size underflow, as one-way).
+/// transient; the rectifier starts at equilibrium (V = 0): −0.2 σS would put kilovolts across
+/// its diodes at t = 0, where the charge solver stops (step size underflow).
 fn start_charge(h: &HarvesterParams, chain: &ChainParams) -> f64 {
     match h.load {
         Load::Rectifier(_) => equilibrium_charge(h, &chain.gaps),
