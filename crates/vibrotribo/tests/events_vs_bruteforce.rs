@@ -135,19 +135,7 @@ fn chatter_case() {
 
 #[test]
 fn four_mass_stack_with_sticking() {
-    let params = ChainParams {
-        masses: vec![0.04, 0.09, 0.07, 0.05],
-        stiffness: vec![150.0, 100.0, 130.0, 90.0],
-        damping: vec![0.03, 0.01, 0.02, 0.04],
-        gaps: vec![0.006, 0.004, 0.008],
-        restitution: 0.3,
-        excitation: vibrotribo::Excitation {
-            amplitude: 0.05,
-            frequency: vibrotribo::Frequency::OmegaRatio(0.55),
-        },
-        stops: Default::default(),
-        forces: Vec::new(),
-    };
+    let params = common::four_mass_stack();
     let out = check(&params, &ChainState::at_rest(4), 8.0, 200);
     println!(
         "4 masses: {} impacts, max |Δt| {:.1e} s, min gap/δ {:.1e}",

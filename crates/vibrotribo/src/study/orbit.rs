@@ -73,6 +73,7 @@ pub fn power_on_periodic_state(
         power: solver.summary((warmup * period) as usize),
         breakdown: None,
         storage_voltage: solver.storage_voltage(),
+        terminal_energy_j: solver.terminal_energy(),
         time_to_target: solver.time_to_target(),
         solver: solver.stats(),
         solver_error: None,

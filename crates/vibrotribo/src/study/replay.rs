@@ -76,6 +76,7 @@ pub fn replay(
             power: s.summary(options.transient_periods as usize),
             breakdown: s.breakdown_margin().copied(),
             storage_voltage: s.storage_voltage(),
+            terminal_energy_j: s.terminal_energy(),
             time_to_target: s.time_to_target(),
             solver: s.stats(),
             solver_error: None,

@@ -59,6 +59,11 @@ pub struct ElectricalOutcome {
     pub breakdown: Option<BreakdownMargin>,
     /// Storage capacitor voltage at the end, V (rectifier).
     pub storage_voltage: Option<f64>,
+    /// Energy that left the transducer through its terminals since the charge solver started,
+    /// J: ∫V·I dt
+    /// ([`ChargeSolver::terminal_energy`](crate::electrical::ChargeSolver::terminal_energy));
+    /// for the rectifier, the energy of `periods` plus the bridge's losses.
+    pub terminal_energy_j: f64,
     /// First time the storage voltage reached the target, s (rectifier with a target).
     pub time_to_target: Option<f64>,
     /// The solver's work counters.
@@ -260,6 +265,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         ),
         breakdown: s.breakdown_margin().copied(),
         storage_voltage: s.storage_voltage(),
+        terminal_energy_j: s.terminal_energy(),
         time_to_target: s.time_to_target(),
         solver: s.stats(),
         solver_error: s.status().err(),

@@ -2,6 +2,7 @@
 //! `ode_solvers`, not the closed form under test) and reference-data loading.
 #![allow(dead_code)]
 
+pub mod electrostatics;
 pub mod fd;
 pub mod quadrature;
 
@@ -80,7 +81,16 @@ impl System<f64, DVector<f64>> for ClusterOde {
 /// ode_solvers 0.6's dense output extrapolates its last point past the current step (and can
 /// spin), so the grid is produced by chaining integrations with sparse output, each of which
 /// ends exactly at its `x_end`.
-pub fn integrate(ode: ClusterOde, t0: f64, t1: f64, dx: f64, y0: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
+///
+/// Any system in the same autonomous form (time as the last state component, appended here)
+/// can be integrated: [`ClusterOde`], or the coupled equations of tests/coupling_events.rs.
+pub fn integrate<O: System<f64, DVector<f64>> + Clone>(
+    ode: O,
+    t0: f64,
+    t1: f64,
+    dx: f64,
+    y0: &[f64],
+) -> (Vec<f64>, Vec<Vec<f64>>) {
     let steps = ((t1 - t0) / dx).round().max(1.0) as usize;
     let dx = (t1 - t0) / steps as f64;
     let mut xs = vec![t0];
@@ -95,7 +105,7 @@ pub fn integrate(ode: ClusterOde, t0: f64, t1: f64, dx: f64, y0: &[f64]) -> (Vec
     (xs, ys)
 }
 
-fn integrate_segment(ode: ClusterOde, ta: f64, tb: f64, y0: &[f64]) -> Vec<f64> {
+fn integrate_segment<O: System<f64, DVector<f64>>>(ode: O, ta: f64, tb: f64, y0: &[f64]) -> Vec<f64> {
     // Stiffness detection off: these problems are not stiff and the heuristic misfires at
     // this tolerance.
     let mut state = y0.to_vec();
@@ -129,7 +139,7 @@ fn integrate_segment(ode: ClusterOde, ta: f64, tb: f64, y0: &[f64]) -> Vec<f64> 
 }
 
 /// State at `t1` only.
-pub fn integrate_to(ode: ClusterOde, t0: f64, t1: f64, y0: &[f64]) -> Vec<f64> {
+pub fn integrate_to<O: System<f64, DVector<f64>>>(ode: O, t0: f64, t1: f64, y0: &[f64]) -> Vec<f64> {
     integrate_segment(ode, t0, t1, y0)
 }
 
@@ -244,4 +254,22 @@ pub fn grazing_pair(eps: f64) -> (ChainParams, ChainState, f64) {
         velocities: vec![0.0, delta * (1.0 + eps) * wn],
     };
     (params, initial, wn)
+}
+
+/// Four masses that stick and release (tests/events_vs_bruteforce.rs): 40–90 g, gaps 4–8 mm,
+/// μ = 0.3, A = 50 mm, Ω = 0.55.
+pub fn four_mass_stack() -> ChainParams {
+    ChainParams {
+        masses: vec![0.04, 0.09, 0.07, 0.05],
+        stiffness: vec![150.0, 100.0, 130.0, 90.0],
+        damping: vec![0.03, 0.01, 0.02, 0.04],
+        gaps: vec![0.006, 0.004, 0.008],
+        restitution: 0.3,
+        excitation: Excitation {
+            amplitude: 0.05,
+            frequency: Frequency::OmegaRatio(0.55),
+        },
+        stops: Default::default(),
+        forces: Vec::new(),
+    }
 }

@@ -77,6 +77,7 @@ impl ChargeSolver {
             ts_now: TransducerState::default(),
             open_charge: 0.0,
             energy: 0.0,
+            terminal_energy: 0.0,
             last_period_power: 0.0,
             h: 1e-6 * period,
             h_acc: 0.0,
@@ -350,6 +351,19 @@ impl ChargeSolver {
     /// Energy delivered to the load since the start, J.
     pub fn total_energy(&self) -> f64 {
         self.energy
+    }
+
+    /// Energy that left the transducer through its terminals since the start, J: ∫V·I dt,
+    /// V the terminal voltage (V) and I = dQ/dt (A), by each step's collocation quadrature
+    /// (the one that books [`total_energy`](Self::total_energy)). For a resistor it is the
+    /// load's energy; for the rectifier, the energy into the storage side
+    /// ([`total_energy`](Self::total_energy), `∫V_s I_out dt`) plus what the bridge
+    /// dissipates (diodes, their series resistances and leakage); 0 in open circuit (I = 0)
+    /// and short circuit (V = 0). With two-way coupling it is the electrical term of the
+    /// energy balance: the work of the electrostatic forces on the masses is
+    /// −ΔU − ∫V·I dt (docs/MODEL.md §2).
+    pub fn terminal_energy(&self) -> f64 {
+        self.terminal_energy
     }
 
     /// Per-period records, in time order (the last may be incomplete).

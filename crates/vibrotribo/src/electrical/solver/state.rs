@@ -88,6 +88,9 @@ pub(super) struct Trial<const S: usize> {
     pub(super) power: [f64; S],
     /// Energy delivered over the step, J: `h Σ bⱼ pⱼ`.
     pub(super) energy: f64,
+    /// Energy that left the transducer through its terminals over the step, J: `h Σ bⱼ Vⱼ Iⱼ`
+    /// (V the terminal voltage, I = dQ/dt at the stages).
+    pub(super) terminal_energy: f64,
     /// Largest |terminal voltage|, V, and |current|, A, at the stages.
     pub(super) peak_voltage: f64,
     pub(super) peak_current: f64,
@@ -114,6 +117,7 @@ impl<const S: usize> Trial<S> {
             z: [[0.0; S]; 2],
             power: [0.0; S],
             energy: 0.0,
+            terminal_energy: 0.0,
             peak_voltage: 0.0,
             peak_current: 0.0,
             scale_voltage: 0.0,
@@ -184,6 +188,9 @@ pub struct ChargeSolver {
     pub(super) open_charge: f64,
     /// Energy delivered since the start, J.
     pub(super) energy: f64,
+    /// Energy that left the transducer through its terminals since the start, J (∫V·I dt;
+    /// see [`ChargeSolver::terminal_energy`]).
+    pub(super) terminal_energy: f64,
     /// Average power over the last complete period, W (0 before there is one).
     pub(super) last_period_power: f64,
     pub(super) h: f64,

@@ -292,6 +292,8 @@ impl ChargeSolver {
         let dp_du = -2.0 * conductance * v0 * n0.elastance;
         let coupling = (dp_du * e, (dp_du * noise / el1).abs());
         let err_e = self.energy_error(tab, h, p0, trial, p_noise, coupling);
+        // The load is the resistor: what leaves the terminals is what it dissipates.
+        trial.terminal_energy = trial.energy;
         trial.err = err_v.max(err_e);
     }
 
@@ -451,6 +453,7 @@ impl ChargeSolver {
         trial.dq = dq;
         let (mut peak_v, mut peak_i, mut scale_v) = (0.0f64, 0.0f64, y0[1].abs());
         let mut v1 = 0.0;
+        let mut terminal = 0.0;
         for j in 0..S {
             let yj = [y0[0] + z[0][j], y0[1] + z[1][j]];
             let (_, _, v, b) = f(yj, &nodes[j]);
@@ -458,8 +461,11 @@ impl ChargeSolver {
             peak_i = peak_i.max(b.current.abs());
             scale_v = scale_v.max(yj[1].abs());
             trial.power[j] = yj[1] * b.output;
+            // The power leaving the transducer's terminals: V·I, I = dQ/dt the bridge's input.
+            terminal += tab.a[S - 1][j] * v * b.current;
             v1 = v;
         }
+        trial.terminal_energy = h * terminal;
         trial.peak_voltage = peak_v;
         trial.peak_current = peak_i;
         trial.scale_voltage = scale_v;
@@ -581,6 +587,7 @@ impl ChargeSolver {
         self.ts_now = n1;
         self.y = [self.y[0] + trial.z[0][S - 1], self.y[1] + trial.z[1][S - 1]];
         self.energy += trial.energy;
+        self.terminal_energy += trial.terminal_energy;
         if let Some(p) = self.periods.last_mut() {
             p.energy_j += trial.energy;
         }
