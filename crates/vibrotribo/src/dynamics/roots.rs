@@ -159,17 +159,27 @@ fn safe_step(jet: &Jet) -> f64 {
     let f = (jet.d[0] - level).max(0.0);
     let [_, d1, d2, d3] = jet.d;
     let b = jet.bound.map(|x| x * BOUND_SAFETY);
-    let r1 = first_positive_root(&[f, d1, -0.5 * b[2]]);
-    let r2 = first_positive_root(&[f, d1, 0.5 * d2, -b[3] / 6.0]);
+    let p1 = [f, d1, -0.5 * b[2]];
+    let p2 = [f, d1, 0.5 * d2, -b[3] / 6.0];
     // The quartic bound costs a cubic solve for its critical points; it is needed where the
     // lower orders give no progress (at zero with vanishing slope and curvature, as after a
-    // release) and is not worth it far from zero.
-    let r3 = if f <= 1e6 * jet.noise[0] {
+    // release) and is not worth it far from zero. Near zero it usually gives the longest
+    // step, so it goes first there.
+    let mut step = if f <= 1e6 * jet.noise[0] {
         first_positive_root(&[f, d1, 0.5 * d2, d3 / 6.0, -b[4] / 24.0])
     } else {
         0.0
     };
-    r1.max(r2).max(r3)
+    // A bound that is already ≤ 0 at the step found so far has its first root before it and
+    // cannot lengthen the step (a root is returned at or below the true one): skip its solve.
+    // The result is the maximum of the three roots, as if each had been solved.
+    if step == 0.0 || horner(&p2, step) > 0.0 {
+        step = step.max(first_positive_root(&p2));
+    }
+    if step == 0.0 || horner(&p1, step) > 0.0 {
+        step = step.max(first_positive_root(&p1));
+    }
+    step
 }
 
 /// Smallest positive root of `c0 + c1 h + c2 h²` (c0 ≥ 0), if any.
