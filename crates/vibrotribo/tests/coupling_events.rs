@@ -525,14 +525,20 @@ fn contact_forces(rec: &Recorder, chain: &ChainParams, h: &HarvesterParams, char
                 flow.state_at(tp, &mut x, &mut v);
                 let before = contact_force(chain, h, cluster, k, tp, &x, &v, charge(tp));
                 out.before_release = out.before_release.min(before);
-                if total < 0.0 && before > 0.0 {
+                // A total force within 1e-12 of the mechanical force it balances is at its
+                // zero: the positions it is computed from carry ~1e-16 relative rounding each
+                // and the run's state is held to 1e-11 m, so no sign below that is a timing
+                // error (the window's secant is then no rate either: a release at +2.3e-14 N
+                // after a window that started at +5.1e-15 N was counted infinitely early).
+                let zero = 1e-12 * mech.abs();
+                if total < -zero && before > 0.0 {
                     let late = (t - tp) * (-total) / (before - total);
                     if late > out.late.0 {
                         out.late = (late, t);
                     }
-                } else if total > 0.0 && before > total {
+                } else if total > zero && before > total {
                     out.early = out.early.max((t - tp) * total / (before - total));
-                } else if total > 0.0 {
+                } else if total > zero {
                     out.early = f64::INFINITY;
                 }
             }
