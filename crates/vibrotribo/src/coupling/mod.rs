@@ -23,12 +23,12 @@
 //!    advances the charge over the gaps of that motion, sampled at the window's 7
 //!    Chebyshev–Lobatto points; it also integrates the charge's time moments over the window
 //!    (∫Q, ∫Q², ∫τQ, ∫τQ², by each step's collocation quadrature, the one that books the
-//!    load's energy; [`ChargeSolver::start_moments`]), which give on each mass the impulse
+//!    load's energy; [`ChargeSolver::start_moments`](crate::electrical::ChargeSolver::start_moments)), which give on each mass the impulse
 //!    ∫F dτ and the first moment ∫τF dτ of the force of the solver's charge;
 //! 4. if the sampled charge differs from the guess by more than the window's charge tolerance,
 //!    or the installed force's impulse or first moment differs from the solver's by more than
 //!    their tolerances (below), the window is redone from its start (the solver is rewound,
-//!    [`ChargeSolver::checkpoint`]) with the new charge as the guess and, on each mass, a
+//!    [`ChargeSolver::checkpoint`](crate::electrical::ChargeSolver::checkpoint)) with the new charge as the guess and, on each mass, a
 //!    force βτ + γτ² added to the polynomial force so that its impulse and first moment
 //!    are those just measured; if the interpolant's own error estimate exceeds the charge
 //!    tolerance, the window is shortened.

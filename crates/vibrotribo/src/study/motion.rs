@@ -36,7 +36,7 @@ use crate::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::sensitivity::length_scale;
 
-/// The kind of motion of a recorded window (see the [module docs](self)).
+/// The kind of motion of a recorded window (see the module docs of `study/motion.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Motion {
     /// Repeats with a period.
@@ -128,7 +128,7 @@ impl<'a> Window<'a> {
     }
 }
 
-/// Classifies a recorded `window` of `params` (see the [module docs](self)); `settled` is
+/// Classifies a recorded `window` of `params` (see the module docs of `study/motion.rs`); `settled` is
 /// the adaptive settling before it, `None` after a fixed transient of
 /// `options.transient_periods`; `spectrum` the Lyapunov spectrum over the window if one was
 /// computed. Without one, a window that is neither periodic nor settling gets the spectrum
@@ -227,7 +227,7 @@ pub fn classify(
 }
 
 /// The sign of a largest Lyapunov exponent `largest` (1/s) told apart from 0 by its
-/// standard error `se` (1/s): `Greater` or `Less` only beyond [`SIGMAS`] errors, `Equal`
+/// standard error `se` (1/s): `Greater` or `Less` only beyond 3 (`SIGMAS`) errors, `Equal`
 /// within them (a non-finite error counts as 0). The rule behind `chaotic`,
 /// `quasiperiodic` and a contracting (settling) window.
 pub fn exponent_sign(largest: f64, se: f64) -> Ordering {

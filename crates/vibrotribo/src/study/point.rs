@@ -152,7 +152,7 @@ pub struct PointResult {
     pub lyapunov: Option<Result<LyapunovSpectrum, LyapunovError>>,
     /// Batch-means standard error of [`average_power_w`](Self::average_power_w), W: the
     /// per-period powers of the recorded window in 10 consecutive batches
-    /// ([`batch_means_se`]); about 0 for a periodic motion, the sampling error of a
+    /// ([`batch_means_se`](crate::analysis::batch_means_se)); about 0 for a periodic motion, the sampling error of a
     /// non-periodic one.
     pub average_power_se_w: Option<f64>,
     /// The motion of the recorded window, with [`PointOptions::classify`].

@@ -31,7 +31,7 @@ pub enum SettleMode {
     /// earlier versions, bit for bit).
     #[default]
     Fixed,
-    /// Until the motion repeats (see the [module docs](self)).
+    /// Until the motion repeats (see the module docs of `study/settle.rs`).
     Auto(AutoSettle),
 }
 
@@ -138,7 +138,7 @@ pub(super) fn section_states<'a>(
 /// At most this many Newton attempts per point.
 const MAX_SHOTS: u32 = 3;
 
-/// Settles `params` from `initial` (see the [module docs](self)): runs `sim_options`'
+/// Settles `params` from `initial` (see the module docs of `study/settle.rs`): runs `sim_options`'
 /// mechanics in blocks until the period test of `options` passes on the trailing returns,
 /// Newton shooting finishes a geometric approach, the returns prove irregular after
 /// `options.transient_periods`, or `auto.cap_periods` is reached.

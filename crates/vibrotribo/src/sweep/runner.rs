@@ -77,7 +77,7 @@ pub enum SweepError {
 }
 
 /// Runs the points of a sweep or a map: the base configuration with keys set, condensed by
-/// [`run_point`].
+/// [`run_point`](crate::study::run_point).
 #[derive(Debug, Clone)]
 pub struct PointRunner {
     base: Config,
