@@ -111,15 +111,29 @@ impl Signal {
         self.forced_mag += c.hypot(s);
     }
 
+    /// Amplitude of the harmonic part, `hypot(f_c, f_s)` (the same at every time: computed
+    /// once per search and passed to [`jet`](Self::jet)).
+    pub fn harmonic_amplitude(&self) -> f64 {
+        self.fc.hypot(self.fs)
+    }
+
     /// Value, derivatives and bounds at time `t` (phase `ph` of `t`), the bounds valid up to
-    /// the horizon `horizon` ≥ t, s, of the search.
+    /// the horizon `horizon` ≥ t, s, of the search; `amp` is
+    /// [`harmonic_amplitude`](Self::harmonic_amplitude).
     #[inline]
-    pub fn jet(&self, t: f64, ph: Phase, clusters: &[ClusterFlow], omega: f64, horizon: f64) -> Jet {
+    pub fn jet(
+        &self,
+        t: f64,
+        ph: Phase,
+        clusters: &[ClusterFlow],
+        omega: f64,
+        horizon: f64,
+        amp: f64,
+    ) -> Jet {
         let f0 = self.fc * ph.cos + self.fs * ph.sin;
         let f1 = omega * (self.fs * ph.cos - self.fc * ph.sin);
         let w2 = omega * omega;
         let mut d = [self.constant + f0, f1, -w2 * f0, -w2 * f1];
-        let amp = self.fc.hypot(self.fs);
         let mut bound = [0.0; 5];
         let mut mag = [
             self.constant_mag + self.forced_mag,

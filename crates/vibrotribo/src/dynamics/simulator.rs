@@ -534,7 +534,8 @@ impl Simulator {
                 }
                 _ => (self.force_signal(k), self.t),
             };
-            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon);
+            let amp = sig.harmonic_amplitude();
+            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon, amp);
             match first_root(eval, start, horizon) {
                 Ok(Found::Root(te)) if te < horizon => {
                     horizon = te.max(self.t);
@@ -567,7 +568,8 @@ impl Simulator {
         let mut best = None;
         let mut horizon = horizon;
         for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
-            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon);
+            let amp = sig.harmonic_amplitude();
+            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon, amp);
             match first_root(eval, self.t, horizon) {
                 Ok(Found::Root(te)) if te < horizon => {
                     horizon = te.max(self.t);
