@@ -347,9 +347,18 @@ fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
             let mut n = 0;
             let mut lo = 0.0;
             let mut plo = c[0];
-            let bound = root_bound(c) * (1.0 + 1e-12) + f64::MIN_POSITIVE;
-            for &hi in crit[..ncrit].iter().chain(std::iter::once(&bound)) {
-                let hi = hi.max(lo);
+            for k in 0..=ncrit {
+                let hi = if k < ncrit {
+                    crit[k].max(lo)
+                } else {
+                    // Beyond the last critical point the polynomial is monotone towards the
+                    // sign of its leading coefficient: no root there if it already has that
+                    // sign (or is zero), and no bound (a cube root) is needed to say so.
+                    if plo == 0.0 || (plo < 0.0) == (c[deg] < 0.0) {
+                        break;
+                    }
+                    (root_bound(c) * (1.0 + 1e-12) + f64::MIN_POSITIVE).max(lo)
+                };
                 let phi = horner(c, hi);
                 if phi == 0.0 {
                     if hi > 0.0 && n < out.len() {
