@@ -347,9 +347,14 @@ fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
             let mut n = 0;
             let mut lo = 0.0;
             let mut plo = c[0];
-            for k in 0..=ncrit {
-                let hi = if k < ncrit {
-                    crit[k].max(lo)
+            for next in crit[..ncrit]
+                .iter()
+                .copied()
+                .map(Some)
+                .chain(std::iter::once(None))
+            {
+                let hi = if let Some(critical) = next {
+                    critical.max(lo)
                 } else {
                     // Beyond the last critical point the polynomial is monotone towards the
                     // sign of its leading coefficient: no root there if it already has that
