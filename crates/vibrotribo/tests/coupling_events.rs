@@ -844,6 +844,11 @@ fn known_coupled_event_timing() {
             let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
             let scan = scan_stored_flow(&rec.traj, &chain.gaps, SCAN_GRID);
             let cf = contact_forces(&rec, &chain, &h, true);
+            println!(
+                "{name}, {load_name}: latest release {:.2e} s after its zero (t = {:.9} s), \
+                 release forces [{:.2e}, {:.2e}] N, min gap {:.2e} δ, {:?}",
+                cf.late.0, cf.late.1, cf.release_force.0, cf.release_force.1, scan.0, rec.stats
+            );
             if scan.0 < -1e-12 {
                 failures.push(format!(
                     "{name}, {load_name}: gap {:.2e} δ at {:.9} s",
