@@ -15,17 +15,18 @@
 //!   search, never below −tol.
 //! - **The contact force from the energy function.** Computed here from the state at the event
 //!   and the forces −∂U/∂D at the solver's charge, not by the engine: every stick presses, and
-//!   every release comes where the contact force, mechanical plus electrostatic, crosses zero,
-//!   within the window that ends at it and not before the zero.
+//!   every release comes where the contact force, mechanical plus electrostatic, crosses zero:
+//!   within 1e-9 s after that zero (linear interpolation over the window that ends at the
+//!   release) and not before it.
 //! - **A closed form.** In open circuit the force is constant; two masses with equal k/m
 //!   then have a relative motion r(t) = s(1 − cos ω_n t) + a sin ω_n t, whose grazing is
 //!   known exactly (tests/special_cases.rs's grazing pair, with the electrostatic pull).
 //! - **Conservation at events** (tests/reliability.rs): momentum kept, kinetic energy never
 //!   gained.
 //!
-//! The one-way accuracy of the events (stored-flow gaps ≥ −1e-12 δ as in
-//! tests/events_vs_bruteforce.rs, releases within 1e-9 s of the zero of their force) is not met
-//! everywhere: [`known_coupled_event_timing`] (ignored), notes/coupled-event-accuracy.md.
+//! The one-way accuracy of the stored flow (gaps ≥ −1e-12 δ as in
+//! tests/events_vs_bruteforce.rs) is not met everywhere: [`known_coupled_stored_flow_gaps`]
+//! (ignored), notes/coupled-event-accuracy.md.
 
 mod common;
 
@@ -617,8 +618,8 @@ fn start_charge(h: &HarvesterParams, chain: &ChainParams) -> f64 {
 /// Grid intervals per stored piece of flow in the gap scan.
 const SCAN_GRID: usize = 16;
 
-/// How long after the true zero of its contact force a release may come in the strict
-/// check, s ([`known_coupled_event_timing`]); the main checks allow the window it ends.
+/// How long before or after the true zero of its contact force a release may come, s (one-way:
+/// 1e-12 s against the closed form, tests/special_cases.rs).
 const RELEASE_TIME: f64 = 1e-9;
 
 /// Runs each sticking scenario with `load` and checks the events (see the module docs):
@@ -626,7 +627,7 @@ const RELEASE_TIME: f64 = 1e-9;
 /// kinetic energy gained at any event; every chatter sequence ends in a stick, and some of
 /// those sticks are released; every stick presses; every release comes where the contact
 /// force, mechanical + electrostatic, crosses zero: it pressed at the start of the window
-/// that ends at the release, and the release is not before its zero by more than
+/// that ends at the release, and the release is neither before nor after its zero by more than
 /// [`RELEASE_TIME`]; and the electrostatic force matters there (the mechanical force alone
 /// is far from zero).
 fn check_events_with_every_scenario(load_name: &str, load: Load) {
@@ -673,6 +674,12 @@ fn check_events_with_every_scenario(load_name: &str, load: Load) {
         assert!(
             cf.before_release >= -1e-12,
             "{what}: released late by more than a window: {cf:?}"
+        );
+        assert!(
+            cf.late.0 <= RELEASE_TIME,
+            "{what}: released {:e} s late (at {} s): {cf:?}",
+            cf.late.0,
+            cf.late.1
         );
         assert!(
             cf.early <= RELEASE_TIME,
@@ -834,14 +841,14 @@ fn grazing_pair_in_open_circuit_against_the_closed_form() {
     }
 }
 
-/// The one-way accuracy of the events, not met in two-way runs (notes/coupled-event-accuracy.md):
-/// every gap of the stored flow ≥ −1e-12 of its δ (tests/events_vs_bruteforce.rs's criterion;
-/// one-way runs of these chains reach −2.7e-13 δ at worst), and every release within
-/// [`RELEASE_TIME`] after the zero of its contact force (one-way: 1e-12 s against the closed form,
-/// tests/special_cases.rs).
+/// The one-way accuracy of the stored flow, not met in two-way runs
+/// (notes/coupled-event-accuracy.md §2): every gap of the stored flow ≥ −1e-12 of its δ
+/// (tests/events_vs_bruteforce.rs's criterion; one-way runs of these chains reach −2.7e-13 δ at
+/// worst). Also prints each run's latest release after the zero of its contact force (asserted
+/// in the main checks).
 #[test]
-#[ignore = "known: two-way events are less accurate than one-way ones (notes/coupled-event-accuracy.md)"]
-fn known_coupled_event_timing() {
+#[ignore = "known: two-way stored-flow gaps go below one-way's −1e-12 δ (notes/coupled-event-accuracy.md)"]
+fn known_coupled_stored_flow_gaps() {
     let mut failures = Vec::new();
     for (name, chain, periods) in sticking_scenarios() {
         for (load_name, load) in loads(1e5) {
@@ -850,17 +857,15 @@ fn known_coupled_event_timing() {
             let rec = coupled_run(&chain, &ChainState::at_rest(chain.len()), &h, periods);
             let scan = scan_stored_flow(&rec.traj, &chain.gaps, SCAN_GRID);
             let cf = contact_forces(&rec, &chain, &h, true);
+            println!(
+                "{name}, {load_name}: latest release {:.2e} s after its zero (t = {:.9} s), \
+                 release forces [{:.2e}, {:.2e}] N, min gap {:.2e} δ, {:?}",
+                cf.late.0, cf.late.1, cf.release_force.0, cf.release_force.1, scan.0, rec.stats
+            );
             if scan.0 < -1e-12 {
                 failures.push(format!(
                     "{name}, {load_name}: gap {:.2e} δ at {:.9} s",
                     scan.0, scan.1
-                ));
-            }
-            if cf.late.0 > RELEASE_TIME {
-                failures.push(format!(
-                    "{name}, {load_name}: release at {:.9} s {:.2e} s after the zero of its force \
-                     ({:.2e} N there)",
-                    cf.late.1, cf.late.0, cf.release_force.0
                 ));
             }
         }

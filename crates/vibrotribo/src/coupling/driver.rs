@@ -7,7 +7,9 @@ use thiserror::Error;
 
 use super::CouplingOptions;
 use super::window::{ChargePolynomial, DEGREE, NODES, force_polynomial, nodes, significant_degree};
-use crate::dynamics::{Event, Flow, Observer, RunEnd, Segment, Simulator, StateView, Verdict};
+use crate::dynamics::{
+    ContactStatus, Event, EventKind, Flow, Observer, RunEnd, Segment, Simulator, StateView, Verdict,
+};
 use crate::electrical::{ChargeMoments, ChargeSolver, ElectricalError, Electrostatics, NoFieldEnergy};
 use crate::error::SimError;
 use crate::model::{ChainState, ForcePolynomial};
@@ -122,6 +124,9 @@ pub struct CoupledChain {
     min_stiffness: f64,
     stats: CouplingStats,
     started: bool,
+    /// The time of the last window of length zero (an event at its start), s, and how many
+    /// such windows in a row were accepted there.
+    instant: (f64, u32),
     /// Per mass: the force polynomial of the current trial (N/sʲ in t − t₀).
     forces: Vec<ForcePolynomial>,
     /// Per mass: the impulse and first moment (`∫F dτ`, `∫τ F dτ` over the window, N·s,
@@ -163,6 +168,7 @@ impl CoupledChain {
             min_stiffness,
             stats: CouplingStats::default(),
             started: false,
+            instant: (f64::NAN, 0),
             forces: vec![ForcePolynomial::zero(); n],
             target: vec![[0.0; 2]; n],
             segments: Vec::new(),
@@ -244,11 +250,7 @@ impl CoupledChain {
 
     /// The charge tolerance of a window of length `h`, C, around charge `q0`.
     fn charge_tolerance(&self, h: f64, q0: f64, scale: f64) -> f64 {
-        let slope: f64 = self
-            .statics
-            .gap_force_polynomials()
-            .map(|(_, c)| c[1].abs() + 2.0 * c[2].abs() * (q0.abs() + scale))
-            .fold(0.0, f64::max);
+        let slope = self.force_slope(q0.abs() + scale);
         let tol_x = self.options.position_tolerance;
         let omega = 2.0 * std::f64::consts::PI / self.sim.period();
         // The force error δF = slope·δQ moves a mass by ∫(h − τ)δF/m ≤ h²·mean|δF|/m and
@@ -256,6 +258,47 @@ impl CoupledChain {
         let by_position = tol_x * self.min_mass / (slope * h * h);
         let by_velocity = tol_x * omega * self.min_mass / (slope * h);
         by_position.min(by_velocity).max(1e-15 * scale)
+    }
+
+    /// The largest `|∂G_k/∂Q|` of a gap force for charges up to `q` in magnitude, N/C.
+    fn force_slope(&self, q: f64) -> f64 {
+        self.statics
+            .gap_force_polynomials()
+            .map(|(_, c)| c[1].abs() + 2.0 * c[2].abs() * q)
+            .fold(0.0, f64::max)
+    }
+
+    /// The force error, N, allowed on a mass where the engine decides a contact (a stick or a
+    /// release at a window's end): the force of the weakest spring stretched by the position
+    /// tolerance. A release then comes within this force over the contact force's rate of
+    /// the zero of the force of the solver's charge.
+    fn force_tolerance(&self) -> f64 {
+        self.min_stiffness * self.options.position_tolerance
+    }
+
+    /// How far the installed force at `span` after the window's start misses the force of the
+    /// charge `q` on any mass, against [`force_tolerance`](Self::force_tolerance) (≤ 1 passes).
+    fn end_force_error(&self, span: f64, q: f64) -> f64 {
+        self.end_force_errors(span, q).0 / self.force_tolerance()
+    }
+
+    /// The largest and the summed `|installed − exact|` force on the masses at `span` after
+    /// the window's start, N (see [`end_force_error`](Self::end_force_error)).
+    fn end_force_errors(&self, span: f64, q: f64) -> (f64, f64) {
+        let mut worst: f64 = 0.0;
+        let mut sum = 0.0;
+        let mut exact = vec![0.0; self.forces.len()];
+        for (k, c) in self.statics.gap_force_polynomials() {
+            let g = c[0] + c[1] * q + c[2] * q * q;
+            exact[k] += g;
+            exact[k + 1] -= g;
+        }
+        for (f, e) in self.forces.iter().zip(&exact) {
+            let installed = f.coefficients.iter().rev().fold(0.0, |acc, &c| acc * span + c);
+            worst = worst.max((installed - e).abs());
+            sum += (installed - e).abs();
+        }
+        (worst, sum)
     }
 
     /// Installs on `sim` the force polynomials of the charge `q` on a window from `t0`.
@@ -380,9 +423,13 @@ impl CoupledChain {
     /// solution of a force term f_j τʲ carries terms up to j!/(ω_n h)ʲ times its static
     /// effect f_j hʲ/K, which the homogeneous part then cancels. Constant on windows shorter
     /// than [`CONSTANT_BELOW`] periods.
-    fn fit(&self, values: &[f64; NODES], h: f64) -> ChargePolynomial {
+    ///
+    /// On a window that decides a contact (`precise`, see [`window`](Self::window)) the
+    /// budget alone decides at every length: there the force at the window's end must meet the
+    /// force tolerance, which a constant does not where the force changes.
+    fn fit(&self, values: &[f64; NODES], h: f64, precise: bool) -> ChargePolynomial {
         let period = self.sim.period();
-        if h < CONSTANT_BELOW * period {
+        if !precise && h < CONSTANT_BELOW * period {
             return ChargePolynomial::constant(values[0], h);
         }
         let full = ChargePolynomial::new(values, h);
@@ -420,8 +467,25 @@ impl CoupledChain {
         let mut h = self.h.min(limit - t0);
         let q0 = host.charge_solver().charge();
         let scale = host.charge_solver().transducer().charge_scale();
+        // Whether the window decides a contact: a contact is stuck (or in a chatter sequence)
+        // at its start, or a trial of it ended at a stick, release or chatter point. Its force
+        // must then also meet the force tolerance at its end, where the engine decides.
+        //
+        // Not after two windows of length zero at this instant: the events at a window's start
+        // are decided with the first trial that sees one, and the trials' force polynomials
+        // agree at the start but not in their derivatives, which decide a pair whose contact
+        // force is zero there (a stick at a chatter point). Trials that keep those derivatives
+        // could then undo each other's events at one instant (stick, release, stick, ...);
+        // such a window keeps the forces of a window that decides nothing, as before.
+        let settled = !(self.instant.0 == t0 && self.instant.1 >= 2);
+        let mut precise = settled
+            && self
+                .sim
+                .contact_status()
+                .iter()
+                .any(|s| *s != ContactStatus::Open);
         let mut guess = match self.previous {
-            Some(p) if !p.cut => self.fit(&p.charge.values_at_nodes(t0 - p.t0, h), h),
+            Some(p) if !p.cut => self.fit(&p.charge.values_at_nodes(t0 - p.t0, h), h, precise),
             _ => ChargePolynomial::constant(q0, h),
         };
         let mut sweeps = 0;
@@ -433,7 +497,10 @@ impl CoupledChain {
             sweeps += 1;
             self.stats.sweeps += 1;
             let tol = self.charge_tolerance(h, q0, scale);
-            let negligible = 0.01 * 2.0 * self.options.position_tolerance * self.min_mass / (h * h);
+            let mut negligible = 0.01 * 2.0 * self.options.position_tolerance * self.min_mass / (h * h);
+            if precise {
+                negligible = negligible.min(0.25 * self.force_tolerance());
+            }
             let cp = host.charge_solver().checkpoint();
             let tracked = host.charge_solver().start_moments(t0, q0);
             let mut trial = self.sim.clone();
@@ -481,16 +548,26 @@ impl CoupledChain {
                     if shorter <= 0.0 {
                         // The event is at the window's start: accept it with no flow.
                         host.charge_solver().stop_moments();
+                        self.instant = if self.instant.0 == t0 {
+                            (t0, self.instant.1 + 1)
+                        } else {
+                            (t0, 1)
+                        };
                         self.accept(trial, t0, ChargePolynomial::constant(q0, 0.0), true, None);
                         return Ok(());
                     }
-                    guess = self.fit(&guess.values_at_nodes(0.0, shorter), shorter);
+                    guess = self.fit(&guess.values_at_nodes(0.0, shorter), shorter, precise);
                     h = shorter;
                     matched = false;
                     continue;
                 }
             }
-            let sampled = self.fit(&values, h);
+            let decided = settled
+                && self.events.iter().any(|(e, _, _)| {
+                    matches!(e.kind, EventKind::Stick | EventKind::Release | EventKind::Chatter)
+                });
+            precise = precise || decided;
+            let sampled = self.fit(&values, h, precise);
             let misfit = guess
                 .values_at_nodes(0.0, h)
                 .iter()
@@ -506,6 +583,29 @@ impl CoupledChain {
                 }
                 _ => 0.0,
             };
+            // Below CONSTANT_BELOW periods the window itself bounds how far a decision at its
+            // end can be from the zero of the force (every window starts at the force of the
+            // solver's charge), and the force test is not made.
+            //
+            // A window that only has a contact stuck (none decided in it) is held to the test
+            // only where a release may hide at its end: where the engine's contact force there
+            // is within the force error of zero. A contact force is r·ΣF_G − Σ_{i≤j}F_i with
+            // 0 ≤ r ≤ 1, so its error is at most the summed error on the masses; beyond that its
+            // sign is the true force's and the window decides nothing. (Testing every window of
+            // a long sticking phase cost up to 61× in the chatter case at low Ω.)
+            let force_error = if precise && span > 0.0 && h > CONSTANT_BELOW * period {
+                let q = host.charge_solver().charge();
+                let (_, summed) = self.end_force_errors(span, q);
+                let near = decided
+                    || trial
+                        .contact_forces()
+                        .iter()
+                        .flatten()
+                        .any(|n| n.abs() <= summed + self.force_tolerance());
+                if near { self.end_force_error(span, q) } else { 0.0 }
+            } else {
+                0.0
+            };
             if estimate > tol {
                 host.charge_solver().rewind(&cp);
                 self.stats.shortened += 1;
@@ -514,23 +614,26 @@ impl CoupledChain {
                 if shorter <= MIN_WINDOW * period {
                     return Err(CouplingError::WindowCollapsed { t: t0, h: shorter });
                 }
-                guess = self.fit(&sampled.values_at_nodes(0.0, shorter), shorter);
+                guess = self.fit(&sampled.values_at_nodes(0.0, shorter), shorter, precise);
                 h = shorter;
                 self.h = self.h.min(h);
                 sweeps = 0;
                 matched = false;
                 continue;
             }
-            if misfit > tol || moment_error > 1.0 {
+            if misfit > tol || moment_error > 1.0 || force_error > 1.0 {
                 host.charge_solver().rewind(&cp);
-                if sweeps >= self.options.max_iterations {
+                // The end force still off after a few sweeps: the window is too long for the
+                // polynomial (a transient it does not resolve), not the guess too far.
+                let stalled = force_error > 1.0 && sweeps >= 3;
+                if sweeps >= self.options.max_iterations || stalled {
                     h *= 0.5;
                     if h <= MIN_WINDOW * period {
                         return Err(CouplingError::WindowCollapsed { t: t0, h });
                     }
                     self.h = self.h.min(h);
                     sweeps = 0;
-                    guess = self.fit(&sampled.values_at_nodes(0.0, h), h);
+                    guess = self.fit(&sampled.values_at_nodes(0.0, h), h, precise);
                     matched = false;
                 } else {
                     guess = sampled;

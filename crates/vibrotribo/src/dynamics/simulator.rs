@@ -278,6 +278,23 @@ impl Simulator {
         self.forces.at(i, t).0
     }
 
+    /// Contact force of each closed (stuck or chattering) contact at the current time, N,
+    /// compressive positive (the function whose zero releases it); `None` for an open or
+    /// resting contact. Indexed like [`contact_status`](Self::contact_status).
+    pub fn contact_forces(&self) -> Vec<Option<f64>> {
+        let w = self.forcing.omega;
+        (0..self.closure.len())
+            .map(|k| match self.closure[k] {
+                Closure::Stuck | Closure::Chatter { .. } if !self.absent(k) => {
+                    let sig = self.force_signal(k);
+                    let amp = sig.harmonic_amplitude();
+                    Some(sig.jet(self.t, self.phase_now, &self.clusters, w, self.t, amp).d[0])
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Status of each contact (index k: between mass k and k+1, 0-based; with stops, N − 1 is
     /// the lower stop and N the upper one, see [`ChainParams::contact_count`]).
     pub fn contact_status(&self) -> Vec<ContactStatus> {
