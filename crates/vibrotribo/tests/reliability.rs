@@ -36,6 +36,8 @@
 //! rounded to a few ulps at an impact, which moves E by a few ulps of Σ m v²; 256 leaves a wide
 //! margin for impulses resolved over several pairwise iterations).
 
+mod common;
+
 use std::f64::consts::PI;
 
 use rand::rngs::StdRng;
@@ -508,16 +510,8 @@ impl Observer for Invariants<'_> {
     }
     fn event(&mut self, _event: &Event, state: &StateView<'_>) {
         self.events += 1;
-        let m = &self.params.masses;
-        let momentum = |v: &[f64]| m.iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
-        let energy = |v: &[f64]| m.iter().zip(v).map(|(m, v)| 0.5 * m * v * v).sum::<f64>();
-        let size = |v: &[f64]| m.iter().zip(v).map(|(m, v)| (m * v).abs()).sum::<f64>();
-        let p_scale = size(&self.v_before).max(size(state.velocities)) + f64::MIN_POSITIVE;
-        let dp = (momentum(state.velocities) - momentum(&self.v_before)).abs() / p_scale;
+        let (dp, de) = common::event_jumps(&self.params.masses, &self.v_before, state.velocities);
         self.worst_momentum = self.worst_momentum.max(dp);
-        // Relative to Σ m v² = 2E before the event.
-        let e0 = energy(&self.v_before);
-        let de = (energy(state.velocities) - e0) / (2.0 * e0 + f64::MIN_POSITIVE);
         self.worst_energy = self.worst_energy.max(de);
         for k in 0..self.params.gaps.len() {
             let gap = self.params.gaps[k] - (state.positions[k + 1] - state.positions[k]);

@@ -9,6 +9,21 @@ pub mod quadrature;
 use ode_solvers::{DVector, Dop853, OutputType, System};
 use vibrotribo::{ChainParams, ChainState, Excitation, Frequency};
 
+/// What an event did to masses `m` whose velocities went from `before` to `after`: the change
+/// of momentum relative to the summed |m v| before and after (≈ 0 for an exchange inside the
+/// chain), and the gain of kinetic energy relative to Σ m v² before (≤ 0 for an impact or a
+/// stick).
+pub fn event_jumps(m: &[f64], before: &[f64], after: &[f64]) -> (f64, f64) {
+    let momentum = |v: &[f64]| m.iter().zip(v).map(|(m, v)| m * v).sum::<f64>();
+    let energy = |v: &[f64]| m.iter().zip(v).map(|(m, v)| 0.5 * m * v * v).sum::<f64>();
+    let size = |v: &[f64]| m.iter().zip(v).map(|(m, v)| (m * v).abs()).sum::<f64>();
+    let p_scale = size(before).max(size(after)) + f64::MIN_POSITIVE;
+    let dp = (momentum(after) - momentum(before)).abs() / p_scale;
+    let e0 = energy(before);
+    let de = (energy(after) - e0) / (2.0 * e0 + f64::MIN_POSITIVE);
+    (dp, de)
+}
+
 /// The equations of motion of a chain partitioned into clusters (each a contiguous range of
 /// masses moving as one body), integrated numerically. State: [s_c, v_c] per cluster, where
 /// s_c is the position of the cluster's top mass.
@@ -227,6 +242,34 @@ pub fn random_chain(rng: &mut Lcg, n: usize, mu: f64) -> (ChainParams, vibrotrib
         velocities: (0..n).map(|_| rng.range(-0.3, 0.3) * v).collect(),
     };
     (params, state)
+}
+
+/// Asserts that `e` is the first contact of a grazing pair at its closed-form time
+/// `t_expected`, s, and closing speed `v_expected`, m/s, for an overlap `eps` ≥ 0 of the gap:
+/// an exact graze (ε = 0, a double root, which rounding noise η in the gap moves by
+/// √(2η/d'') ~ 1e-9 s) within 1e-7 s and slower than 1e-6 m/s; a crossing within
+/// 1e-12 s + 1e-14/v and 1e-6 of its speed.
+pub fn assert_grazing_contact(e: &vibrotribo::Event, eps: f64, t_expected: f64, v_expected: f64) {
+    assert_eq!(e.kind, vibrotribo::EventKind::Impact);
+    if eps == 0.0 {
+        assert!(
+            (e.time - t_expected).abs() < 1e-7,
+            "graze at {} expected {t_expected}",
+            e.time
+        );
+        assert!(e.velocity_before < 1e-6, "grazing speed {}", e.velocity_before);
+    } else {
+        assert!(
+            (e.time - t_expected).abs() < 1e-12 + 1e-14 / v_expected,
+            "ε = {eps}: t = {} expected {t_expected}",
+            e.time
+        );
+        assert!(
+            (e.velocity_before - v_expected).abs() < 1e-6 * v_expected,
+            "ε = {eps}: v = {} expected {v_expected}",
+            e.velocity_before
+        );
+    }
 }
 
 /// Two undamped masses with equal k/m: the base motion cancels in the relative coordinate
