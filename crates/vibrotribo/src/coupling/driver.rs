@@ -277,13 +277,8 @@ impl CoupledChain {
     }
 
     /// How far the installed force at `span` after the window's start misses the force of the
-    /// charge `q` on any mass, against [`force_tolerance`](Self::force_tolerance) (≤ 1 passes).
-    fn end_force_error(&self, span: f64, q: f64) -> f64 {
-        self.end_force_errors(span, q).0 / self.force_tolerance()
-    }
-
-    /// The largest and the summed `|installed − exact|` force on the masses at `span` after
-    /// the window's start, N (see [`end_force_error`](Self::end_force_error)).
+    /// charge `q` on the masses, N: the largest and the summed `|installed − exact|` (the
+    /// largest against [`force_tolerance`](Self::force_tolerance) is the window's end test).
     fn end_force_errors(&self, span: f64, q: f64) -> (f64, f64) {
         let mut worst: f64 = 0.0;
         let mut sum = 0.0;
@@ -595,14 +590,14 @@ impl CoupledChain {
             // a long sticking phase cost up to 61× in the chatter case at low Ω.)
             let force_error = if precise && span > 0.0 && h > CONSTANT_BELOW * period {
                 let q = host.charge_solver().charge();
-                let (_, summed) = self.end_force_errors(span, q);
+                let (worst, summed) = self.end_force_errors(span, q);
                 let near = decided
                     || trial
                         .contact_forces()
                         .iter()
                         .flatten()
                         .any(|n| n.abs() <= summed + self.force_tolerance());
-                if near { self.end_force_error(span, q) } else { 0.0 }
+                if near { worst / self.force_tolerance() } else { 0.0 }
             } else {
                 0.0
             };
