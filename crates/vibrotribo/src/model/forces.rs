@@ -14,6 +14,13 @@ use super::ChainParams;
 /// Highest degree of a [`ForcePolynomial`].
 pub const MAX_FORCE_DEGREE: usize = crate::dynamics::poly::MAX_DEGREE;
 
+// The validation message spells the limit out (it said "degree 8" long after the limit had
+// become 12): change it with the limit.
+const _: () = assert!(
+    MAX_FORCE_DEGREE == 12,
+    "update the message in ForcePolynomial::validate"
+);
+
 /// An external force on one mass as a polynomial in time,
 /// `f(t) = Σ_j c_j (t − t_ref)^j`, N, of degree at most [`MAX_FORCE_DEGREE`].
 ///
@@ -70,7 +77,7 @@ impl ForcePolynomial {
             format!("{name}.coefficients"),
             len as f64,
             len <= MAX_FORCE_DEGREE + 1,
-            "must have at most 9 entries (degree 8)",
+            "must have at most 13 entries (degree 12)",
         )?;
         for (j, &c) in self.coefficients.iter().enumerate() {
             check_finite(&format!("{name}.coefficients[{j}]"), c)?;
@@ -96,5 +103,32 @@ impl ChainParams {
             check_finite(&format!("forces[{i}]"), f)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_degree_limit_is_the_one_the_message_names() {
+        let at_limit = ForcePolynomial {
+            t_ref: 0.0,
+            coefficients: vec![1.0; MAX_FORCE_DEGREE + 1],
+        };
+        assert!(at_limit.validate("forces[0]").is_ok());
+        let over = ForcePolynomial {
+            t_ref: 0.0,
+            coefficients: vec![1.0; MAX_FORCE_DEGREE + 2],
+        };
+        let message = over.validate("forces[0]").unwrap_err().to_string();
+        assert!(message.contains("forces[0].coefficients"), "{message}");
+        assert!(
+            message.contains(&format!(
+                "at most {} entries (degree {MAX_FORCE_DEGREE})",
+                MAX_FORCE_DEGREE + 1
+            )),
+            "{message}"
+        );
     }
 }

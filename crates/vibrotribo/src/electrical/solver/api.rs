@@ -538,14 +538,21 @@ impl ChargeSolver {
         match self.load {
             LoadModel::Resistor { conductance } => {
                 let tab = self.tab_resistor;
-                self.integrate(&tab, ta, tb, n0, wave, |s, h, n0, nodes, trial| {
-                    s.trial_resistor(&tab, conductance, h, n0, nodes, trial);
-                    true
-                })?;
+                // The boundary layer after the kink in closed form where it fits in one step.
+                let (start, n_start, kink) = match self.layer_step(&tab, conductance, ta, tb, n0, wave)? {
+                    Some((t1, n1)) => (t1, n1, false),
+                    None => (ta, n0, true),
+                };
+                if start < tb {
+                    self.integrate(&tab, start, tb, n_start, wave, kink, |s, h, n0, nodes, trial| {
+                        s.trial_resistor(&tab, conductance, h, n0, nodes, trial);
+                        true
+                    })?;
+                }
             }
             LoadModel::Rectifier(load) => {
                 let tab = self.tab_rectifier;
-                self.integrate(&tab, ta, tb, n0, wave, |s, h, n0, nodes, trial| {
+                self.integrate(&tab, ta, tb, n0, wave, true, |s, h, n0, nodes, trial| {
                     s.trial_rectifier(&tab, &load, h, n0, nodes, trial)
                 })?;
             }

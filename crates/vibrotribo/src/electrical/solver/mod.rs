@@ -58,10 +58,14 @@
 //! RADAU5's controller with Gustafsson's predictive variant (`h ∝ err^(−1/(S+1))`). Where the
 //! estimate cannot see the solution's structure, the step is shaped directly:
 //!
-//! - after a kink the resistor's charge crosses a boundary layer of width `RC`; its amplitude
-//!   is estimated from the quasi-static charge `u ≈ −I_sc/k`, the layer is entered at
-//!   `h·k = 2`, and once it has decayed below the tolerance the step returns to the size it
-//!   had before the kink;
+//! - after a kink the resistor's charge crosses a boundary layer of width `RC`. By default
+//!   (`ChargeOptions::analytic_layers`) one step carries it in closed form: the step integrates
+//!   the slow solution, started where Hairer's estimate vanishes, and adds the layer's decaying
+//!   exponential and its energy exactly (the `layer` module). Where that step does not fit
+//!   (a piece shorter than ~30 R·C, charge moments being taken) the layer is crossed with short
+//!   steps: its amplitude is estimated from the quasi-static charge `u ≈ −I_sc/k`, the layer is
+//!   entered at `h·k = 2`, and once it has decayed below the tolerance the step returns to the
+//!   size it had before the kink;
 //! - a failed stiff rectifier step (the bridge switching) jumps to `h·k ≈ 2`, and a rectifier
 //!   step in which a conducting junction's voltage moves by more than 4 n·V_T is retried
 //!   shorter: the current changes by orders of magnitude there, which neither the collocation
@@ -75,6 +79,7 @@
 
 mod api;
 mod checkpoint;
+mod layer;
 mod output;
 mod results;
 mod state;

@@ -13,7 +13,9 @@ impl ChargeSolver {
     /// quasi-static `u` is smooth where `Q` nearly equals `Q_eq`); a non-stiff one evaluates the
     /// collocation polynomial of `Q` and subtracts the exact `Q_eq(t)`.
     pub(super) fn dense(&self, step: &Step, t: f64, qeq: f64) -> ([f64; 2], f64) {
-        if step.stages == RESISTOR_STAGES {
+        if let Some(layer) = &step.layer {
+            super::layer::dense_layer(&self.tab_resistor, step, layer, t)
+        } else if step.stages == RESISTOR_STAGES {
             dense_with(&self.tab_resistor, step, t, qeq)
         } else {
             dense_with(&self.tab_rectifier, step, t, qeq)

@@ -22,6 +22,10 @@ pub struct ChargeOptions {
     /// Guard against runaway step counts (`electrical.max_steps_per_period`): at most this
     /// many steps, accepted or rejected, within one excitation period. Default 10 000 000.
     pub max_steps_per_period: u64,
+    /// Resistor: carry the boundary layer after a kink (width R·C) in closed form within one
+    /// step instead of crossing it with short steps (`electrical.analytic_layers`, default
+    /// true; see the solver's `layer` module). Same results within the tolerance, fewer steps.
+    pub analytic_layers: bool,
 }
 
 impl Default for ChargeOptions {
@@ -30,6 +34,7 @@ impl Default for ChargeOptions {
             rtol: 1e-5,
             atol_voltage: None,
             max_steps_per_period: 10_000_000,
+            analytic_layers: true,
         }
     }
 }

@@ -77,6 +77,8 @@ pub(super) struct Step {
     pub(super) qeq0: f64,
     pub(super) dq: [f64; MAX_STAGES],
     pub(super) stiff: bool,
+    /// The boundary layer carried in closed form by this step, if any (`layer.rs`).
+    pub(super) layer: Option<super::layer::LayerTerm>,
 }
 
 /// Result of solving the stages of one trial step (one buffer reused for every trial).

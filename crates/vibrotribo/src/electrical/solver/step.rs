@@ -13,7 +13,10 @@ use crate::electrical::waveform::GapWaveform;
 
 impl ChargeSolver {
     /// Integrates `[ta, tb]` (smooth) with Radau IIA of `S` stages; `solve` solves the stage
-    /// system of one trial step (false if it failed, with `trial.retry` set).
+    /// system of one trial step (false if it failed, with `trial.retry` set). `kink`: `ta` is
+    /// a kink (a new error history, a boundary layer to cross); false where the piece goes on
+    /// from a step that already crossed it (`layer_step`).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn integrate<W, const S: usize, F>(
         &mut self,
         tab: &Tableau<S>,
@@ -21,6 +24,7 @@ impl ChargeSolver {
         tb: f64,
         mut n0: TransducerState,
         wave: &W,
+        kink: bool,
         mut solve: F,
     ) -> Result<(), ElectricalError>
     where
@@ -29,14 +33,17 @@ impl ChargeSolver {
     {
         let mut t = ta;
         let c = tab.c;
-        // A kink starts a new error history.
-        self.have_acc = false;
-        let mut layer = self.kink_start(&n0);
+        let mut layer = None;
+        if kink {
+            // A kink starts a new error history.
+            self.have_acc = false;
+            layer = self.kink_start(&n0);
+            // The last step's polynomial does not extrapolate across a kink.
+            self.smooth_since_last_step = false;
+        }
         let mut trial = Trial::<S>::new();
         // Step size at which the stage solver last failed.
         let mut solve_cap = f64::INFINITY;
-        // The last step's polynomial does not extrapolate across a kink.
-        self.smooth_since_last_step = false;
         while t < tb {
             self.steps_in_period += 1;
             if self.steps_in_period > self.options.max_steps_per_period {
@@ -92,8 +99,18 @@ impl ChargeSolver {
                 self.record(wave)?;
                 let hnew = self.controller::<S>(h, err, true);
                 self.h = if clipped {
-                    // A step shortened to meet the interval end says little about the next.
-                    (h * 0.9 / err_root::<S>(err.max(1e-10))).min(h_prop).max(hnew)
+                    // A step shortened to meet the interval end says little about the next:
+                    // it grows back to the step proposed before at most as its error allows,
+                    // and at once where its error is at the floor (no error signal at all: a
+                    // piece a few ulps long, such as coupled windows ending next to an event,
+                    // left the next piece to start from a step of a few ulps, which failed as
+                    // an underflow).
+                    let back = if err <= 1e-10 {
+                        h_prop
+                    } else {
+                        (h * 0.9 / err_root::<S>(err)).min(h_prop)
+                    };
+                    back.max(hnew)
                 } else {
                     hnew
                 };
@@ -136,7 +153,8 @@ impl ChargeSolver {
                 // does not fall with h until h·k ~ 1: go there at once. For the resistor only
                 // the first step of a piece meets one (after the kink); the rectifier meets
                 // one at every switching of the bridge.
-                let layer_possible = t == ta || matches!(self.load, LoadModel::Rectifier(_));
+                // (Not after a layer carried in closed form: `kink` is false then.)
+                let layer_possible = (kink && t == ta) || matches!(self.load, LoadModel::Rectifier(_));
                 if solved && layer_possible && trial.hk > 2.0 {
                     self.h = self.h.min(2.0 * h / trial.hk);
                 }
@@ -581,6 +599,7 @@ impl ChargeSolver {
             qeq0: trial.qeq0,
             dq: pad(&trial.dq),
             stiff: trial.stiff,
+            layer: None,
         });
         self.stats.steps += 1;
         self.t = t1;

@@ -1,0 +1,601 @@
+//! The resistor's boundary layer after a kink, carried in closed form.
+//!
+//! ## What it replaces
+//!
+//! After a kink (an impact changes the gaps' velocities, so the short-circuit current jumps)
+//! the resistor's charge `u = Q − Q_eq` leaves its slow solution and relaxes back to it as
+//! `exp(−∫k dt)`, `k = 1/(RC)`, a layer of width R·C (~0.2–90 µs at 100 kΩ). Resolving it
+//! with collocation steps took about 40 % of all accepted Radau steps on the paper's cases
+//! (`bench/README.md`, "The boundary layer in closed form").
+//!
+//! ## Method
+//!
+//! `u' = −k(t)·u − I_sc(t)` is linear, so `u = w + δ·φ(t)` with `φ = exp(−∫_{t₀}^t k)` and `w`
+//! any solution of the same equation. The first step after the kink integrates `w`, started
+//! on the slow solution, and carries `δ·φ` exactly:
+//!
+//! 1. **The slow start `w₀`.** The collocation polynomial of a step (degree S through t₀ and the
+//!    S Radau nodes) is asked to satisfy the equation at t₀ as well as at the nodes: S + 1
+//!    conditions for the S stage values and `w₀`. For the exact slow solution these hold to
+//!    the collocation error; a start off the slow solution by `ε` violates the condition at t₀
+//!    by `k₀ε`. This is the same quantity Hairer's embedded estimate measures (`γ₀(h f₀ +
+//!    Σ ddᵢ Zᵢ)`, `f₀` the derivative at t₀), so the step is the Radau step from the `w₀`
+//!    whose estimate vanishes. So that this estimate is not missed, the step is short: as
+//!    long as the layer needs (~30–40 R·C), and resolved far better than the tolerance where
+//!    it is at most a third of the step the controller had before the kink (error ∝ h⁸).
+//!    Longer layer steps are checked by step doubling instead: `w₀`, the end, and the full
+//!    step's polynomial at the stage points of two half steps (its interior has only the
+//!    stage order 7, the end order 13) must agree within the voltage tolerance. After the
+//!    layer step the next step resumes the step size from before the kink.
+//! 2. **The layer `δ·φ`,** `δ = u(t₀) − w₀`, with `∫k` from the interpolant of the stage
+//!    elastances (the quadrature of the method's own A matrix at the stages). The step must
+//!    be long enough for the layer to decay below the tolerance within it (and to hold the
+//!    quadrature nodes below).
+//! 3. **The energy** `∫ G e² u² dt` (G = 1/R, e the elastance) splits into the slow part
+//!    `∫ G e² w²`, the method's quadrature of the stage powers of `w` as for any step, and the
+//!    layer's part `∫ G e² (2wδφ + δ²φ²)`, by Gauss–Laguerre quadrature (10 nodes) in the
+//!    scaled time `s = k·(t − t₀)` with `e`, `w` and `∫k` from the step's interpolants. The
+//!    two terms have their own scales (φ and φ²), so each integrand is smooth against
+//!    Laguerre's weight.
+//!
+//! Outputs at the stages (the air-breakdown check, peaks) and dense output (samples, the V–Q
+//! cycle) add `δ·φ` and the layer's partial energy. Not used for the rectifier (nonlinear),
+//! with charge moments (two-way coupling, whose windows are short), or where the piece is too
+//! short for the layer (or the step doubling fails): then the layer is crossed with short
+//! steps as before (`ChargeSolver::kink_start`).
+
+use super::state::{ChargeSolver, LAYER_MARGIN, MAX_STAGES, NOISE, RESISTOR_STAGES, Step, Trial};
+use crate::electrical::ElectricalError;
+use crate::electrical::radau::{Tableau, solve_unpivoted};
+use crate::electrical::transducer::TransducerState;
+use crate::electrical::waveform::GapWaveform;
+
+/// Nodes of 10-point Gauss–Laguerre quadrature, `∫₀^∞ e^(−s) f(s) ds ≈ Σ wᵢ f(xᵢ)` (numpy's
+/// `laggauss(10)`; exact for polynomials of degree ≤ 19). Each term of the layer's energy is
+/// taken in its own scaled time, where its integrand is smooth and nearly constant.
+const LAGUERRE_X: [f64; 10] = [
+    0.1377934705404926,
+    0.729454549503171,
+    1.8083429017403159,
+    3.4014336978548996,
+    5.552496140063804,
+    8.330152746764497,
+    11.843785837900066,
+    16.279257831378104,
+    21.99658581198076,
+    29.92069701227389,
+];
+
+/// Weights of the same quadrature.
+const LAGUERRE_W: [f64; 10] = [
+    0.3084411157650173,
+    0.4011199291552761,
+    0.2180682876118096,
+    0.062087456098677773,
+    0.0095015169751811,
+    0.0007530083885875384,
+    2.8259233495995642e-05,
+    4.249313984962698e-07,
+    1.839564823979633e-09,
+    9.91182721960906e-13,
+];
+
+/// Smallest `h·k` of a step that carries a layer: its Laguerre nodes (up to s = 29.9) then lie
+/// inside it.
+const MIN_HK: f64 = 32.0;
+
+/// `∫k dt` beyond the layer's own need by which it must have decayed at the step's end
+/// (`e^(−2)` of the tolerance, on top of the margin of `kink_start`).
+const DECAY_MARGIN: f64 = 2.0;
+
+/// A layer step at most this fraction of the step the controller had before the kink is not
+/// checked by step doubling: its slow part's collocation error is then below
+/// `(1/3)^(S+1) = 1.5e-4` of that of a step the estimate accepted.
+const UNCHECKED_FRACTION: f64 = 1.0 / 3.0;
+
+/// Beyond this `∫k dt` the layer's remaining energy is taken as zero (`e^(−60)`).
+const NEGLIGIBLE_DECAY: f64 = 60.0;
+
+/// Coefficients of a polynomial in θ ∈ [0, 1] (θ = (t − t₀)/h), lowest first; degree ≤ 8.
+type Mono = [f64; MAX_STAGES + 2];
+
+/// The layer term `δ·φ(t)` of a step and what its outputs need (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct LayerTerm {
+    /// Layer amplitude δ = u(t₀) − w₀, C.
+    pub(super) delta: f64,
+    /// Load conductance G = 1/R, S.
+    conductance: f64,
+    /// Step length, s.
+    h: f64,
+    /// Elastance interpolant e(θ), 1/F.
+    elastance: Mono,
+    /// Slow charge interpolant w(θ), C.
+    slow: Mono,
+    /// `K(θ) = ∫_{t₀}^{t₀+θh} k dt` (dimensionless).
+    decay: Mono,
+    /// The layer's energy over the whole step, J.
+    pub(super) energy: f64,
+}
+
+impl LayerTerm {
+    /// `φ(θ) = exp(−K(θ))`.
+    pub(super) fn phi(&self, theta: f64) -> f64 {
+        (-horner(&self.decay, theta)).exp()
+    }
+
+    /// The layer's energy `∫ G e²(2wδφ + δ²φ²) dt` from `t₀ + θh` to the layer's end, J.
+    pub(super) fn energy_after(&self, theta: f64) -> f64 {
+        let k_theta = horner(&self.decay, theta);
+        if k_theta > NEGLIGIBLE_DECAY {
+            return 0.0;
+        }
+        let phi0 = (-k_theta).exp();
+        let rate = self.conductance * horner(&self.elastance, theta) * self.h; // dK/dθ
+        if rate.is_nan() || rate <= 0.0 {
+            return 0.0;
+        }
+        // Each term in its own scaled time s = m·(K(θ') − K(θ)) ≈ m·rate·(θ' − θ), m = 1, 2.
+        let mut total = 0.0;
+        for (m, weight) in [
+            (1.0, 2.0 * self.delta * phi0),
+            (2.0, self.delta * self.delta * phi0 * phi0),
+        ] {
+            let mut sum = 0.0;
+            for (x, w) in LAGUERRE_X.iter().zip(&LAGUERRE_W) {
+                let dtheta = x / (m * rate);
+                let t = theta + dtheta;
+                let e = horner(&self.elastance, t);
+                let decay = horner(&self.decay, t) - k_theta;
+                // φ(θ')^m / φ(θ)^m · e^{s}, s = x.
+                let excess = (-(m * decay) + x).exp();
+                let slow = if m == 1.0 { horner(&self.slow, t) } else { 1.0 };
+                sum += w * self.conductance * e * e * slow * excess;
+            }
+            total += weight * sum * self.h / (m * rate);
+        }
+        total
+    }
+
+    /// The layer's energy from `t₀` to `t₀ + θh`, J.
+    pub(super) fn energy_until(&self, theta: f64) -> f64 {
+        self.energy - self.energy_after(theta)
+    }
+}
+
+/// `Σ cⱼ θʲ`.
+fn horner(c: &Mono, theta: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, cj| acc * theta + cj)
+}
+
+/// The inverse of the Vandermonde matrix of the nodes {0, c₁, …, c_S} of 7-stage Radau IIA:
+/// the monomial coefficients of an interpolant are this matrix times its values there.
+fn inverse_vandermonde(
+    c: &[f64; RESISTOR_STAGES],
+) -> &'static [[f64; RESISTOR_STAGES + 1]; RESISTOR_STAGES + 1] {
+    static INVERSE: std::sync::OnceLock<[[f64; RESISTOR_STAGES + 1]; RESISTOR_STAGES + 1]> =
+        std::sync::OnceLock::new();
+    INVERSE.get_or_init(|| {
+        const N: usize = RESISTOR_STAGES + 1;
+        let mut x = [0.0; N];
+        x[1..].copy_from_slice(c);
+        // Column k: the coefficients of the Lagrange basis polynomial of node k, from Newton's
+        // divided differences of the unit vector.
+        let mut inv = [[0.0; N]; N];
+        for k in 0..N {
+            let mut d = [0.0; N];
+            d[k] = 1.0;
+            for level in 1..N {
+                for i in (level..N).rev() {
+                    d[i] = (d[i] - d[i - 1]) / (x[i] - x[i - level]);
+                }
+            }
+            let mut p = [0.0; N];
+            for i in (0..N).rev() {
+                // p ← p·(θ − xᵢ) + dᵢ
+                for j in (0..N).rev() {
+                    let lower = if j > 0 { p[j - 1] } else { 0.0 };
+                    p[j] = lower - p[j] * x[i];
+                }
+                p[0] += d[i];
+            }
+            for (j, pj) in p.iter().enumerate() {
+                inv[j][k] = *pj;
+            }
+        }
+        inv
+    })
+}
+
+/// The monomial coefficients (in θ) of the polynomial through `(0, y[0])` and `(cᵢ, y[i + 1])`.
+fn interpolant(c: &[f64; RESISTOR_STAGES], y: &[f64; RESISTOR_STAGES + 1]) -> Mono {
+    let inv = inverse_vandermonde(c);
+    let mut m = [0.0; MAX_STAGES + 2];
+    for (mj, row) in m.iter_mut().zip(inv) {
+        *mj = row.iter().zip(y).map(|(a, b)| a * b).sum();
+    }
+    m
+}
+
+/// `∫₀^θ p` as monomial coefficients.
+fn integral(p: &Mono) -> Mono {
+    let mut q = [0.0; MAX_STAGES + 2];
+    for j in 0..q.len() - 1 {
+        q[j + 1] = p[j] / (j + 1) as f64;
+    }
+    q
+}
+
+/// The slow start of one step: `w₀` and the stage increments `zᵢ = wᵢ − w₀`.
+struct SlowStart {
+    w0: f64,
+    z: [f64; RESISTOR_STAGES],
+}
+
+impl ChargeSolver {
+    /// The stage increments of the resistor's Radau step of length `h` from `u0`:
+    /// `(I + hA·diag(k)) z = −ΔQ_eq − (hA k) u₀` (as `trial_resistor`), or `None`.
+    fn stage_solve(
+        tab: &Tableau<RESISTOR_STAGES>,
+        conductance: f64,
+        h: f64,
+        n0: &TransducerState,
+        nodes: &[TransducerState; RESISTOR_STAGES],
+        u0: f64,
+    ) -> Option<[f64; RESISTOR_STAGES]> {
+        const S: usize = RESISTOR_STAGES;
+        let mut m = [[0.0; S]; S];
+        let mut z = [0.0; S];
+        for i in 0..S {
+            let mut row_sum = 0.0;
+            for j in 0..S {
+                let v = tab.a[i][j] * h * conductance * nodes[j].elastance;
+                m[i][j] = v;
+                row_sum += v;
+            }
+            m[i][i] += 1.0;
+            z[i] = -(nodes[i].equilibrium_charge - n0.equilibrium_charge) - row_sum * u0;
+        }
+        solve_unpivoted(&mut m, &mut z).then_some(z)
+    }
+
+    /// The Radau step from the `w₀` whose embedded estimate vanishes (module docs, 1.), or
+    /// `None` if its stage system cannot be solved.
+    fn slow_start(
+        tab: &Tableau<RESISTOR_STAGES>,
+        conductance: f64,
+        h: f64,
+        n0: &TransducerState,
+        nodes: &[TransducerState; RESISTOR_STAGES],
+    ) -> Option<SlowStart> {
+        const S: usize = RESISTOR_STAGES;
+        let hk: [f64; S] = std::array::from_fn(|j| h * conductance * nodes[j].elastance);
+        let dq: [f64; S] = std::array::from_fn(|j| nodes[j].equilibrium_charge - n0.equilibrium_charge);
+        // (I + hA·diag(k)) z = −ΔQ_eq − (hA k) w₀: z = z_a + w₀ z_b.
+        let mut m = [[0.0; S]; S];
+        let mut za = [0.0; S];
+        let mut zb = [0.0; S];
+        for i in 0..S {
+            let mut row_sum = 0.0;
+            for j in 0..S {
+                let v = tab.a[i][j] * hk[j];
+                m[i][j] = v;
+                row_sum += v;
+            }
+            m[i][i] += 1.0;
+            za[i] = -dq[i];
+            zb[i] = -row_sum;
+        }
+        let mut m2 = m;
+        if !solve_unpivoted(&mut m, &mut za) || !solve_unpivoted(&mut m2, &mut zb) {
+            return None;
+        }
+        // The estimate's condition h f₀ + Σ ddᵢ (zᵢ + ΔQ_eq,ᵢ) = 0 with f₀ = −k₀ w₀.
+        let k0h = h * conductance * n0.elastance;
+        let mut num = 0.0;
+        let mut den = -k0h;
+        for i in 0..S {
+            num += tab.dd[i] * (za[i] + dq[i]);
+            den += tab.dd[i] * zb[i];
+        }
+        let w0 = -num / den;
+        if !w0.is_finite() {
+            return None;
+        }
+        Some(SlowStart {
+            w0,
+            z: std::array::from_fn(|i| za[i] + w0 * zb[i]),
+        })
+    }
+
+    /// Crosses the boundary layer at the start of a resistor piece `[ta, tb]` in one step
+    /// (module docs) if there is one and the piece can hold it. Returns the time and
+    /// transducer state the piece continues from, or `None` (nothing done: the piece starts as
+    /// before, crossing the layer with short steps).
+    ///
+    /// The step is as short as the layer allows (`h·k₀ ≥ 32` and the layer decayed below the
+    /// tolerance at its end), so that the slow part is smooth over it; the next step resumes
+    /// the step the controller had before the kink, as after a layer crossed with short steps.
+    /// Where the layer step is not at least 3× shorter than that step (so that its slow part is
+    /// not resolved far better than the tolerance already), it is checked by step doubling.
+    pub(super) fn layer_step<W: GapWaveform + ?Sized>(
+        &mut self,
+        tab: &Tableau<RESISTOR_STAGES>,
+        conductance: f64,
+        ta: f64,
+        tb: f64,
+        n0: TransducerState,
+        wave: &W,
+    ) -> Result<Option<(f64, TransducerState)>, ElectricalError> {
+        const S: usize = RESISTOR_STAGES;
+        if !self.options.analytic_layers || self.moments.is_some() {
+            return Ok(None);
+        }
+        let u0 = self.y[0];
+        let e0 = n0.elastance;
+        let k0 = conductance * e0;
+        let jump = ((u0 + n0.equilibrium_current / k0) * e0).abs();
+        let tol = self.options.rtol * (u0 * e0).abs() + self.atol();
+        if jump.is_nan() || jump <= tol {
+            return Ok(None);
+        }
+        let h_smooth = self.h;
+        let needed = (jump / tol).ln() + LAYER_MARGIN + DECAY_MARGIN;
+        let mut h_len: f64 = MIN_HK.max(1.1 * needed) / k0;
+        let c = tab.c;
+        for _ in 0..4 {
+            if h_len >= tb - ta {
+                h_len = tb - ta;
+            }
+            if h_len * k0 < MIN_HK {
+                return Ok(None);
+            }
+            let t1 = if h_len == tb - ta { tb } else { ta + h_len };
+            let h = t1 - ta;
+            let doubling = h > UNCHECKED_FRACTION * h_smooth;
+            // With doubling, the half steps first: the full step's node gaps must be the last
+            // evaluated (the breakdown check reads them).
+            let halves = if doubling {
+                let half = 0.5 * h;
+                let times_half: [f64; S] = std::array::from_fn(|i| ta + c[i] * half);
+                let nodes_half = self.eval_nodes(&times_half, wave)?;
+                let Some(first) = Self::slow_start(tab, conductance, half, &n0, &nodes_half) else {
+                    return Ok(None);
+                };
+                let w_half = first.w0 + first.z[S - 1];
+                let mid = times_half[S - 1];
+                let times_second: [f64; S] =
+                    std::array::from_fn(|i| if i + 1 == S { t1 } else { mid + c[i] * half });
+                let nodes_second = self.eval_nodes(&times_second, wave)?;
+                let Some(second) = Self::stage_solve(
+                    tab,
+                    conductance,
+                    t1 - mid,
+                    &nodes_half[S - 1],
+                    &nodes_second,
+                    w_half,
+                ) else {
+                    return Ok(None);
+                };
+                Some((first, nodes_half, w_half, second, nodes_second))
+            } else {
+                None
+            };
+            let times: [f64; S] = std::array::from_fn(|i| if i + 1 == S { t1 } else { ta + c[i] * h });
+            let nodes = self.eval_nodes(&times, wave)?;
+            let Some(slow) = Self::slow_start(tab, conductance, h, &n0, &nodes) else {
+                return Ok(None);
+            };
+            // The layer must have decayed within the step (k may fall along it).
+            let decay_end =
+                h * conductance * (0..S).map(|j| tab.a[S - 1][j] * nodes[j].elastance).sum::<f64>();
+            if decay_end < needed {
+                if t1 == tb {
+                    return Ok(None);
+                }
+                h_len *= 2.0 * needed / decay_end.max(f64::MIN_POSITIVE);
+                continue;
+            }
+            let w0 = slow.w0;
+            let dq: [f64; S] = std::array::from_fn(|j| nodes[j].equilibrium_charge - n0.equilibrium_charge);
+            let noise = NOISE * (self.qeq_noise_scale(&n0, &dq) + w0.abs()) * e0;
+            let scale_at = |w: f64, e: f64| self.options.rtol * (w * e).abs() + self.atol() + noise * e / e0;
+            let mut err_w: f64 = 0.0;
+            if let Some((first, nodes_half, w_half, second, nodes_second)) = &halves {
+                // Step doubling: the slow start, the end, and the full step's polynomial at the
+                // half steps' stage points (its interior has only the stage order S).
+                let e1 = nodes[S - 1].elastance;
+                let w1 = w0 + slow.z[S - 1];
+                err_w = err_w
+                    .max(((w0 - first.w0) * e0).abs() / scale_at(w0, e0))
+                    .max(((w1 - w_half - second[S - 1]) * e1).abs() / scale_at(w1, e1));
+                for (theta0, start, z, at) in [
+                    (0.0, first.w0, &first.z, nodes_half),
+                    (0.5, *w_half, second, nodes_second),
+                ] {
+                    for i in 0..S {
+                        let dense = tab.dense_weights(theta0 + 0.5 * c[i]);
+                        let full_at = w0 + dense.iter().zip(&slow.z).map(|(l, z)| l * z).sum::<f64>();
+                        let half_at = start + z[i];
+                        let e = at[i].elastance;
+                        err_w = err_w.max(((full_at - half_at) * e).abs() / scale_at(half_at, e));
+                    }
+                }
+            }
+            let mut trial = Trial::<S>::new();
+            let layer = self.fill_layer_trial(tab, conductance, h, u0, &n0, &nodes, &slow, &mut trial);
+            let p0_w = conductance * (w0 * e0).powi(2);
+            let p_noise = conductance * noise * (2.0 * trial.peak_voltage + noise);
+            let err_e = self.energy_error(tab, h, p0_w, &mut trial, p_noise, (0.0, 0.0));
+            trial.energy += layer.energy;
+            trial.terminal_energy = trial.energy;
+            self.steps_in_period += 1;
+            if !(err_w <= 1.0 && err_e <= 1.0 && layer.energy.is_finite()) {
+                // Shorter would not hold the layer: cross it with short steps.
+                self.stats.rejected += 1;
+                return Ok(None);
+            }
+            self.have_acc = false;
+            self.accept(ta, t1, &trial, nodes[S - 1]);
+            if let Some(step) = self.last_step.as_mut() {
+                step.layer = Some(layer);
+            }
+            self.smooth_since_last_step = true;
+            self.record(wave)?;
+            self.h = h_smooth.max(h);
+            return Ok(Some((t1, nodes[S - 1])));
+        }
+        Ok(None)
+    }
+
+    /// The trial of a layer step: true stage increments (slow part plus layer), the slow
+    /// part's stage powers (its energy by the method's quadrature), peaks; returns the layer.
+    #[allow(clippy::too_many_arguments)]
+    fn fill_layer_trial(
+        &self,
+        tab: &Tableau<RESISTOR_STAGES>,
+        conductance: f64,
+        h: f64,
+        u0: f64,
+        n0: &TransducerState,
+        nodes: &[TransducerState; RESISTOR_STAGES],
+        slow: &SlowStart,
+        trial: &mut Trial<RESISTOR_STAGES>,
+    ) -> LayerTerm {
+        const S: usize = RESISTOR_STAGES;
+        let delta = u0 - slow.w0;
+        let mut e = [0.0; S + 1];
+        let mut w = [0.0; S + 1];
+        e[0] = n0.elastance;
+        w[0] = slow.w0;
+        for j in 0..S {
+            e[j + 1] = nodes[j].elastance;
+            w[j + 1] = slow.w0 + slow.z[j];
+        }
+        let elastance = interpolant(&tab.c, &e);
+        let mut rate = elastance;
+        for r in &mut rate {
+            *r *= conductance * h;
+        }
+        let decay = integral(&rate);
+        let mut layer = LayerTerm {
+            delta,
+            conductance,
+            h,
+            elastance,
+            slow: interpolant(&tab.c, &w),
+            decay,
+            energy: 0.0,
+        };
+        layer.energy = layer.energy_after(0.0);
+        let v0 = -u0 * n0.elastance;
+        let mut v_max = v0.abs();
+        for (j, node) in nodes.iter().enumerate() {
+            let phi = layer.phi(tab.c[j]);
+            let u = slow.w0 + slow.z[j] + delta * phi;
+            trial.z[0][j] = u - u0;
+            let vw = -(slow.w0 + slow.z[j]) * node.elastance;
+            trial.power[j] = vw * vw * conductance;
+            v_max = v_max.max((u * node.elastance).abs());
+            trial.dq[j] = node.equilibrium_charge - n0.equilibrium_charge;
+        }
+        trial.qeq0 = n0.equilibrium_charge;
+        trial.peak_voltage = v_max;
+        trial.peak_current = v_max * conductance;
+        trial.scale_voltage = v_max;
+        trial.stiff = true;
+        trial.hk = h * conductance * n0.elastance;
+        trial.err = 0.0;
+        layer
+    }
+}
+
+/// Dense output of a layer step at `t` (module docs): the slow part from its collocation
+/// polynomial (`step.z` holds the true stage increments, slow part plus layer) plus `δ·φ`; the
+/// energy from the slow part's stage powers plus the layer's energy so far.
+pub(super) fn dense_layer(
+    tab: &Tableau<RESISTOR_STAGES>,
+    step: &Step,
+    layer: &LayerTerm,
+    t: f64,
+) -> ([f64; 2], f64) {
+    const S: usize = RESISTOR_STAGES;
+    let theta = (t - step.t0) / step.h;
+    let wts = tab.dense_weights(theta);
+    let w0 = step.y0[0] - layer.delta;
+    let mut u = w0;
+    let mut e = step.e0;
+    for (i, wi) in wts.iter().enumerate() {
+        // Slow increment = true increment − δ(φᵢ − 1).
+        let zi = step.z[0][i] - layer.delta * (layer.phi(tab.c[i]) - 1.0);
+        u += wi * zi;
+        e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
+    }
+    u += layer.delta * layer.phi(theta);
+    e += layer.energy_until(theta);
+    ([u, step.y0[1]], e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolant_reproduces_a_polynomial_of_degree_seven() {
+        let tab = Tableau::<RESISTOR_STAGES>::new();
+        let p = [0.3, -1.2, 2.5, 0.7, -3.1, 1.9, 0.4, -0.8];
+        let eval = |t: f64| p.iter().rev().fold(0.0, |acc, c| acc * t + c);
+        let mut y = [0.0; RESISTOR_STAGES + 1];
+        y[0] = eval(0.0);
+        for i in 0..RESISTOR_STAGES {
+            y[i + 1] = eval(tab.c[i]);
+        }
+        let m = interpolant(&tab.c, &y);
+        for (j, (a, b)) in m.iter().zip(&p).enumerate() {
+            assert!((a - b).abs() < 1e-9, "coefficient {j}: {a} against {b}");
+        }
+        assert_eq!(m[RESISTOR_STAGES + 1], 0.0);
+    }
+
+    #[test]
+    fn layer_energy_of_constant_coefficients_is_the_closed_form() {
+        // e, w constant: ∫₀^∞ G e² (2wδ e^(−kt) + δ² e^(−2kt)) dt = G e² (2wδ/k + δ²/(2k)).
+        let (g, e, w, delta, h) = (1e-5, 2e10, 3e-12, -7e-11, 1e-3);
+        let k = g * e;
+        let mut elastance = [0.0; MAX_STAGES + 2];
+        elastance[0] = e;
+        let mut slow = [0.0; MAX_STAGES + 2];
+        slow[0] = w;
+        let mut rate = elastance;
+        for r in &mut rate {
+            *r *= g * h;
+        }
+        let layer = LayerTerm {
+            delta,
+            conductance: g,
+            h,
+            elastance,
+            slow,
+            decay: integral(&rate),
+            energy: 0.0,
+        };
+        let exact = g * e * e * (2.0 * w * delta / k + delta * delta / (2.0 * k));
+        let got = layer.energy_after(0.0);
+        assert!(
+            (got - exact).abs() <= 1e-13 * exact.abs(),
+            "{got:e} against {exact:e}"
+        );
+        // From θ: the tail e^(−kθh) (first term) and e^(−2kθh) (second).
+        let theta = 0.3 / (k * h);
+        let tail = g
+            * e
+            * e
+            * (2.0 * w * delta / k * (-0.3_f64).exp() + delta * delta / (2.0 * k) * (-0.6_f64).exp());
+        let got = layer.energy_after(theta);
+        assert!(
+            (got - tail).abs() <= 1e-13 * exact.abs(),
+            "{got:e} against {tail:e}"
+        );
+        assert!((layer.phi(theta) - (-0.3_f64).exp()).abs() < 1e-15);
+    }
+}
