@@ -600,7 +600,9 @@ fn sticking_scenarios() -> Vec<(&'static str, ChainParams, f64)> {
 
 /// A start away from electrostatic equilibrium (−0.2 σS, C), so that the charge has a
 /// transient; the rectifier starts at equilibrium (V = 0): −0.2 σS would put kilovolts across
-/// its diodes at t = 0, where the charge solver stops (step size underflow).
+/// its diodes at t = 0, a picosecond discharge through their series resistances (handled since
+/// stop 20, `electrical_analytic::rectifier_started_kilovolts_from_equilibrium_…`; it used to
+/// stop the charge solver) that these event tests are not about.
 fn start_charge(h: &HarvesterParams, chain: &ChainParams) -> f64 {
     match h.load {
         Load::Rectifier(_) => equilibrium_charge(h, &chain.gaps),

@@ -613,3 +613,55 @@ fn a_piece_an_ulp_long_does_not_stall_the_next() {
         "energy {a:e} J in one piece, {b:e} J split"
     );
 }
+
+/// The rectifier started with no transferred charge (Q = 0 where Q_eq = C·V_oc, 68 kV across
+/// the bridge at the paper's rest gaps of 20 mm): the bridge conducts through its series
+/// resistances (2R_s·C ~ 2.5 ps) until the transducer's voltage is down to the storage voltage plus two diode
+/// drops. This stopped at t = 0 with a step-size underflow (the switching rule measured the
+/// diodes' terminal voltages, kilovolts apart between stages, not their junctions). Checked at
+/// constant gaps against charge conservation (everything through the bridge lands on C_s:
+/// C_s·ΔV_s = |ΔQ|) and the energy identity at the terminals (∫V·I dt = e(u₀² − u₁²)/2, the
+/// field energy given up), and against the end state: |V| − V_s below two diode drops.
+#[test]
+fn rectifier_started_kilovolts_from_equilibrium_discharges_through_the_bridge() {
+    let (d1, d2) = (0.02, 0.02);
+    let wave = move |_t: f64, g: &mut [f64], r: &mut [f64]| {
+        g.copy_from_slice(&[d1, d2]);
+        r.fill(0.0);
+    };
+    let cs = 1e-6;
+    let rectifier = Rectifier {
+        storage_capacitance: cs,
+        ..Rectifier::default()
+    };
+    let p = HarvesterParams {
+        load: Load::Rectifier(rectifier),
+        initial_charge: Some(0.0),
+        ..HarvesterParams::default()
+    };
+    let (c, voc) = paper_c_voc(d1, d2);
+    let (e, q_eq) = (1.0 / c, c * voc);
+    // The period of the paper's default case (0.18 s): the old rule's first step fell below
+    // the rounding floor 4ε·T there.
+    let mut s = ChargeSolver::new(&p, ChainParams::default().period(), 2, ChargeOptions::default()).unwrap();
+    s.advance(0.0, 1e-6, &wave)
+        .unwrap_or_else(|err| panic!("the kilovolt start failed: {err}"));
+    let (u0, u1) = (0.0 - q_eq, s.charge() - q_eq);
+    assert!(-u0 * e > 1e4, "the start has {} V across the bridge", -u0 * e);
+    let vs = s.storage_voltage().unwrap();
+    let moved = s.charge() - 0.0;
+    check("charge on C_s", 1e-6, moved.abs(), cs * vs, 1e-6 * moved.abs());
+    let released = 0.5 * e * (u0 * u0 - u1 * u1);
+    check(
+        "terminal energy",
+        1e-6,
+        released,
+        s.terminal_energy(),
+        1e-6 * released,
+    );
+    let v = -u1 * e;
+    assert!(
+        v.abs() > vs && v.abs() - vs < 2.0,
+        "V = {v} V against V_s = {vs} V"
+    );
+}

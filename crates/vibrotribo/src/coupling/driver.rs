@@ -23,14 +23,14 @@ pub enum CouplingError {
     Sim(#[from] SimError),
     /// The charge solver stopped.
     #[error("charge solver: {0}")]
-    Electrical(#[from] ElectricalError),
+    Electrical(ElectricalError),
     /// The transducer has no field energy.
     #[error(transparent)]
     NoFieldEnergy(#[from] NoFieldEnergy),
     /// The windows had to shrink below rounding without meeting the tolerance.
     #[error(
         "two-way coupling: the window at t = {t} s shrank to {h:e} s without the charge meeting its \
-         tolerance (harvester.coupling_tolerance_m may be too tight)"
+         tolerance (harvester.coupling_tolerance may be too tight)"
     )]
     WindowCollapsed {
         /// Time, s.
@@ -715,5 +715,13 @@ impl<H: ChargeHost + ?Sized> Observer for Trial<'_, H> {
         } else {
             Ok(ControlFlow::Break(()))
         }
+    }
+}
+
+// Not `#[from]`: that would also make the inner error the `source()`, which the message
+// already shows (a failure's chain printed it twice).
+impl From<ElectricalError> for CouplingError {
+    fn from(e: ElectricalError) -> Self {
+        CouplingError::Electrical(e)
     }
 }

@@ -119,6 +119,11 @@ impl DiodeLaw {
         self.a
     }
 
+    /// Series resistance R_s of one diode, Ω.
+    pub(crate) fn series_resistance(&self) -> f64 {
+        self.rs
+    }
+
     /// Current i, A, and conductance di/dv, S, at terminal voltage `v`, V.
     #[inline]
     pub(crate) fn current(&self, v: f64) -> (f64, f64) {
@@ -146,10 +151,16 @@ impl DiodeLaw {
     }
 
     /// The bridge's two junction voltages, in units of n·V_T, at transducer voltage `v` and
-    /// storage voltage `vs`, V: `(V − V_s)/2` and `−(V + V_s)/2`.
+    /// storage voltage `vs`, V: those of diodes with terminal voltages `(V − V_s)/2` and
+    /// `−(V + V_s)/2`, less the drop `i·R_s` on their series resistance. (Far into conduction
+    /// the terminal voltage moves by kilovolts while the junction moves by a few n·V_T.)
     #[inline]
     pub(crate) fn junction_exponents(&self, v: f64, vs: f64) -> [f64; 2] {
-        [0.5 * (v - vs) * self.inv_a, -0.5 * (v + vs) * self.inv_a]
+        let junction = |vd: f64| {
+            let (i, _) = self.current(vd);
+            (vd - (i - self.gp * vd) * self.rs) * self.inv_a
+        };
+        [junction(0.5 * (v - vs)), junction(-0.5 * (v + vs))]
     }
 
     /// The full-wave bridge at transducer voltage `v` and storage voltage `vs`, V.

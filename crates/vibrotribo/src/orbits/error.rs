@@ -50,7 +50,7 @@ pub enum OrbitError {
     /// The orbit found passes a point where the flow map is not differentiable (grazing or
     /// simultaneous impacts): its monodromy matrix and multipliers do not exist.
     #[error("the orbit passes a non-differentiable point: {0}")]
-    NonSmooth(#[from] NonSmoothPoint),
+    NonSmooth(NonSmoothPoint),
     /// Newton's method did not converge: no periodic orbit near the initial state, or one it
     /// cannot reach. `residuals` is the scaled residual `max_i |φ(z) − z|_i / scale_i` at each
     /// accepted iterate.
@@ -94,4 +94,12 @@ fn list(values: &[f64]) -> String {
         .map(|v| format!("{v:.2e}"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+// Not `#[from]`: that would also make the inner error the `source()`, which the message
+// already shows (a failure's chain printed it twice).
+impl From<NonSmoothPoint> for OrbitError {
+    fn from(e: NonSmoothPoint) -> Self {
+        OrbitError::NonSmooth(e)
+    }
 }

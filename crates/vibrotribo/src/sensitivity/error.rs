@@ -52,7 +52,7 @@ pub enum SensitivityError {
     Sim(#[from] SimError),
     /// The trajectory passes a point where the flow map is not differentiable.
     #[error("the flow map is not differentiable here: {0}")]
-    NonSmooth(#[from] NonSmoothPoint),
+    NonSmooth(NonSmoothPoint),
     /// The observer saw no flow (the run had zero length and nothing was observed).
     #[error("no flow was observed")]
     Empty,
@@ -75,4 +75,12 @@ pub enum SensitivityError {
         /// The higher parameter value.
         high: f64,
     },
+}
+
+// Not `#[from]`: that would also make the inner error the `source()`, which the message
+// already shows (a failure's chain printed it twice).
+impl From<NonSmoothPoint> for SensitivityError {
+    fn from(e: NonSmoothPoint) -> Self {
+        SensitivityError::NonSmooth(e)
+    }
 }

@@ -30,7 +30,7 @@ pub enum StudyError {
     Sim(#[from] SimError),
     /// The charge solver stopped.
     #[error("charge solver: {0}")]
-    Electrical(#[from] ElectricalError),
+    Electrical(ElectricalError),
     /// The base motion cannot drive this run (the reason named).
     #[error("base motion: {0}")]
     BaseMotion(String),
@@ -485,5 +485,33 @@ fn coupling_error(e: CouplingError) -> StudyError {
             name: "harvester.coupling".into(),
             message: other.to_string(),
         }),
+    }
+}
+
+// Not `#[from]`: that would also make the inner error the `source()`, which the message
+// already shows (a failure's chain printed it twice).
+impl From<ElectricalError> for StudyError {
+    fn from(e: ElectricalError) -> Self {
+        StudyError::Electrical(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_charge_solver_failure_is_told_once() {
+        let inner = ElectricalError::StepSizeUnderflow { t: 0.0, h: 1e-17 };
+        let text = inner.to_string();
+        let e = StudyError::from(inner);
+        let mut chain = String::new();
+        let mut cause: Option<&dyn std::error::Error> = Some(&e);
+        while let Some(c) = cause {
+            chain.push_str(&format!(": {c}"));
+            cause = c.source();
+        }
+        assert_eq!(chain.matches(&text).count(), 1, "{chain}");
+        assert!(chain.starts_with(": charge solver: "), "{chain}");
     }
 }

@@ -182,8 +182,14 @@ impl ChargeSolver {
                 let b = diode.bridge(v0, self.y[1]);
                 let sweep = (n0.elastance * (n0.equilibrium_current - b.current)).abs();
                 let h_switch = KINK_SWING * diode.thermal_scale() / sweep;
-                if h_switch > 0.0 {
-                    self.h = self.h.min(h_switch);
+                // Far into conduction the bridge is ohmic (two series resistances): its current
+                // then changes on the time scale 2R_s·C, however fast the voltage sweeps. (A
+                // start away from equilibrium puts kilovolts across the bridge, where the sweep
+                // rule alone asked for steps below the rounding of t and stopped the run.)
+                let h_ohmic = 2.0 * diode.series_resistance() / n0.elastance;
+                let h_first = h_switch.max(h_ohmic);
+                if h_first > 0.0 {
+                    self.h = self.h.min(h_first);
                 }
                 return None;
             }
