@@ -54,6 +54,23 @@ impl<const S: usize> Tableau<S> {
         }
     }
 
+    /// The stage matrix `I + A·diag(hk)` of a linear equation `y' = −k(t)·y + …` whose stage
+    /// values of `h·k` are `hk`, and the row sums `(A·hk)ᵢ` (the stages' response to a unit start
+    /// value), dimensionless.
+    pub fn stage_matrix(&self, hk: &[f64; S]) -> ([[f64; S]; S], [f64; S]) {
+        let mut m = [[0.0; S]; S];
+        let mut row_sums = [0.0; S];
+        for i in 0..S {
+            for j in 0..S {
+                let v = self.a[i][j] * hk[j];
+                m[i][j] = v;
+                row_sums[i] += v;
+            }
+            m[i][i] += 1.0;
+        }
+        (m, row_sums)
+    }
+
     /// Weights `ℓᵢ(θ)` of the stage increments in the collocation polynomial at
     /// `t₀ + θh`: `y(t₀ + θh) = y₀ + Σᵢ ℓᵢ(θ) Zᵢ`.
     #[inline]

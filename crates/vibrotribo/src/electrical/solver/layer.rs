@@ -243,19 +243,11 @@ impl ChargeSolver {
         nodes: &[TransducerState; RESISTOR_STAGES],
         u0: f64,
     ) -> Option<[f64; RESISTOR_STAGES]> {
-        const S: usize = RESISTOR_STAGES;
-        let mut m = [[0.0; S]; S];
-        let mut z = [0.0; S];
-        for i in 0..S {
-            let mut row_sum = 0.0;
-            for j in 0..S {
-                let v = tab.a[i][j] * h * conductance * nodes[j].elastance;
-                m[i][j] = v;
-                row_sum += v;
-            }
-            m[i][i] += 1.0;
-            z[i] = -(nodes[i].equilibrium_charge - n0.equilibrium_charge) - row_sum * u0;
-        }
+        let hk = std::array::from_fn(|j| h * conductance * nodes[j].elastance);
+        let (mut m, row_sums) = tab.stage_matrix(&hk);
+        let mut z = std::array::from_fn(|i| {
+            -(nodes[i].equilibrium_charge - n0.equilibrium_charge) - row_sums[i] * u0
+        });
         solve_unpivoted(&mut m, &mut z).then_some(z)
     }
 
@@ -272,20 +264,9 @@ impl ChargeSolver {
         let hk: [f64; S] = std::array::from_fn(|j| h * conductance * nodes[j].elastance);
         let dq: [f64; S] = std::array::from_fn(|j| nodes[j].equilibrium_charge - n0.equilibrium_charge);
         // (I + hA·diag(k)) z = −ΔQ_eq − (hA k) w₀: z = z_a + w₀ z_b.
-        let mut m = [[0.0; S]; S];
-        let mut za = [0.0; S];
-        let mut zb = [0.0; S];
-        for i in 0..S {
-            let mut row_sum = 0.0;
-            for j in 0..S {
-                let v = tab.a[i][j] * hk[j];
-                m[i][j] = v;
-                row_sum += v;
-            }
-            m[i][i] += 1.0;
-            za[i] = -dq[i];
-            zb[i] = -row_sum;
-        }
+        let (mut m, row_sums) = tab.stage_matrix(&hk);
+        let mut za: [f64; S] = std::array::from_fn(|i| -dq[i]);
+        let mut zb: [f64; S] = std::array::from_fn(|i| -row_sums[i]);
         let mut m2 = m;
         if !solve_unpivoted(&mut m, &mut za) || !solve_unpivoted(&mut m2, &mut zb) {
             return None;

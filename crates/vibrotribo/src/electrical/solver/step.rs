@@ -257,18 +257,8 @@ impl ChargeSolver {
             hk[j] = h * conductance * nodes[j].elastance;
             dq[j] = nodes[j].equilibrium_charge - n0.equilibrium_charge;
         }
-        let mut m = [[0.0; S]; S];
-        let mut z = [0.0; S];
-        for i in 0..S {
-            let mut row_sum = 0.0;
-            for j in 0..S {
-                let v = tab.a[i][j] * hk[j];
-                m[i][j] = v;
-                row_sum += v;
-            }
-            m[i][i] += 1.0;
-            z[i] = -dq[i] - row_sum * u0;
-        }
+        let (mut m, row_sums) = tab.stage_matrix(&hk);
+        let mut z: [f64; S] = std::array::from_fn(|i| -dq[i] - row_sums[i] * u0);
         trial.qeq0 = n0.equilibrium_charge;
         trial.dq = dq;
         if !solve_unpivoted(&mut m, &mut z) {
