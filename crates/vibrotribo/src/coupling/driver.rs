@@ -276,19 +276,25 @@ impl CoupledChain {
         self.min_stiffness * self.options.position_tolerance
     }
 
+    /// The electrostatic force on each mass of the transferred charge `q` (C), N: each gap's
+    /// force `G_k` acts on mass k and, with the opposite sign, on mass k + 1.
+    fn mass_forces(&self, q: f64) -> Vec<f64> {
+        let mut forces = vec![0.0; self.forces.len()];
+        for (k, c) in self.statics.gap_force_polynomials() {
+            let g = c[0] + c[1] * q + c[2] * q * q;
+            forces[k] += g;
+            forces[k + 1] -= g;
+        }
+        forces
+    }
+
     /// How far the installed force at `span` after the window's start misses the force of the
     /// charge `q` on the masses, N: the largest and the summed `|installed − exact|` (the
     /// largest against [`force_tolerance`](Self::force_tolerance) is the window's end test).
     fn end_force_errors(&self, span: f64, q: f64) -> (f64, f64) {
         let mut worst: f64 = 0.0;
         let mut sum = 0.0;
-        let mut exact = vec![0.0; self.forces.len()];
-        for (k, c) in self.statics.gap_force_polynomials() {
-            let g = c[0] + c[1] * q + c[2] * q * q;
-            exact[k] += g;
-            exact[k + 1] -= g;
-        }
-        for (f, e) in self.forces.iter().zip(&exact) {
+        for (f, e) in self.forces.iter().zip(&self.mass_forces(q)) {
             let installed = f.coefficients.iter().rev().fold(0.0, |acc, &c| acc * span + c);
             worst = worst.max((installed - e).abs());
             sum += (installed - e).abs();
@@ -318,17 +324,14 @@ impl CoupledChain {
             f.coefficients.clear();
             f.coefficients.resize(super::window::FORCE_DEGREE + 1, 0.0);
         }
-        let mut at_start = vec![0.0; self.forces.len()];
         for (k, c) in self.statics.gap_force_polynomials() {
             let g = force_polynomial(q, c);
             for (j, gj) in g.iter().enumerate() {
                 self.forces[k].coefficients[j] += gj;
                 self.forces[k + 1].coefficients[j] -= gj;
             }
-            let g0 = c[0] + c[1] * q0 + c[2] * q0 * q0;
-            at_start[k] += g0;
-            at_start[k + 1] -= g0;
         }
+        let at_start = self.mass_forces(q0);
         for (f, &f0) in self.forces.iter_mut().zip(&at_start) {
             // The force at the start is the solver's charge's (the polynomial's value there
             // differs from it by the fit's truncation and rounding only).

@@ -165,14 +165,16 @@ impl Simulator {
         for i in 1..n {
             offsets[i] = offsets[i - 1] + params.gaps[i - 1];
         }
+        let forcing = Forcing::new(params.excitation.amplitude, params.omega());
+        let phase_now = forcing.phase(t0);
         let mut sim = Simulator {
-            forcing: Forcing::new(params.excitation.amplitude, params.omega()),
+            forcing,
             forces: ExternalForces::new(params),
             params: params.clone(),
             options,
             offsets,
             t: t0,
-            phase_now: Forcing::new(params.excitation.amplitude, params.omega()).phase(t0),
+            phase_now,
             period_index: (t0 / params.period()).floor() as u64,
             events_in_period: 0,
             clusters: Vec::with_capacity(n),

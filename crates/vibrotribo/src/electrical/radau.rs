@@ -25,6 +25,10 @@ pub(crate) struct Tableau<const S: usize> {
     pub dd_abs_sum: f64,
     /// Denominators of the Lagrange basis on the nodes {0, c₁, …, c_S} for the increments.
     lagrange_den: [f64; S],
+    /// The same basis as polynomials: `ℓᵢ(θ) = Σⱼ increment_basis[i][j] θ^(j+1)` (ℓᵢ(0) = 0),
+    /// the monomial form of [`dense_weights`](Self::dense_weights), for integrating an
+    /// interpolant.
+    pub increment_basis: [[f64; S]; S],
 }
 
 impl<const S: usize> Tableau<S> {
@@ -42,6 +46,24 @@ impl<const S: usize> Tableau<S> {
             std::array::from_fn(|i| (0..S).filter(|&j| j != i).fold(c[i], |d, j| d * (c[i] - c[j])));
         let a: [[f64; S]; S] = std::array::from_fn(|i| std::array::from_fn(|j| a(i, j)));
         let dd: [f64; S] = std::array::from_fn(|i| dd[i]);
+        let increment_basis = std::array::from_fn(|i| {
+            // θ·Π_{j≠i}(θ − c_j)/den_i, from p = 1 multiplied out factor by factor (p[m]: θ^m).
+            let mut p = [0.0; S];
+            p[0] = 1.0;
+            let mut degree = 0;
+            for (j, cj) in c.iter().enumerate() {
+                if j == i {
+                    continue;
+                }
+                for m in (0..=degree + 1).rev() {
+                    let lower = if m > 0 { p[m - 1] } else { 0.0 };
+                    p[m] = lower - cj * p[m];
+                }
+                degree += 1;
+            }
+            // The extra factor θ shifts p up by one: coefficient m of p is that of θ^(m+1).
+            p.map(|pm| pm / lagrange_den[i])
+        });
         Tableau {
             c,
             a,
@@ -51,6 +73,7 @@ impl<const S: usize> Tableau<S> {
             dd_a_abs: std::array::from_fn(|j| (0..S).map(|i| (a[i][j] * dd[i]).abs()).sum()),
             dd_abs_sum: dd.iter().map(|d| d.abs()).sum(),
             lagrange_den,
+            increment_basis,
         }
     }
 
@@ -306,6 +329,18 @@ mod tests {
         }
         let mut b = [1.0; S];
         assert!(!solve_fixed(&mut m, &mut b) || b.iter().any(|x| x.abs() > 1e10));
+        // The basis polynomials are the dense weights (to the conditioning of the monomial
+        // form: 1.5e-12 at worst for S = 7 on [0, 1]; the product form is the exact one).
+        for theta in [0.0, 0.13, 0.5, 0.87, 1.0, 1.4] {
+            let w = t.dense_weights(theta);
+            for (i, (basis, wi)) in t.increment_basis.iter().zip(w).enumerate() {
+                let p = basis.iter().rev().fold(0.0, |acc, c| acc * theta + c) * theta;
+                assert!(
+                    (p - wi).abs() < 1e-10 * (1.0 + wi.abs()),
+                    "S = {S}, ℓ_{i}({theta}): {p} against {wi}"
+                );
+            }
+        }
         // Dense weights reproduce the nodes.
         for i in 0..S {
             let w = t.dense_weights(t.c[i]);

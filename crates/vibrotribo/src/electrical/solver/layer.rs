@@ -44,7 +44,7 @@
 //! short for the layer (or the step doubling fails): then the layer is crossed with short
 //! steps as before (`ChargeSolver::kink_start`).
 
-use super::state::{ChargeSolver, LAYER_MARGIN, MAX_STAGES, NOISE, RESISTOR_STAGES, Step, Trial};
+use super::state::{ChargeSolver, MAX_STAGES, NOISE, RESISTOR_STAGES, Step, Trial};
 use crate::electrical::ElectricalError;
 use crate::electrical::radau::{Tableau, solve_unpivoted};
 use crate::electrical::transducer::TransducerState;
@@ -85,7 +85,7 @@ const LAGUERRE_W: [f64; 10] = [
 const MIN_HK: f64 = 32.0;
 
 /// `∫k dt` beyond the layer's own need by which it must have decayed at the step's end
-/// (`e^(−2)` of the tolerance, on top of the margin of `kink_start`).
+/// (`e^(−2)` of the tolerance, on top of the margin in `layer_decay_needed`).
 const DECAY_MARGIN: f64 = 2.0;
 
 /// A layer step at most this fraction of the step the controller had before the kink is not
@@ -168,51 +168,15 @@ fn horner(c: &Mono, theta: f64) -> f64 {
     c.iter().rev().fold(0.0, |acc, cj| acc * theta + cj)
 }
 
-/// The inverse of the Vandermonde matrix of the nodes {0, c₁, …, c_S} of 7-stage Radau IIA:
-/// the monomial coefficients of an interpolant are this matrix times its values there.
-fn inverse_vandermonde(
-    c: &[f64; RESISTOR_STAGES],
-) -> &'static [[f64; RESISTOR_STAGES + 1]; RESISTOR_STAGES + 1] {
-    static INVERSE: std::sync::OnceLock<[[f64; RESISTOR_STAGES + 1]; RESISTOR_STAGES + 1]> =
-        std::sync::OnceLock::new();
-    INVERSE.get_or_init(|| {
-        const N: usize = RESISTOR_STAGES + 1;
-        let mut x = [0.0; N];
-        x[1..].copy_from_slice(c);
-        // Column k: the coefficients of the Lagrange basis polynomial of node k, from Newton's
-        // divided differences of the unit vector.
-        let mut inv = [[0.0; N]; N];
-        for k in 0..N {
-            let mut d = [0.0; N];
-            d[k] = 1.0;
-            for level in 1..N {
-                for i in (level..N).rev() {
-                    d[i] = (d[i] - d[i - 1]) / (x[i] - x[i - level]);
-                }
-            }
-            let mut p = [0.0; N];
-            for i in (0..N).rev() {
-                // p ← p·(θ − xᵢ) + dᵢ
-                for j in (0..N).rev() {
-                    let lower = if j > 0 { p[j - 1] } else { 0.0 };
-                    p[j] = lower - p[j] * x[i];
-                }
-                p[0] += d[i];
-            }
-            for (j, pj) in p.iter().enumerate() {
-                inv[j][k] = *pj;
-            }
-        }
-        inv
-    })
-}
-
-/// The monomial coefficients (in θ) of the polynomial through `(0, y[0])` and `(cᵢ, y[i + 1])`.
-fn interpolant(c: &[f64; RESISTOR_STAGES], y: &[f64; RESISTOR_STAGES + 1]) -> Mono {
-    let inv = inverse_vandermonde(c);
+/// The monomial coefficients (in θ) of the collocation polynomial through `(0, y0)` and
+/// `(cᵢ, y[i])`: `y0 + Σᵢ ℓᵢ(θ)(y[i] − y0)` with the tableau's basis.
+fn interpolant(tab: &Tableau<RESISTOR_STAGES>, y0: f64, y: &[f64; RESISTOR_STAGES]) -> Mono {
     let mut m = [0.0; MAX_STAGES + 2];
-    for (mj, row) in m.iter_mut().zip(inv) {
-        *mj = row.iter().zip(y).map(|(a, b)| a * b).sum();
+    m[0] = y0;
+    for (basis, yi) in tab.increment_basis.iter().zip(y) {
+        for (mj, bj) in m[1..].iter_mut().zip(basis) {
+            *mj += bj * (yi - y0);
+        }
     }
     m
 }
@@ -312,16 +276,14 @@ impl ChargeSolver {
         if !self.options.analytic_layers || self.moments.is_some() {
             return Ok(None);
         }
+        let Some(layer_need) = self.layer_decay_needed(conductance, &n0) else {
+            return Ok(None);
+        };
+        let needed = layer_need + DECAY_MARGIN;
         let u0 = self.y[0];
         let e0 = n0.elastance;
         let k0 = conductance * e0;
-        let jump = ((u0 + n0.equilibrium_current / k0) * e0).abs();
-        let tol = self.options.rtol * (u0 * e0).abs() + self.atol();
-        if jump.is_nan() || jump <= tol {
-            return Ok(None);
-        }
         let h_smooth = self.h;
-        let needed = (jump / tol).ln() + LAYER_MARGIN + DECAY_MARGIN;
         let mut h_len: f64 = MIN_HK.max(1.1 * needed) / k0;
         let c = tab.c;
         for _ in 0..4 {
@@ -445,15 +407,9 @@ impl ChargeSolver {
     ) -> LayerTerm {
         const S: usize = RESISTOR_STAGES;
         let delta = u0 - slow.w0;
-        let mut e = [0.0; S + 1];
-        let mut w = [0.0; S + 1];
-        e[0] = n0.elastance;
-        w[0] = slow.w0;
-        for j in 0..S {
-            e[j + 1] = nodes[j].elastance;
-            w[j + 1] = slow.w0 + slow.z[j];
-        }
-        let elastance = interpolant(&tab.c, &e);
+        let e: [f64; S] = std::array::from_fn(|j| nodes[j].elastance);
+        let w: [f64; S] = std::array::from_fn(|j| slow.w0 + slow.z[j]);
+        let elastance = interpolant(tab, n0.elastance, &e);
         let mut rate = elastance;
         for r in &mut rate {
             *r *= conductance * h;
@@ -464,7 +420,7 @@ impl ChargeSolver {
             conductance,
             h,
             elastance,
-            slow: interpolant(&tab.c, &w),
+            slow: interpolant(tab, slow.w0, &w),
             decay,
             energy: 0.0,
         };
@@ -507,7 +463,8 @@ pub(super) fn dense_layer(
     let mut u = w0;
     let mut e = step.e0;
     for (i, wi) in wts.iter().enumerate() {
-        // Slow increment = true increment − δ(φᵢ − 1).
+        // Slow increment = true increment − δ(φᵢ − 1). (Not the monomial interpolant `slow`:
+        // the product form of the weights is exact to rounding, the monomial one to ~1e-11.)
         let zi = step.z[0][i] - layer.delta * (layer.phi(tab.c[i]) - 1.0);
         u += wi * zi;
         e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
@@ -526,12 +483,8 @@ mod tests {
         let tab = Tableau::<RESISTOR_STAGES>::new();
         let p = [0.3, -1.2, 2.5, 0.7, -3.1, 1.9, 0.4, -0.8];
         let eval = |t: f64| p.iter().rev().fold(0.0, |acc, c| acc * t + c);
-        let mut y = [0.0; RESISTOR_STAGES + 1];
-        y[0] = eval(0.0);
-        for i in 0..RESISTOR_STAGES {
-            y[i + 1] = eval(tab.c[i]);
-        }
-        let m = interpolant(&tab.c, &y);
+        let y: [f64; RESISTOR_STAGES] = std::array::from_fn(|i| eval(tab.c[i]));
+        let m = interpolant(&tab, eval(0.0), &y);
         for (j, (a, b)) in m.iter().zip(&p).enumerate() {
             assert!((a - b).abs() < 1e-9, "coefficient {j}: {a} against {b}");
         }

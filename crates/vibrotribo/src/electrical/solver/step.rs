@@ -199,19 +199,28 @@ impl ChargeSolver {
         if self.h * k0 <= 2.0 {
             return None;
         }
-        let jump = ((self.y[0] + n0.equilibrium_current / k0) * n0.elastance).abs();
-        let tol = self.options.rtol * (self.y[0] * n0.elastance).abs() + self.atol();
-        if jump.is_nan() || jump <= tol {
-            return None;
-        }
+        let needed = self.layer_decay_needed(conductance, n0)?;
         let h_smooth = self.h;
         self.h = 2.0 / k0;
         Some(Layer {
             conductance,
             decayed: 0.0,
-            needed: (jump / tol).ln() + LAYER_MARGIN,
+            needed,
             h_smooth,
         })
+    }
+
+    /// Resistor: the decay `∫k dt` after which the boundary layer at `n0` (the charge's offset
+    /// from its quasi-static value `u ≈ −I_sc/k`, as a voltage) is below the voltage tolerance,
+    /// with `LAYER_MARGIN`; `None` if it is below the tolerance already (no layer).
+    pub(super) fn layer_decay_needed(&self, conductance: f64, n0: &TransducerState) -> Option<f64> {
+        let k0 = conductance * n0.elastance;
+        let jump = ((self.y[0] + n0.equilibrium_current / k0) * n0.elastance).abs();
+        let tol = self.options.rtol * (self.y[0] * n0.elastance).abs() + self.atol();
+        if jump.is_nan() || jump <= tol {
+            return None;
+        }
+        Some((jump / tol).ln() + LAYER_MARGIN)
     }
 
     /// Step-size controller of RADAU5 (with Gustafsson's predictive variant): the next step
