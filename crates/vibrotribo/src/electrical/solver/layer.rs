@@ -44,44 +44,15 @@
 //! short for the layer (or the step doubling fails): then the layer is crossed with short
 //! steps as before (`ChargeSolver::kink_start`).
 
-use super::state::{ChargeSolver, MAX_STAGES, NOISE, RESISTOR_STAGES, Step, Trial};
+use super::layer_term::{LayerTerm, MONO_TERMS, Mono};
+use super::state::{ChargeSolver, NOISE, RESISTOR_STAGES, Step, Trial};
 use crate::electrical::ElectricalError;
 use crate::electrical::radau::{Tableau, solve_unpivoted};
 use crate::electrical::transducer::TransducerState;
 use crate::electrical::waveform::GapWaveform;
 
-/// Nodes of 10-point Gauss–Laguerre quadrature, `∫₀^∞ e^(−s) f(s) ds ≈ Σ wᵢ f(xᵢ)` (numpy's
-/// `laggauss(10)`; exact for polynomials of degree ≤ 19). Each term of the layer's energy is
-/// taken in its own scaled time, where its integrand is smooth and nearly constant.
-const LAGUERRE_X: [f64; 10] = [
-    0.1377934705404926,
-    0.729454549503171,
-    1.8083429017403159,
-    3.4014336978548996,
-    5.552496140063804,
-    8.330152746764497,
-    11.843785837900066,
-    16.279257831378104,
-    21.99658581198076,
-    29.92069701227389,
-];
-
-/// Weights of the same quadrature.
-const LAGUERRE_W: [f64; 10] = [
-    0.3084411157650173,
-    0.4011199291552761,
-    0.2180682876118096,
-    0.062087456098677773,
-    0.0095015169751811,
-    0.0007530083885875384,
-    2.8259233495995642e-05,
-    4.249313984962698e-07,
-    1.839564823979633e-09,
-    9.91182721960906e-13,
-];
-
-/// Smallest `h·k` of a step that carries a layer: its Laguerre nodes (up to s = 29.9) then lie
-/// inside it.
+/// Smallest `h·k` of a step that carries a layer: the Laguerre nodes of its energy (up to
+/// s = 29.9, `layer_term`) then lie inside it.
 const MIN_HK: f64 = 32.0;
 
 /// `∫k dt` beyond the layer's own need by which it must have decayed at the step's end
@@ -93,85 +64,13 @@ const DECAY_MARGIN: f64 = 2.0;
 /// `(1/3)^(S+1) = 1.5e-4` of that of a step the estimate accepted.
 const UNCHECKED_FRACTION: f64 = 1.0 / 3.0;
 
-/// Beyond this `∫k dt` the layer's remaining energy is taken as zero (`e^(−60)`).
-const NEGLIGIBLE_DECAY: f64 = 60.0;
-
-/// Coefficients of a polynomial in θ ∈ [0, 1] (θ = (t − t₀)/h), lowest first; degree ≤ 8.
-type Mono = [f64; MAX_STAGES + 2];
-
-/// The layer term `δ·φ(t)` of a step and what its outputs need (module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct LayerTerm {
-    /// Layer amplitude δ = u(t₀) − w₀, C.
-    pub(super) delta: f64,
-    /// Load conductance G = 1/R, S.
-    conductance: f64,
-    /// Step length, s.
-    h: f64,
-    /// Elastance interpolant e(θ), 1/F.
-    elastance: Mono,
-    /// Slow charge interpolant w(θ), C.
-    slow: Mono,
-    /// `K(θ) = ∫_{t₀}^{t₀+θh} k dt` (dimensionless).
-    decay: Mono,
-    /// The layer's energy over the whole step, J.
-    pub(super) energy: f64,
-}
-
-impl LayerTerm {
-    /// `φ(θ) = exp(−K(θ))`.
-    pub(super) fn phi(&self, theta: f64) -> f64 {
-        (-horner(&self.decay, theta)).exp()
-    }
-
-    /// The layer's energy `∫ G e²(2wδφ + δ²φ²) dt` from `t₀ + θh` to the layer's end, J.
-    pub(super) fn energy_after(&self, theta: f64) -> f64 {
-        let k_theta = horner(&self.decay, theta);
-        if k_theta > NEGLIGIBLE_DECAY {
-            return 0.0;
-        }
-        let phi0 = (-k_theta).exp();
-        let rate = self.conductance * horner(&self.elastance, theta) * self.h; // dK/dθ
-        if rate.is_nan() || rate <= 0.0 {
-            return 0.0;
-        }
-        // Each term in its own scaled time s = m·(K(θ') − K(θ)) ≈ m·rate·(θ' − θ), m = 1, 2.
-        let mut total = 0.0;
-        for (m, weight) in [
-            (1.0, 2.0 * self.delta * phi0),
-            (2.0, self.delta * self.delta * phi0 * phi0),
-        ] {
-            let mut sum = 0.0;
-            for (x, w) in LAGUERRE_X.iter().zip(&LAGUERRE_W) {
-                let dtheta = x / (m * rate);
-                let t = theta + dtheta;
-                let e = horner(&self.elastance, t);
-                let decay = horner(&self.decay, t) - k_theta;
-                // φ(θ')^m / φ(θ)^m · e^{s}, s = x.
-                let excess = (-(m * decay) + x).exp();
-                let slow = if m == 1.0 { horner(&self.slow, t) } else { 1.0 };
-                sum += w * self.conductance * e * e * slow * excess;
-            }
-            total += weight * sum * self.h / (m * rate);
-        }
-        total
-    }
-
-    /// The layer's energy from `t₀` to `t₀ + θh`, J.
-    pub(super) fn energy_until(&self, theta: f64) -> f64 {
-        self.energy - self.energy_after(theta)
-    }
-}
-
-/// `Σ cⱼ θʲ`.
-fn horner(c: &Mono, theta: f64) -> f64 {
-    c.iter().rev().fold(0.0, |acc, cj| acc * theta + cj)
-}
+// The collocation polynomial (degree S) and its integral fit in a `Mono`.
+const _: () = assert!(MONO_TERMS == RESISTOR_STAGES + 2);
 
 /// The monomial coefficients (in θ) of the collocation polynomial through `(0, y0)` and
 /// `(cᵢ, y[i])`: `y0 + Σᵢ ℓᵢ(θ)(y[i] − y0)` with the tableau's basis.
 fn interpolant(tab: &Tableau<RESISTOR_STAGES>, y0: f64, y: &[f64; RESISTOR_STAGES]) -> Mono {
-    let mut m = [0.0; MAX_STAGES + 2];
+    let mut m = [0.0; MONO_TERMS];
     m[0] = y0;
     for (basis, yi) in tab.increment_basis.iter().zip(y) {
         for (mj, bj) in m[1..].iter_mut().zip(basis) {
@@ -179,15 +78,6 @@ fn interpolant(tab: &Tableau<RESISTOR_STAGES>, y0: f64, y: &[f64; RESISTOR_STAGE
         }
     }
     m
-}
-
-/// `∫₀^θ p` as monomial coefficients.
-fn integral(p: &Mono) -> Mono {
-    let mut q = [0.0; MAX_STAGES + 2];
-    for j in 0..q.len() - 1 {
-        q[j + 1] = p[j] / (j + 1) as f64;
-    }
-    q
 }
 
 /// The slow start of one step: `w₀` and the stage increments `zᵢ = wᵢ − w₀`.
@@ -409,22 +299,13 @@ impl ChargeSolver {
         let delta = u0 - slow.w0;
         let e: [f64; S] = std::array::from_fn(|j| nodes[j].elastance);
         let w: [f64; S] = std::array::from_fn(|j| slow.w0 + slow.z[j]);
-        let elastance = interpolant(tab, n0.elastance, &e);
-        let mut rate = elastance;
-        for r in &mut rate {
-            *r *= conductance * h;
-        }
-        let decay = integral(&rate);
-        let mut layer = LayerTerm {
+        let layer = LayerTerm::new(
             delta,
             conductance,
             h,
-            elastance,
-            slow: interpolant(tab, slow.w0, &w),
-            decay,
-            energy: 0.0,
-        };
-        layer.energy = layer.energy_after(0.0);
+            interpolant(tab, n0.elastance, &e),
+            interpolant(tab, slow.w0, &w),
+        );
         let v0 = -u0 * n0.elastance;
         let mut v_max = v0.abs();
         for (j, node) in nodes.iter().enumerate() {
@@ -489,47 +370,5 @@ mod tests {
             assert!((a - b).abs() < 1e-9, "coefficient {j}: {a} against {b}");
         }
         assert_eq!(m[RESISTOR_STAGES + 1], 0.0);
-    }
-
-    #[test]
-    fn layer_energy_of_constant_coefficients_is_the_closed_form() {
-        // e, w constant: ∫₀^∞ G e² (2wδ e^(−kt) + δ² e^(−2kt)) dt = G e² (2wδ/k + δ²/(2k)).
-        let (g, e, w, delta, h) = (1e-5, 2e10, 3e-12, -7e-11, 1e-3);
-        let k = g * e;
-        let mut elastance = [0.0; MAX_STAGES + 2];
-        elastance[0] = e;
-        let mut slow = [0.0; MAX_STAGES + 2];
-        slow[0] = w;
-        let mut rate = elastance;
-        for r in &mut rate {
-            *r *= g * h;
-        }
-        let layer = LayerTerm {
-            delta,
-            conductance: g,
-            h,
-            elastance,
-            slow,
-            decay: integral(&rate),
-            energy: 0.0,
-        };
-        let exact = g * e * e * (2.0 * w * delta / k + delta * delta / (2.0 * k));
-        let got = layer.energy_after(0.0);
-        assert!(
-            (got - exact).abs() <= 1e-13 * exact.abs(),
-            "{got:e} against {exact:e}"
-        );
-        // From θ: the tail e^(−kθh) (first term) and e^(−2kθh) (second).
-        let theta = 0.3 / (k * h);
-        let tail = g
-            * e
-            * e
-            * (2.0 * w * delta / k * (-0.3_f64).exp() + delta * delta / (2.0 * k) * (-0.6_f64).exp());
-        let got = layer.energy_after(theta);
-        assert!(
-            (got - tail).abs() <= 1e-13 * exact.abs(),
-            "{got:e} against {tail:e}"
-        );
-        assert!((layer.phi(theta) - (-0.3_f64).exp()).abs() < 1e-15);
     }
 }

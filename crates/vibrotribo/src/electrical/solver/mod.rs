@@ -80,6 +80,7 @@
 mod api;
 mod checkpoint;
 mod layer;
+mod layer_term;
 mod output;
 mod results;
 mod state;

@@ -78,7 +78,7 @@ pub(super) struct Step {
     pub(super) dq: [f64; MAX_STAGES],
     pub(super) stiff: bool,
     /// The boundary layer carried in closed form by this step, if any (`layer.rs`).
-    pub(super) layer: Option<super::layer::LayerTerm>,
+    pub(super) layer: Option<super::layer_term::LayerTerm>,
 }
 
 /// Result of solving the stages of one trial step (one buffer reused for every trial).
