@@ -77,21 +77,25 @@ impl<const S: usize> Tableau<S> {
         }
     }
 
-    /// The stage matrix `I + A·diag(hk)` of a linear equation `y' = −k(t)·y + …` whose stage
-    /// values of `h·k` are `hk`, and the row sums `(A·hk)ᵢ` (the stages' response to a unit start
-    /// value), dimensionless.
-    pub fn stage_matrix(&self, hk: &[f64; S]) -> ([[f64; S]; S], [f64; S]) {
+    /// The stage system of a linear equation `y' = −k(t)·y + …` whose stage values of `h·k` are
+    /// `hk`: the matrix `I + A·diag(hk)` and the right-hand side `rhs(i, (A·hk)ᵢ)` of each row
+    /// (`(A·hk)ᵢ` is stage i's response to a unit start value), dimensionless. Inlined: the
+    /// resistor's trial step builds one per trial.
+    #[inline(always)]
+    pub fn stage_system(&self, hk: &[f64; S], rhs: impl Fn(usize, f64) -> f64) -> ([[f64; S]; S], [f64; S]) {
         let mut m = [[0.0; S]; S];
-        let mut row_sums = [0.0; S];
+        let mut b = [0.0; S];
         for i in 0..S {
+            let mut row_sum = 0.0;
             for j in 0..S {
                 let v = self.a[i][j] * hk[j];
                 m[i][j] = v;
-                row_sums[i] += v;
+                row_sum += v;
             }
             m[i][i] += 1.0;
+            b[i] = rhs(i, row_sum);
         }
-        (m, row_sums)
+        (m, b)
     }
 
     /// Weights `ℓᵢ(θ)` of the stage increments in the collocation polynomial at

@@ -98,9 +98,8 @@ impl ChargeSolver {
         u0: f64,
     ) -> Option<[f64; RESISTOR_STAGES]> {
         let hk = std::array::from_fn(|j| h * conductance * nodes[j].elastance);
-        let (mut m, row_sums) = tab.stage_matrix(&hk);
-        let mut z = std::array::from_fn(|i| {
-            -(nodes[i].equilibrium_charge - n0.equilibrium_charge) - row_sums[i] * u0
+        let (mut m, mut z) = tab.stage_system(&hk, |i, row_sum| {
+            -(nodes[i].equilibrium_charge - n0.equilibrium_charge) - row_sum * u0
         });
         solve_unpivoted(&mut m, &mut z).then_some(z)
     }
@@ -118,9 +117,8 @@ impl ChargeSolver {
         let hk: [f64; S] = std::array::from_fn(|j| h * conductance * nodes[j].elastance);
         let dq: [f64; S] = std::array::from_fn(|j| nodes[j].equilibrium_charge - n0.equilibrium_charge);
         // (I + hA·diag(k)) z = −ΔQ_eq − (hA k) w₀: z = z_a + w₀ z_b.
-        let (mut m, row_sums) = tab.stage_matrix(&hk);
+        let (mut m, mut zb) = tab.stage_system(&hk, |_, row_sum| -row_sum);
         let mut za: [f64; S] = std::array::from_fn(|i| -dq[i]);
-        let mut zb: [f64; S] = std::array::from_fn(|i| -row_sums[i]);
         let mut m2 = m;
         if !solve_unpivoted(&mut m, &mut za) || !solve_unpivoted(&mut m2, &mut zb) {
             return None;

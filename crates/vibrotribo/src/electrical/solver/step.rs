@@ -266,8 +266,7 @@ impl ChargeSolver {
             hk[j] = h * conductance * nodes[j].elastance;
             dq[j] = nodes[j].equilibrium_charge - n0.equilibrium_charge;
         }
-        let (mut m, row_sums) = tab.stage_matrix(&hk);
-        let mut z: [f64; S] = std::array::from_fn(|i| -dq[i] - row_sums[i] * u0);
+        let (mut m, mut z) = tab.stage_system(&hk, |i, row_sum| -dq[i] - row_sum * u0);
         trial.qeq0 = n0.equilibrium_charge;
         trial.dq = dq;
         if !solve_unpivoted(&mut m, &mut z) {
