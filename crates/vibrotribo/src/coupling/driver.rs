@@ -7,6 +7,7 @@ use thiserror::Error;
 
 use super::CouplingOptions;
 use super::window::{ChargePolynomial, DEGREE, NODES, force_polynomial, nodes, significant_degree};
+use crate::dynamics::response::SERIES_REACH;
 use crate::dynamics::{
     ContactStatus, Event, EventKind, Flow, Observer, RunEnd, Segment, Simulator, StateView, Verdict,
 };
@@ -120,6 +121,11 @@ pub struct CoupledChain {
     min_mass: f64,
     /// Largest natural frequency of a single mass, rad/s.
     omega_n: f64,
+    /// The least `ω_n τ` at which the engine sums a force's response from its particular
+    /// polynomial (below it, as a power series that does not amplify rounding): the
+    /// response's [`SERIES_REACH`] in `(2α + ω_n)τ` over `1 + 2ζ` of the most damped mass (a
+    /// cluster's damping ratio is at most its members' largest).
+    series_x: f64,
     /// Smallest stiffness, N/m.
     min_stiffness: f64,
     stats: CouplingStats,
@@ -156,6 +162,14 @@ impl CoupledChain {
             .zip(&p.stiffness)
             .map(|(m, k)| (k / m).sqrt())
             .fold(0.0, f64::max);
+        let zeta_max = p
+            .masses
+            .iter()
+            .zip(&p.stiffness)
+            .zip(&p.damping)
+            .map(|((m, k), c)| c / (2.0 * (k * m).sqrt()))
+            .fold(0.0, f64::max);
+        let series_x = SERIES_REACH / (1.0 + 2.0 * zeta_max);
         let min_stiffness = p.stiffness.iter().copied().fold(f64::INFINITY, f64::min);
         Ok(CoupledChain {
             sim,
@@ -165,6 +179,7 @@ impl CoupledChain {
             previous: None,
             min_mass,
             omega_n,
+            series_x,
             min_stiffness,
             stats: CouplingStats::default(),
             started: false,
@@ -348,7 +363,7 @@ impl CoupledChain {
             // on to the positions and velocities at its end. It vanishes at τ = 0, so that
             // the force at the window's start stays the solver's charge's (see above).
             let h = q.h;
-            let x = self.omega_n * h;
+            let x = (self.omega_n * h).max(self.series_x);
             let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
             for (f, target) in self.forces.iter_mut().zip(&self.target) {
                 let [i0, i1] = polynomial_moments(&f.coefficients, h);
@@ -417,10 +432,13 @@ impl CoupledChain {
 
     /// The charge polynomial through `values` at the nodes of a window of length `h`, s, cut
     /// to the highest degree whose force polynomials the engine can integrate without
-    /// amplifying rounding beyond a hundredth of the position tolerance: the particular
-    /// solution of a force term f_j τʲ carries terms up to j!/(ω_n h)ʲ times its static
-    /// effect f_j hʲ/K, which the homogeneous part then cancels. Constant on windows shorter
-    /// than [`CONSTANT_BELOW`] periods.
+    /// amplifying rounding beyond a hundredth of the position tolerance: where the engine
+    /// sums a force term f_j τʲ's response from its particular polynomial, that polynomial
+    /// carries terms up to j!/(ω_n τ)ʲ times the static effect f_j τʲ/K, which the
+    /// homogeneous part then cancels. It does so only from `ω_n τ ≥` `series_x` on (a power
+    /// series before), so the amplification is at most j!/max(ω_n h, series_x)ʲ: about one for
+    /// a lightly damped chain, whatever the window's length. Constant on windows shorter than
+    /// [`CONSTANT_BELOW`] periods.
     ///
     /// On a window that decides a contact (`precise`, see [`window`](Self::window)) the
     /// budget alone decides at every length: there the force at the window's end must meet the
@@ -431,7 +449,7 @@ impl CoupledChain {
             return ChargePolynomial::constant(values[0], h);
         }
         let full = ChargePolynomial::new(values, h);
-        let x = self.omega_n * h;
+        let x = (self.omega_n * h).max(self.series_x);
         let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
         for degree in (1..=DEGREE).rev() {
             let q = full.truncated(degree);

@@ -9,6 +9,7 @@ mod forces;
 mod observer;
 mod oscillator;
 pub(crate) mod poly;
+pub(crate) mod response;
 mod roots;
 mod signal;
 mod simulator;

@@ -21,10 +21,13 @@
 //! continuous across regimes, so near-critical damping loses no accuracy.
 //!
 //! An external force polynomial in time `f(t)` on the right-hand side (see
-//! [`super::forces`]) adds its polynomial particular solution `p(t)` (same degree) to `s_p`;
-//! without one the flow is computed exactly as before.
+//! [`super::forces`]) adds its response from rest `r(t − t₀)` (see [`super::response`]: a
+//! power series on short flows, `p(t) + h_p(t − t₀)` with the polynomial particular solution
+//! `p` on long ones), so that the homogeneous part keeps the initial conditions of the
+//! harmonic motion alone; without one the flow is computed exactly as before.
 
-use super::poly::{Poly, TERMS};
+use super::poly::Poly;
+use super::response::{self, Response, SERIES_REACH};
 use crate::error::SimError;
 
 /// The forcing phase at a time: `cos ωt` and `sin ωt`, computed once per time and shared by
@@ -139,8 +142,9 @@ pub struct Oscillator {
     /// A prescribed motion (a cluster stuck to a rigid stop): no homogeneous part, and a
     /// motion that does not depend on the initial state.
     prescribed: bool,
-    /// Particular solution of the polynomial external forcing, m (zero if none).
-    pub(crate) poly: Poly,
+    /// The polynomial external force per unit mass, `f(t)/M` about `t0`, m/s² (zero if
+    /// none); the flow adds its response from rest (module docs).
+    pub(crate) force: Poly,
 }
 
 /// Mechanical constants of one oscillator (a mass or a stuck cluster).
@@ -243,19 +247,22 @@ impl Oscillator {
             omega: w,
             magnitude: 0.0,
             prescribed: false,
-            poly: if fpoly.is_zero() {
+            force: if fpoly.is_zero() {
                 Poly::ZERO
             } else {
-                fpoly.particular(m, c, kk)
+                let mut f = fpoly.shifted(t0);
+                for cj in &mut f.c[..f.len] {
+                    *cj /= m;
+                }
+                f
             },
         };
-        let (sp, vp) = osc.forced(t0, ph);
+        // The response from rest is zero at t0: the homogeneous part takes the initial
+        // conditions relative to the harmonic motion alone.
+        let (sp, vp) = osc.forced(ph);
         (osc.h0, osc.e0) = two_sum(s0, -sp);
         (osc.h1, osc.e1) = two_sum(v0, -vp);
         osc.magnitude = osc.mean.abs() + osc.pc.abs() + osc.ps.abs() + osc.h0.abs();
-        if !osc.poly.is_zero() {
-            osc.magnitude += osc.poly.magnitude_at(t0);
-        }
         Ok(osc)
     }
 
@@ -280,7 +287,7 @@ impl Oscillator {
             omega: forcing.omega,
             magnitude: mean.abs() + ps.abs(),
             prescribed: true,
-            poly: Poly::ZERO,
+            force: Poly::ZERO,
         }
     }
 
@@ -289,27 +296,63 @@ impl Oscillator {
         self.prescribed
     }
 
-    /// Forced (particular) part at time `t` (phase `ph` of `t`): displacement, m, and
-    /// velocity, m/s.
+    /// Forced part of the harmonic base motion (static offset and steady harmonic response)
+    /// at phase `ph`: displacement, m, and velocity, m/s. A polynomial force's response is
+    /// not in it (see [`response`](Self::response)).
     #[inline]
-    pub(crate) fn forced(&self, t: f64, ph: Phase) -> (f64, f64) {
+    pub(crate) fn forced(&self, ph: Phase) -> (f64, f64) {
         let s = self.mean + self.pc * ph.cos + self.ps * ph.sin;
         let v = self.omega * (self.ps * ph.cos - self.pc * ph.sin);
-        if self.poly.is_zero() {
-            (s, v)
-        } else {
-            let (p, pd) = self.poly.value_and_rate(t);
-            (s + p, v + pd)
-        }
+        (s, v)
     }
 
     /// The external polynomial forcing per unit mass that drives this flow, `f(t)/M`, m/s²
-    /// (`p'' + 2α p' + ω_n² p` of its particular polynomial p; zero if none).
+    /// (zero if none).
     pub(crate) fn driving(&self) -> Poly {
-        if self.poly.is_zero() {
+        self.force
+    }
+
+    /// Whether a polynomial external force drives this flow.
+    #[inline]
+    pub(crate) fn is_driven(&self) -> bool {
+        !self.force.is_zero()
+    }
+
+    /// The response from rest to the polynomial force at time `t` (zero without one): its
+    /// power series while `(2α + ω_n)|t − t0|` ≤ [`SERIES_REACH`], beyond that the particular
+    /// polynomial plus the homogeneous solution that cancels its initial values, well
+    /// conditioned there (see [`super::response`]).
+    #[inline]
+    pub(crate) fn response(&self, t: f64) -> Response {
+        if self.force.is_zero() {
+            return Response::default();
+        }
+        let tau = t - self.t0;
+        if (2.0 * self.alpha + self.wn2.sqrt()) * tau.abs() <= SERIES_REACH {
+            return response::series(&self.force, self.alpha, self.wn2, tau);
+        }
+        let p = self.force.particular(1.0, 2.0 * self.alpha, self.wn2);
+        let (p0, p1) = (p.c[0], p.c[1]);
+        let (pv, pd) = p.value_and_rate(t);
+        let (c, s) = self.propagator(tau);
+        let (hc, hs) = (p0 * c, (p1 + self.alpha * p0) * s);
+        let (dc, ds) = (p1 * c, (self.wn2 * p0 + self.alpha * p1) * s);
+        Response {
+            r: pv - (hc + hs),
+            rd: pd - (dc - ds),
+            mag: p.magnitude_at(t) + hc.abs() + hs.abs(),
+            mag_d: p.derivative().magnitude_at(t) + dc.abs() + ds.abs(),
+        }
+    }
+
+    /// The force per unit mass about `t`, its coefficients `φ⁽ᵏ⁾(t)/k!`, m/s² per sᵏ (zero
+    /// without a force).
+    #[inline]
+    pub(crate) fn force_taylor(&self, t: f64) -> Poly {
+        if self.force.is_zero() {
             Poly::ZERO
         } else {
-            self.poly.driving(self.alpha, self.wn2)
+            self.force.shifted(t)
         }
     }
 
@@ -337,6 +380,25 @@ impl Oscillator {
     pub(crate) fn homogeneous_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
         let g = self.homogeneous(t);
         (g.h + g.eh, g.hd + g.ehd, g.mag_h, g.mag_hd)
+    }
+
+    /// The free motion `u = h + r` at time `t`: the homogeneous part plus the response from
+    /// rest to the polynomial force (which solves `u'' + 2αu' + ω_n²u = f/M`), as
+    /// `(u, u', magnitude of u's terms, magnitude of u''s terms)`. Without a force it is
+    /// [`homogeneous_with_magnitude`](Self::homogeneous_with_magnitude).
+    #[inline]
+    pub(crate) fn free_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
+        let g = self.homogeneous(t);
+        if self.force.is_zero() {
+            return (g.h + g.eh, g.hd + g.ehd, g.mag_h, g.mag_hd);
+        }
+        let r = self.response(t);
+        (
+            (g.h + g.eh) + r.r,
+            (g.hd + g.ehd) + r.rd,
+            g.mag_h + r.mag,
+            g.mag_hd + r.mag_d,
+        )
     }
 
     /// `e^{−ατ}c(τ)` and `e^{−ατ}s(τ)` of the module docs.
@@ -378,9 +440,13 @@ impl Oscillator {
     /// part.
     #[inline]
     pub(crate) fn state(&self, t: f64, ph: Phase) -> (f64, f64) {
-        let (sp, vp) = self.forced(t, ph);
+        let (sp, vp) = self.forced(ph);
         let g = self.homogeneous(t);
-        ((sp + g.h) + g.eh, (vp + g.hd) + g.ehd)
+        if self.force.is_zero() {
+            return ((sp + g.h) + g.eh, (vp + g.hd) + g.ehd);
+        }
+        let r = self.response(t);
+        (((sp + g.h) + g.eh) + r.r, ((vp + g.hd) + g.ehd) + r.rd)
     }
 
     /// Size of the terms the displacement is summed from, m: static offset, forced amplitude
@@ -391,13 +457,13 @@ impl Oscillator {
         self.magnitude
     }
 
-    /// [`magnitude`](Self::magnitude) with the size of the polynomial part's terms at time
-    /// `t` added, m (the polynomial part grows along the piece).
+    /// [`magnitude`](Self::magnitude) with the size of the terms of the polynomial force's
+    /// response at time `t` added, m (that response grows along the piece).
     pub(crate) fn magnitude_at(&self, t: f64) -> f64 {
-        if self.poly.is_zero() {
+        if self.force.is_zero() {
             self.magnitude
         } else {
-            self.magnitude + self.poly.magnitude_at(t)
+            self.magnitude + self.response(t).mag
         }
     }
 
@@ -439,43 +505,55 @@ impl Oscillator {
     /// `c = 1/K + 1/K²` of the larger of the two before it, so the tail after `j` is below
     /// `2c/(1 − c)·max(|g_{j−1}|, |g_j|)`. The forced part's terms then fall by K per term,
     /// so its tail is below `K/(K − 1)` times its next term. The first two coefficients are
-    /// the values [`state`](Self::state) returns. A polynomial part (external forces) adds
-    /// its own scaled Taylor coefficients about `tc`, exact and finite: at least as many
-    /// terms as it has are written, and it has no tail (its size over the radius,
-    /// `Σ |p⁽ʲ⁾(tc)| rʲ/j!`, joins the size of the motion).
+    /// the values [`state`](Self::state) returns. A polynomial force φ = f/M makes the free
+    /// part `u = h + r` (homogeneous part plus the force's response from rest) obey
+    /// `u⁽ʲ⁺²⁾ = φ⁽ʲ⁾ − 2α u⁽ʲ⁺¹⁾ − ω_n² u⁽ʲ⁾`: its coefficients come from the same recurrence
+    /// with φ's Taylor coefficients about `tc` added, and once those are used up (at least
+    /// `len(φ) + 2` terms are written) the recurrence is homogeneous and the tail bound holds
+    /// as without a force. The size of the force's effect over the radius,
+    /// `Σ_k |φ_k| rᵏ⁺²/((k+1)(k+2))`, joins the size of the motion.
     pub(crate) fn taylor(&self, tc: f64, ph: Phase, r: f64, rel: f64, coef: &mut [f64]) -> (usize, f64, f64) {
-        let (sp, vp) = self.forced(tc, ph);
+        let (sp, vp) = self.forced(ph);
         let Homogeneous { h, hd, eh, ehd, .. } = self.homogeneous(tc);
         let max_terms = coef.len();
-        // Homogeneous part g_j and forced part F_j = wⱼ·cyc(j) with wⱼ = (ωr)ʲ/j!.
+        // The free part g_j (homogeneous part plus the force's response) and the forced part
+        // F_j = wⱼ·cyc(j) with wⱼ = (ωr)ʲ/j!.
         let (mut g_prev, mut g) = (h + eh, (hd + ehd) * r);
+        // The force's terms φ_k r^{k+2} about tc, which enter g_{k+2} (none: len 0).
+        let mut drive = [0.0; super::poly::TERMS];
+        let drive_len = self.force.len;
+        let mut drive_size = 0.0;
+        if drive_len > 0 {
+            let resp = self.response(tc);
+            g_prev += resp.r;
+            g += resp.rd * r;
+            let b = self.force.shifted(tc);
+            let mut rk = r * r;
+            for k in 0..drive_len {
+                drive[k] = b.c[k] * rk;
+                drive_size += drive[k].abs() * INV[k + 1] * INV[k + 2];
+                rk *= r;
+            }
+        }
         // The forced part's scaled coefficients cycle through (A, B, −A, −B)·wⱼ: carry the
         // pair (Fⱼ, Fⱼ₊₁ rotated back) and rotate it by a quarter turn per term.
         let amp_a = self.pc * ph.cos + self.ps * ph.sin;
         let amp_b = self.ps * ph.cos - self.pc * ph.sin;
         // No overflow is possible at these magnitudes: no need for hypot.
         let amp = (self.pc * self.pc + self.ps * self.ps).sqrt();
-        // The polynomial part's scaled Taylor coefficients b_j r^j about tc (none: len 0).
-        let mut poly = [0.0; TERMS];
-        let poly_len = self.poly.len;
-        let mut poly_size = 0.0;
-        if poly_len > 0 {
-            let (b, _) = self.poly.taylor_at(tc);
-            let mut rj = 1.0;
-            for j in 0..poly_len {
-                poly[j] = b[j] * rj;
-                poly_size += poly[j].abs();
-                rj *= r;
-            }
-        }
-        let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs() + poly_size);
+        let tol = rel * (self.mean.abs() + amp + g_prev.abs() + g.abs() + drive_size);
         // Terms beyond the reciprocal table are never needed (a sub-piece needs about 20).
         let max_terms = max_terms.min(RECIPROCALS - 1);
-        if max_terms < 2 || max_terms < poly_len {
+        if max_terms < 2 || (drive_len > 0 && max_terms < drive_len + 2) {
             return (0, f64::INFINITY, tol);
         }
-        coef[0] = (sp + h) + eh;
-        coef[1] = ((vp + hd) + ehd) * r;
+        if drive_len == 0 {
+            coef[0] = (sp + h) + eh;
+            coef[1] = ((vp + hd) + ehd) * r;
+        } else {
+            coef[0] = sp + g_prev;
+            coef[1] = vp * r + g;
+        }
         let wr = self.omega * r;
         // (p, q) = wⱼ·(cycⱼ, cycⱼ₊₁) with wⱼ = (ωr)ʲ/j!, at j = 1.
         let (mut p, mut q) = (wr * amp_b, -wr * amp_a);
@@ -488,21 +566,20 @@ impl Oscillator {
         let mut inv_prev = 1.0;
         for (j, slot) in coef.iter_mut().enumerate().take(max_terms).skip(2) {
             let inv_j = INV[j];
-            let g_next = -(two_ar * g + wn2r2 * g_prev * inv_prev) * inv_j;
+            let mut g_next = -(two_ar * g + wn2r2 * g_prev * inv_prev) * inv_j;
+            if j < drive_len + 2 {
+                g_next += drive[j - 2] * inv_j * inv_prev;
+            }
             let step = wr * inv_j;
             (p, q) = (q * step, -p * step);
             w *= step;
-            *slot = if j < poly_len {
-                p + g_next + poly[j]
-            } else {
-                p + g_next
-            };
+            *slot = p + g_next;
             g_prev = g;
             g = g_next;
             inv_prev = inv_j;
             n = j + 1;
             // Terms 0..=j are written: bound the tail Σ_{i > j} (see the docs).
-            if j as f64 >= min_terms && j + 1 >= poly_len {
+            if j as f64 >= min_terms && j > drive_len {
                 let forced_tail = FORCED_TAIL * amp * w * wr * INV[j + 1];
                 tail = forced_tail + HOMOGENEOUS_TAIL * g.abs().max(g_prev.abs());
                 if tail <= tol {
@@ -628,7 +705,7 @@ mod tests {
         let forcing = Forcing::new(0.08, wn * (1.0 - 1e-5));
         for (t0, s0, v0) in [(0.37, 0.07146086647170276, 2.697164490916262), (5.1, -0.013, 0.4)] {
             let osc = Oscillator::new(k, &forcing, t0, s0, v0).unwrap();
-            let (sp, _) = osc.forced(t0, forcing.phase(t0));
+            let (sp, _) = osc.forced(forcing.phase(t0));
             assert!(sp.abs() > 100.0 * s0.abs(), "not near resonance: {sp}");
             let (s, v) = osc.state(t0, forcing.phase(t0));
             assert!((s - s0).abs() <= 2.0 * f64::EPSILON * s0.abs(), "{s} vs {s0}");
@@ -707,6 +784,59 @@ mod tests {
                     "c = {c}, x = {x}: {sum} vs {s}"
                 );
             }
+        }
+    }
+
+    /// The response to a polynomial force is summed as a series up to `Λτ = SERIES_REACH`
+    /// and from the particular polynomial beyond: the two formulas agree at the switch, in
+    /// every damping regime, and on a short flow the series keeps its digits where the
+    /// particular polynomial's would cancel (the response of a constant force is
+    /// `2a sin²(ωτ/2)/ω²` undamped).
+    #[test]
+    fn the_response_is_continuous_where_its_formula_changes() {
+        let forcing = Forcing::new(0.05, 30.0);
+        let f = Poly::new(0.0, &[0.3, -2.0, 5.0, 40.0, -100.0, 300.0, 900.0]);
+        for c in [0.0, 0.3, 2.0 * (0.1f64 * 100.0).sqrt(), 20.0] {
+            let k = OscConstants {
+                mass: 0.1,
+                damping: c,
+                stiffness: 100.0,
+                force: 0.0,
+                poly: f,
+            };
+            let osc = Oscillator::new(k, &forcing, 0.0, 0.0, 0.0).unwrap();
+            let lam = 2.0 * osc.alpha + osc.wn2.sqrt();
+            let tau = SERIES_REACH / lam;
+            let series = response::series(&osc.force, osc.alpha, osc.wn2, tau);
+            let closed = osc.response(tau.next_up());
+            assert!(
+                (series.r - closed.r).abs() <= 1e-12 * series.mag.max(closed.mag),
+                "c = {c}: {} vs {}",
+                series.r,
+                closed.r
+            );
+            assert!(
+                (series.rd - closed.rd).abs() <= 1e-12 * series.mag_d.max(closed.mag_d),
+                "c = {c}"
+            );
+        }
+        let k = OscConstants {
+            mass: 0.1,
+            damping: 0.0,
+            stiffness: 100.0,
+            force: 0.0,
+            poly: Poly::new(0.0, &[0.7]),
+        };
+        let osc = Oscillator::new(k, &forcing, 0.0, 0.0, 0.0).unwrap();
+        let w = (100.0f64 / 0.1).sqrt();
+        for tau in [1e-7, 1e-4, 1e-2] {
+            let exact = 2.0 * 7.0 * (0.5 * w * tau).sin().powi(2) / (w * w);
+            let r = osc.response(tau);
+            assert!(
+                (r.r - exact).abs() <= 4.0 * f64::EPSILON * exact,
+                "τ = {tau}: {} vs {exact}",
+                r.r
+            );
         }
     }
 }

@@ -154,28 +154,6 @@ impl Poly {
         p
     }
 
-    /// `p'' + 2α p' + ω_n² p` (the forcing per unit mass that drives the particular
-    /// solution `p` of an oscillator with those constants).
-    pub fn driving(&self, alpha: f64, wn2: f64) -> Poly {
-        let mut f = Poly {
-            t_ref: self.t_ref,
-            len: self.len,
-            ..Poly::ZERO
-        };
-        for j in 0..self.len {
-            let mut v = wn2 * self.c[j];
-            if j + 1 < self.len {
-                v += 2.0 * alpha * (j + 1) as f64 * self.c[j + 1];
-            }
-            if j + 2 < self.len {
-                v += ((j + 2) * (j + 1)) as f64 * self.c[j + 2];
-            }
-            f.c[j] = v;
-        }
-        f.trim();
-        f
-    }
-
     /// Taylor coefficients about `t`, `b_k = p⁽ᵏ⁾(t)/k!`, and those of `|p|` (the same
     /// shift of `|c_j|` by `|t − t_ref|`, the size of the terms each is summed from).
     pub fn taylor_at(&self, t: f64) -> ([f64; TERMS], [f64; TERMS]) {
@@ -243,11 +221,6 @@ mod tests {
                 "{lhs} vs {}",
                 f.value(t)
             );
-        }
-        // And the driving polynomial per unit mass gives f/M back.
-        let g = p.driving(c / (2.0 * m), k / m);
-        for j in 0..f.len {
-            assert!((g.c[j] * m - f.c[j]).abs() <= 1e-13 * f.c.iter().map(|x| x.abs()).sum::<f64>());
         }
     }
 }

@@ -68,13 +68,10 @@ impl Signal {
         self.add_constant(a * osc.mean);
         // s' forced = ω(ps cos − pc sin).
         self.add_harmonic(a * osc.pc + b * omega * osc.ps, a * osc.ps - b * omega * osc.pc);
+        // The homogeneous part and a polynomial force's response from rest are evaluated
+        // through the oscillator at each time (see `jet`).
         self.terms[self.nterms] = Term { osc: osc_index, a, b };
         self.nterms += 1;
-        if !osc.poly.is_zero() {
-            // a·p + b·p' of the particular polynomial p.
-            self.poly.add_scaled(&osc.poly, a);
-            self.poly.add_scaled(&osc.poly.derivative(), b);
-        }
     }
 
     /// Adds `a × q(t)` for a polynomial `q`.
@@ -148,6 +145,10 @@ impl Signal {
         }
         for term in &self.terms[..self.nterms] {
             let osc = &clusters[term.osc].oscillator;
+            if osc.is_driven() {
+                add_driven_term(term, osc, t, horizon, &mut d, &mut bound, &mut mag);
+                continue;
+            }
             let (h, h1, mag_h, mag_h1) = osc.homogeneous_with_magnitude(t);
             let two_a = 2.0 * osc.alpha;
             let wn2 = osc.wn2;
@@ -210,5 +211,81 @@ impl Signal {
             }
             *bn += acc;
         }
+    }
+}
+
+/// `a·u + b·u'` of a term whose oscillator is driven by a polynomial force per unit mass φ:
+/// `u = h + r` (homogeneous part plus the response from rest) obeys
+/// `u'' + 2αu' + ω_n²u = φ`, so `G = a·u + b·u'` obeys the same equation with the forcing
+/// `F = aφ + bφ'`, and so does each derivative `G⁽ⁿ⁾` with `F⁽ⁿ⁾`. The derivatives at `t` follow
+/// from that recurrence. The bounds on `[t, H]` extend the energy argument of the module docs:
+/// for `g'' + 2αg' + ω_n²g = F` with α ≥ 0, `E = g'² + ω_n²g²` has `d√E/ds ≤ |F|`, so
+/// `√E(s) ≤ √E(t) + ∫_t^s |F|`, and `∫_t^H |F⁽ⁿ⁾| ≤ (H − t)·Σ_{k≥n} |F_k| k!/(k−n)! (H − t)^{k−n}`
+/// with `F_k` the Taylor coefficients of F about t.
+#[cold]
+fn add_driven_term(
+    term: &Term,
+    osc: &Oscillator,
+    t: f64,
+    horizon: f64,
+    d: &mut [f64; 4],
+    bound: &mut [f64; 5],
+    mag: &mut [f64; 4],
+) {
+    let (u, u1, mag_u, mag_u1) = osc.free_with_magnitude(t);
+    let phi = osc.force_taylor(t);
+    let len = phi.len;
+    let (a, b) = (term.a, term.b);
+    // F's Taylor coefficients about t: F_k = a φ_k + b (k+1) φ_{k+1}, and their sizes.
+    let mut fk = [0.0; super::poly::TERMS];
+    let mut fk_abs = [0.0; super::poly::TERMS];
+    for k in 0..len {
+        let next = if k + 1 < len {
+            (k + 1) as f64 * phi.c[k + 1]
+        } else {
+            0.0
+        };
+        fk[k] = a * phi.c[k] + b * next;
+        fk_abs[k] = (a * phi.c[k]).abs() + (b * next).abs();
+    }
+    // F⁽ⁿ⁾(t) = n! F_n.
+    let f_at = |n: usize| if n < len { falling(n, n) * fk[n] } else { 0.0 };
+    let f_mag = |n: usize| if n < len { falling(n, n) * fk_abs[n] } else { 0.0 };
+    let two_a = 2.0 * osc.alpha;
+    let wn2 = osc.wn2;
+    let u2 = phi.c.first().copied().unwrap_or(0.0) - two_a * u1 - wn2 * u;
+    let mut g = [0.0; 6];
+    g[0] = a * u + b * u1;
+    g[1] = a * u1 + b * u2;
+    for n in 2..6 {
+        g[n] = -two_a * g[n - 1] - wn2 * g[n - 2] + f_at(n - 2);
+    }
+    let (aa, bb) = (a.abs(), b.abs());
+    let phi0 = phi.c.first().copied().unwrap_or(0.0).abs();
+    let mut m = [0.0; 4];
+    m[0] = aa * mag_u + bb * mag_u1;
+    m[1] = aa * mag_u1 + bb * (two_a * mag_u1 + wn2 * mag_u + phi0);
+    for n in 2..4 {
+        m[n] = two_a * m[n - 1] + wn2 * m[n - 2] + f_mag(n - 2);
+    }
+    for n in 0..4 {
+        d[n] += g[n];
+        mag[n] += m[n];
+    }
+    // ∫_t^H |F⁽ⁿ⁾| for n = 0..=4.
+    let span = (horizon - t).max(0.0);
+    let mut integral = [0.0; 5];
+    for (n, slot) in integral.iter_mut().enumerate() {
+        let mut acc = 0.0;
+        for k in (n..len).rev() {
+            acc = acc * span + falling(k, n) * fk[k].abs();
+        }
+        *slot = span * acc;
+    }
+    let inv_wn = 1.0 / wn2.sqrt();
+    for n in 1..5 {
+        let up = (g[n] * g[n] + g[n + 1] * g[n + 1] / wn2).sqrt() + integral[n] * inv_wn;
+        let down = (g[n] * g[n] + wn2 * g[n - 1] * g[n - 1]).sqrt() + integral[n - 1];
+        bound[n] += up.min(down);
     }
 }

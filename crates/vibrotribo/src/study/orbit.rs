@@ -76,6 +76,7 @@ pub fn power_on_periodic_state(
         terminal_energy_j: solver.terminal_energy(),
         time_to_target: solver.time_to_target(),
         solver: solver.stats(),
+        coupling: None,
         solver_error: None,
         period: chain.period(),
     })

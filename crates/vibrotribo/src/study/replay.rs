@@ -79,6 +79,7 @@ pub fn replay(
             terminal_energy_j: s.terminal_energy(),
             time_to_target: s.time_to_target(),
             solver: s.stats(),
+            coupling: None,
             solver_error: None,
             period,
         },

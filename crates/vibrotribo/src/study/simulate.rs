@@ -9,7 +9,7 @@ use thiserror::Error;
 use super::observer::{ElectricalSample, RunObserver, Sample};
 use super::settings::{ElectricalFailure, RunSpec, Sampling};
 use crate::analysis::RunStats;
-use crate::coupling::{ChargeHost, CoupledChain, Coupling, CouplingError, CouplingOptions};
+use crate::coupling::{ChargeHost, CoupledChain, Coupling, CouplingError, CouplingOptions, CouplingStats};
 use crate::dynamics::{Event, Flow, Observer, RunEnd, Simulator, StateView, Verdict};
 use crate::electrical::breakdown::BreakdownMargin;
 use crate::electrical::{
@@ -68,6 +68,8 @@ pub struct ElectricalOutcome {
     pub time_to_target: Option<f64>,
     /// The solver's work counters.
     pub solver: SolverStats,
+    /// The coupled run's work counters (two-way coupling only).
+    pub coupling: Option<CouplingStats>,
     /// The solver's failure, if it failed while the mechanics went on
     /// ([`ElectricalFailure::KeepMechanics`]).
     pub solver_error: Option<ElectricalError>,
@@ -268,6 +270,10 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         terminal_energy_j: s.terminal_energy(),
         time_to_target: s.time_to_target(),
         solver: s.stats(),
+        coupling: match &mechanics {
+            Mechanics::Coupled(c) => Some(c.stats()),
+            Mechanics::Plain(_) => None,
+        },
         solver_error: s.status().err(),
         period,
     });
