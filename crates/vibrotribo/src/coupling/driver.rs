@@ -505,6 +505,8 @@ impl CoupledChain {
             _ => ChargePolynomial::constant(q0, h),
         };
         let mut sweeps = 0;
+        // The last window length, s, redone shorter for its error estimate, and that estimate, C.
+        let mut too_long: Option<(f64, f64)> = None;
         let mut cuts = 0;
         // Whether `target` holds the force moments measured by the last sweep of this window
         // (same length): the next trial then matches them.
@@ -625,7 +627,19 @@ impl CoupledChain {
             if estimate > tol {
                 host.charge_solver().rewind(&cp);
                 self.stats.shortened += 1;
-                let factor = (0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)).clamp(0.1, 0.8);
+                // The estimate falls as h^(DEGREE+1) where the charge is smooth, but only about
+                // as h where the window holds the start of a boundary layer (the charge's R·C
+                // relaxation after an impact): after a first cut, the order the estimate showed
+                // between the last two lengths decides the next cut.
+                let order = match too_long {
+                    Some((h_prev, e_prev)) if h_prev > h && e_prev > estimate => {
+                        ((e_prev / estimate).ln() / (h_prev / h).ln()).clamp(1.0, (DEGREE + 1) as f64)
+                    }
+                    Some(_) => 1.0,
+                    None => (DEGREE + 1) as f64,
+                };
+                too_long = Some((h, estimate));
+                let factor = (0.8 * (tol / estimate).powf(1.0 / order)).clamp(0.02, 0.8);
                 let shorter = h * factor;
                 if shorter <= MIN_WINDOW * period {
                     return Err(CouplingError::WindowCollapsed { t: t0, h: shorter });
@@ -658,9 +672,9 @@ impl CoupledChain {
                 continue;
             }
             let grow = if estimate > 0.0 {
-                (0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)).clamp(0.2, 2.0)
+                (0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)).clamp(0.2, 4.0)
             } else {
-                2.0
+                4.0
             };
             let next = (h * grow).min(self.options.max_window_periods * period);
             host.charge_solver().stop_moments();

@@ -603,10 +603,10 @@ const HOMOGENEOUS_TAIL: f64 =
 const FORCED_TAIL: f64 = TAIL_K / (TAIL_K - 1.0);
 
 /// Most Taylor terms with tabulated reciprocals.
-const RECIPROCALS: usize = 64;
+pub(super) const RECIPROCALS: usize = 64;
 
 /// `1/j` for `j` in `0..RECIPROCALS` (`1/0` unused).
-static INV: [f64; RECIPROCALS] = {
+pub(super) static INV: [f64; RECIPROCALS] = {
     let mut t = [0.0; RECIPROCALS];
     let mut j = 1;
     while j < RECIPROCALS {

@@ -28,6 +28,7 @@
 //! `2c/(1 − c)` times the larger of the last two terms (and that of `Σ k s_k` below
 //! `2c((j+4)/(1 − c) + 2c/(1 − c)²)` times it).
 
+use super::oscillator::{INV, RECIPROCALS};
 use super::poly::Poly;
 
 /// Largest `Λ|τ|` (Λ = 2α + ω_n, 1/s) at which the response is summed as a series (module
@@ -35,7 +36,7 @@ use super::poly::Poly;
 pub(crate) const SERIES_REACH: f64 = 6.0;
 
 /// Most terms of the series (never reached within [`SERIES_REACH`]: about 40 suffice).
-const MAX_TERMS: usize = 96;
+const MAX_TERMS: usize = RECIPROCALS - 3;
 
 /// The response from rest at one time (module docs).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -66,28 +67,29 @@ pub(crate) fn series(force: &Poly, alpha: f64, wn2: f64, tau: f64) -> Response {
     let rel = 0.25 * f64::EPSILON;
     for k in 0..MAX_TERMS {
         // s_{k+2} from s_{k+1} = s and s_k = s_prev.
-        let kf = k as f64;
-        let mut num = -(xa * (kf + 1.0) * s + xw2 * s_prev);
+        let mut num = -(xa * (k + 1) as f64 * s + xw2 * s_prev);
         if k < a.len() {
             num += a[k] * tau_pow;
             tau_pow *= tau;
         }
-        let next = num / ((kf + 2.0) * (kf + 1.0));
+        let next = num * (INV[k + 2] * INV[k + 1]);
+        let weight = (k + 2) as f64;
         sum += next;
-        dsum += (kf + 2.0) * next;
+        dsum += weight * next;
         mag += next.abs();
-        dmag += (kf + 2.0) * next.abs();
+        dmag += weight * next.abs();
         s_prev = s;
         s = next;
         if k + 1 >= a.len() {
-            // From s_{k+3} on the recurrence is homogeneous (module docs), j = k + 1.
-            let j = kf + 1.0;
-            let c = xa.abs() / (j + 2.0) + xw2 / ((j + 2.0) * (j + 1.0));
+            // From s_{k+3} on the recurrence is homogeneous (module docs), j = k + 1: the tail
+            // tests `2c/(1 − c)·m ≤ rel·mag` and its derivative's, multiplied out.
+            let c = (xa.abs() + xw2 * INV[k + 2]) * INV[k + 3];
             if c < 0.5 {
-                let m = s.abs().max(s_prev.abs());
-                let tail = 2.0 * c / (1.0 - c) * m;
-                let dtail = 2.0 * c * ((j + 3.0) / (1.0 - c) + 2.0 * c / ((1.0 - c) * (1.0 - c))) * m;
-                if tail <= rel * mag && dtail <= rel * dmag {
+                let one_c = 1.0 - c;
+                let m2c = 2.0 * c * s.abs().max(s_prev.abs());
+                if m2c <= rel * mag * one_c
+                    && m2c * ((k + 4) as f64 * one_c + 2.0 * c) <= rel * dmag * one_c * one_c
+                {
                     break;
                 }
             }

@@ -249,8 +249,9 @@ fn add_driven_term(
         fk_abs[k] = (a * phi.c[k]).abs() + (b * next).abs();
     }
     // F⁽ⁿ⁾(t) = n! F_n.
-    let f_at = |n: usize| if n < len { falling(n, n) * fk[n] } else { 0.0 };
-    let f_mag = |n: usize| if n < len { falling(n, n) * fk_abs[n] } else { 0.0 };
+    const FACTORIAL: [f64; 4] = [1.0, 1.0, 2.0, 6.0];
+    let f_at = |n: usize| if n < len { FACTORIAL[n] * fk[n] } else { 0.0 };
+    let f_mag = |n: usize| if n < len { FACTORIAL[n] * fk_abs[n] } else { 0.0 };
     let two_a = 2.0 * osc.alpha;
     let wn2 = osc.wn2;
     let u2 = phi.c.first().copied().unwrap_or(0.0) - two_a * u1 - wn2 * u;
@@ -272,15 +273,20 @@ fn add_driven_term(
         d[n] += g[n];
         mag[n] += m[n];
     }
-    // ∫_t^H |F⁽ⁿ⁾| for n = 0..=4.
+    // ∫_t^H |F⁽ⁿ⁾| for n = 0..=4: Horner in span over the coefficients of the n-th derivative
+    // of Σ|F_k|xᵏ, each derived from the last.
     let span = (horizon - t).max(0.0);
     let mut integral = [0.0; 5];
+    let mut deriv = fk.map(f64::abs);
     for (n, slot) in integral.iter_mut().enumerate() {
-        let mut acc = 0.0;
-        for k in (n..len).rev() {
-            acc = acc * span + falling(k, n) * fk[k].abs();
+        if n >= len {
+            break;
         }
-        *slot = span * acc;
+        let terms = &deriv[..len - n];
+        *slot = span * terms.iter().rev().fold(0.0, |acc, &c| acc * span + c);
+        for k in 0..len - n - 1 {
+            deriv[k] = (k + 1) as f64 * deriv[k + 1];
+        }
     }
     let inv_wn = 1.0 / wn2.sqrt();
     for n in 1..5 {
