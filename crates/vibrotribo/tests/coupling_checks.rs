@@ -733,8 +733,14 @@ fn force_error_accounts_for_the_residual() {
 /// 1e-11, 1e-12, 1e-13 m (with the correction α + βτ, whose start value moved the force at
 /// each window's start: −5.5e-8, 8.6e-10, −1.6e-10, 2.9e-11 J; before the force moments were
 /// matched: 1.4e-6, 5.8e-7, 2.0e-7, −5.4e-7 J). 1e-13 m takes ~5 s of the ~8 s.
+///
+/// Known to fail since stop 21 (windows sampled in one run, the charge at the inner nodes from
+/// the solver's dense output): +1.9e-8, +2.8e-10, −5.2e-10, −1.3e-12 J, the 1e-12 m residual no
+/// smaller than the 1e-11 m one (all within 2.1e-7 of the electrical terms; at stop 20's end
+/// the table was +1.3e-8, +4.0e-10, −3.3e-10, −3.2e-12 J, its 1e-11 and 1e-12 m rows already
+/// of one size and opposite signs).
 #[test]
-#[ignore = "a table over four tolerances, ~8 s"]
+#[ignore = "known: a table over four tolerances whose 1e-12 m row is no smaller than its 1e-11 m row since stop 21"]
 fn energy_balance_against_the_coupling_tolerance() {
     balance_against_the_coupling_tolerance("two-way", |tolerance| {
         default_case("two_way", 20, 1e-10, tolerance)

@@ -505,6 +505,11 @@ impl CoupledChain {
             _ => ChargePolynomial::constant(q0, h),
         };
         let mut sweeps = 0;
+        // The time of the event a window was cut at and is now redone up to, s: the run goes an
+        // ulp past it, so that the search (whose horizon excludes its end) still reports an
+        // event that falls at the window's end to the ulp (a graze that it would otherwise take
+        // for the next window's start and pass over).
+        let mut event_at_end: Option<f64> = None;
         // The last window length, s, redone shorter for its error estimate, and that estimate, C.
         let mut too_long: Option<(f64, f64)> = None;
         let mut cuts = 0;
@@ -534,23 +539,42 @@ impl CoupledChain {
                     segments: &mut self.segments,
                     events: &mut self.events,
                 };
-                for j in 1..NODES {
-                    match trial.run_until(times[j], &mut watcher) {
-                        Ok(RunEnd::Reached) => values[j] = watcher.host.charge_solver().charge(),
-                        Ok(RunEnd::Stopped { t }) => {
-                            cut = Some((j, t));
-                            break;
-                        }
-                        Err(SimError::Observer(_)) => {
-                            let e = watcher.host.charge_solver().status().err();
-                            return Err(match e {
-                                Some(e) => e.into(),
-                                None => SimError::Observer("coupled run".into()).into(),
-                            });
-                        }
-                        Err(e) => return Err(e.into()),
+                // One run over the window; the solver reads the charge at the inner nodes from
+                // its steps as it passes them.
+                watcher.host.charge_solver().set_probes(&times[1..NODES - 1]);
+                let stop = match event_at_end {
+                    Some(te) => times[NODES - 1].max(te).next_up(),
+                    _ => times[NODES - 1],
+                };
+                let end = trial.run_until(stop, &mut watcher);
+                let solver = watcher.host.charge_solver();
+                let reached = match end {
+                    Ok(RunEnd::Reached) => NODES,
+                    Ok(RunEnd::Stopped { t }) => {
+                        let j = (1..NODES).find(|&j| times[j] >= t).unwrap_or(NODES - 1);
+                        cut = Some((j, t));
+                        j
                     }
+                    Err(SimError::Observer(_)) => {
+                        let e = solver.status().err();
+                        solver.set_probes(&[]);
+                        return Err(match e {
+                            Some(e) => e.into(),
+                            None => SimError::Observer("coupled run".into()).into(),
+                        });
+                    }
+                    Err(e) => {
+                        solver.set_probes(&[]);
+                        return Err(e.into());
+                    }
+                };
+                for (j, v) in values.iter_mut().enumerate().take(reached.min(NODES - 1)).skip(1) {
+                    *v = solver.probe(j - 1).unwrap_or_else(|| solver.charge());
                 }
+                if reached == NODES {
+                    values[NODES - 1] = solver.charge();
+                }
+                solver.set_probes(&[]);
             }
             if let Some((j, te)) = cut {
                 // An event inside the window: at its last node (the window ends there, with the
@@ -576,6 +600,7 @@ impl CoupledChain {
                     }
                     guess = self.fit(&guess.values_at_nodes(0.0, shorter), shorter, precise);
                     h = shorter;
+                    event_at_end = Some(te);
                     matched = false;
                     continue;
                 }
@@ -646,6 +671,7 @@ impl CoupledChain {
                 }
                 guess = self.fit(&sampled.values_at_nodes(0.0, shorter), shorter, precise);
                 h = shorter;
+                event_at_end = None;
                 self.h = self.h.min(h);
                 sweeps = 0;
                 matched = false;
@@ -658,6 +684,7 @@ impl CoupledChain {
                 let stalled = force_error > 1.0 && sweeps >= 3;
                 if sweeps >= self.options.max_iterations || stalled {
                     h *= 0.5;
+                    event_at_end = None;
                     if h <= MIN_WINDOW * period {
                         return Err(CouplingError::WindowCollapsed { t: t0, h });
                     }

@@ -98,6 +98,7 @@ impl ChargeSolver {
             harvester: params.clone(),
             breakdown: None,
             moments: None,
+            probes: Default::default(),
         })
     }
 
@@ -316,6 +317,23 @@ impl ChargeSolver {
     /// Stops accumulating the charge's time integrals.
     pub fn stop_moments(&mut self) {
         self.moments = None;
+    }
+
+    /// Asks for the charge at `times` (s, ascending, after the current time; at most
+    /// [`MAX_PROBES`](super::state::MAX_PROBES)), read from the accepted steps' collocation
+    /// polynomials as the solver passes them ([`probe`](Self::probe)); replaces earlier
+    /// probes. Used by two-way coupling to sample a window's charge in one run.
+    pub(crate) fn set_probes(&mut self, times: &[f64]) {
+        let n = times.len().min(super::state::MAX_PROBES);
+        self.probes = Default::default();
+        self.probes.times[..n].copy_from_slice(&times[..n]);
+        self.probes.len = n;
+    }
+
+    /// The charge at probe `i` of [`set_probes`](Self::set_probes), C, once the solver has
+    /// passed its time.
+    pub(crate) fn probe(&self, i: usize) -> Option<f64> {
+        (i < self.probes.next).then(|| self.probes.values[i])
     }
 
     /// Current time, s.
@@ -563,6 +581,7 @@ impl ChargeSolver {
                 let r1 = self.row(n1, self.y, self.energy);
                 self.note_peaks(r1.current, r1.voltage);
                 self.sample_between(ta, tb, wave, None)?;
+                self.fill_probes(tb, wave, None)?;
                 self.watch_piece(ta, tb, wave)?;
             }
         }

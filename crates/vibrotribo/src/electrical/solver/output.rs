@@ -24,6 +24,11 @@ impl ChargeSolver {
 
     /// Outputs of the last accepted step: samples, V–Q points, target crossing, breakdown.
     pub(super) fn record<W: GapWaveform + ?Sized>(&mut self, wave: &W) -> Result<(), ElectricalError> {
+        if self.probes.next < self.probes.len
+            && let Some(step) = self.last_step
+        {
+            self.fill_probes(step.t0 + step.h, wave, Some(&step))?;
+        }
         if self.breakdown.is_some() {
             self.watch_step(wave)?;
         }
@@ -214,6 +219,36 @@ impl ChargeSolver {
                 _ => self.vq = grid,
             }
             result?;
+        }
+        Ok(())
+    }
+}
+
+impl ChargeSolver {
+    /// The charges at the probe times up to `tb` (s) that are still open: from `step`'s
+    /// collocation polynomial (`tb` its end), or with no step (open and short circuit, whose
+    /// charge follows the gaps algebraically) from the state at each time. A probe at `tb`
+    /// takes the state reached there.
+    pub(super) fn fill_probes<W: GapWaveform + ?Sized>(
+        &mut self,
+        tb: f64,
+        wave: &W,
+        step: Option<&Step>,
+    ) -> Result<(), ElectricalError> {
+        while self.probes.next < self.probes.len && self.probes.times[self.probes.next] <= tb {
+            let t = self.probes.times[self.probes.next];
+            let q = if t == tb {
+                self.charge()
+            } else {
+                let ts = self.eval(t, wave)?;
+                let (y, e) = match step {
+                    Some(s) => self.dense(s, t, ts.equilibrium_charge),
+                    None => (self.y, self.energy),
+                };
+                self.row(ts, y, e).charge
+            };
+            self.probes.values[self.probes.next] = q;
+            self.probes.next += 1;
         }
         Ok(())
     }

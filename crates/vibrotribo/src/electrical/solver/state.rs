@@ -222,6 +222,33 @@ pub struct ChargeSolver {
     pub(super) breakdown: Option<BreakdownWatch>,
     /// Charge moments accumulated over the accepted steps, if requested (two-way coupling).
     pub(super) moments: Option<ChargeMoments>,
+    /// Times at which the charge is wanted from the accepted steps (two-way coupling).
+    pub(super) probes: Probes,
+}
+
+/// Most probe times at once ([`ChargeSolver::set_probes`]).
+pub(crate) const MAX_PROBES: usize = 16;
+
+/// Times at which the charge is read from the accepted steps' collocation polynomials as the
+/// solver passes them, and the charges found, C (NaN until passed).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Probes {
+    pub times: [f64; MAX_PROBES],
+    pub values: [f64; MAX_PROBES],
+    pub len: usize,
+    /// The first probe not yet passed.
+    pub next: usize,
+}
+
+impl Default for Probes {
+    fn default() -> Self {
+        Probes {
+            times: [0.0; MAX_PROBES],
+            values: [f64::NAN; MAX_PROBES],
+            len: 0,
+            next: 0,
+        }
+    }
 }
 
 /// Time integrals of the charge over the steps accepted since
