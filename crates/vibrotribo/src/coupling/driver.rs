@@ -505,6 +505,9 @@ impl CoupledChain {
             _ => ChargePolynomial::constant(q0, h),
         };
         let mut sweeps = 0;
+        // Every trial below that is not accepted rewinds the solver to this state before the
+        // next one.
+        let cp = host.charge_solver().checkpoint();
         // The time of the event a window was cut at and is now redone up to, s: the run goes an
         // ulp past it, so that the search (whose horizon excludes its end) still reports an
         // event that falls at the window's end to the ulp (a graze that it would otherwise take
@@ -524,7 +527,6 @@ impl CoupledChain {
             if precise {
                 negligible = negligible.min(0.25 * self.force_tolerance());
             }
-            let cp = host.charge_solver().checkpoint();
             let tracked = host.charge_solver().start_moments(t0, q0);
             let mut trial = self.sim.clone();
             self.install(&mut trial, t0, &guess, q0, negligible, matched)?;
