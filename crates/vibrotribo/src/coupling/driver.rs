@@ -117,6 +117,8 @@ pub struct CoupledChain {
     /// Preferred length of the next window, s.
     h: f64,
     previous: Option<Previous>,
+    /// A simulator whose buffers the next trial reuses (see [`Simulator::assign_from`]).
+    spare: Option<Simulator>,
     /// Smallest mass, kg.
     min_mass: f64,
     /// Largest natural frequency of a single mass, rad/s.
@@ -177,6 +179,7 @@ impl CoupledChain {
             options,
             h,
             previous: None,
+            spare: None,
             min_mass,
             omega_n,
             series_x,
@@ -519,6 +522,7 @@ impl CoupledChain {
         // Whether `target` holds the force moments measured by the last sweep of this window
         // (same length): the next trial then matches them.
         let mut matched = false;
+        let mut trial = self.spare.take().unwrap_or_else(|| self.sim.clone());
         loop {
             sweeps += 1;
             self.stats.sweeps += 1;
@@ -528,7 +532,7 @@ impl CoupledChain {
                 negligible = negligible.min(0.25 * self.force_tolerance());
             }
             let tracked = host.charge_solver().start_moments(t0, q0);
-            let mut trial = self.sim.clone();
+            trial.assign_from(&self.sim);
             self.install(&mut trial, t0, &guess, q0, negligible, matched)?;
             self.segments.clear();
             self.events.clear();
@@ -713,7 +717,8 @@ impl CoupledChain {
     }
 
     fn accept(&mut self, trial: Simulator, t0: f64, charge: ChargePolynomial, cut: bool, next: Option<f64>) {
-        self.sim = trial;
+        // The window's start state becomes the next window's trial buffer.
+        self.spare = Some(std::mem::replace(&mut self.sim, trial));
         self.stats.windows += 1;
         self.previous = Some(Previous { t0, charge, cut });
         if let Some(next) = next

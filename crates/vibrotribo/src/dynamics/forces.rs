@@ -37,6 +37,12 @@ impl ExternalForces {
         self.constant.is_empty() && self.poly.is_empty()
     }
 
+    /// Makes `self` a copy of `other`, reusing its buffers.
+    pub fn assign_from(&mut self, other: &ExternalForces) {
+        self.constant.clone_from(&other.constant);
+        self.poly.clone_from(&other.poly);
+    }
+
     /// Whether time polynomials are set.
     #[inline]
     pub fn has_polynomials(&self) -> bool {

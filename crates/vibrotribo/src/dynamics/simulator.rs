@@ -88,7 +88,7 @@ pub(super) struct ClusterConsts {
 /// ```
 #[derive(Debug, Clone)]
 pub struct Simulator {
-    pub(super) params: ChainParams,
+    pub(super) params: std::sync::Arc<ChainParams>,
     pub(super) options: SimOptions,
     pub(super) forcing: Forcing,
     /// The external forces on the masses.
@@ -170,7 +170,7 @@ impl Simulator {
         let mut sim = Simulator {
             forcing,
             forces: ExternalForces::new(params),
-            params: params.clone(),
+            params: std::sync::Arc::new(params.clone()),
             options,
             offsets,
             t: t0,
@@ -213,6 +213,70 @@ impl Simulator {
     /// The parameters being simulated.
     pub fn params(&self) -> &ChainParams {
         &self.params
+    }
+
+    /// Makes `self` a copy of `other`, reusing its buffers (a clone without allocations, for
+    /// callers that copy a simulator many times: two-way coupling's trials).
+    pub(crate) fn assign_from(&mut self, other: &Simulator) {
+        // Destructured so that a new field cannot be forgotten here.
+        let Simulator {
+            params,
+            options,
+            forcing,
+            forces,
+            offsets,
+            t,
+            phase_now,
+            period_index,
+            events_in_period,
+            clusters,
+            consts,
+            closure,
+            x,
+            v,
+            last_speed,
+            sequence,
+            pos_tol,
+            vel_tol,
+            acc_tol,
+            term_scale,
+            scratch_first_speed,
+            scratch_lambda,
+            scratch_q,
+            scratch_active,
+            scratch_candidate,
+            scratch_events,
+            scratch_resting,
+            search_from,
+        } = other;
+        self.params = params.clone();
+        self.options = options.clone();
+        self.forcing = *forcing;
+        self.forces.assign_from(forces);
+        self.offsets.clone_from(offsets);
+        self.t = *t;
+        self.phase_now = *phase_now;
+        self.period_index = *period_index;
+        self.events_in_period = *events_in_period;
+        self.clusters.clone_from(clusters);
+        self.consts.clone_from(consts);
+        self.closure.clone_from(closure);
+        self.x.clone_from(x);
+        self.v.clone_from(v);
+        self.last_speed.clone_from(last_speed);
+        self.sequence.clone_from(sequence);
+        self.pos_tol = *pos_tol;
+        self.vel_tol = *vel_tol;
+        self.acc_tol = *acc_tol;
+        self.term_scale = *term_scale;
+        self.scratch_first_speed.clone_from(scratch_first_speed);
+        self.scratch_lambda.clone_from(scratch_lambda);
+        self.scratch_q.clone_from(scratch_q);
+        self.scratch_active.clone_from(scratch_active);
+        self.scratch_candidate.clone_from(scratch_candidate);
+        self.scratch_events.clone_from(scratch_events);
+        self.scratch_resting.clone_from(scratch_resting);
+        self.search_from.clone_from(search_from);
     }
 
     /// Excitation period T, s.
