@@ -26,8 +26,7 @@
 //! `p` on long ones), so that the homogeneous part keeps the initial conditions of the
 //! harmonic motion alone; without one the flow is computed exactly as before.
 
-use super::poly::Poly;
-use super::response::{self, Response, SERIES_REACH};
+use super::poly::{INV, Poly, RECIPROCALS};
 use crate::error::SimError;
 
 /// The forcing phase at a time: `cos ωt` and `sin ωt`, computed once per time and shared by
@@ -161,17 +160,17 @@ pub(crate) struct OscConstants {
 
 /// The homogeneous part of an [`Oscillator`] at one instant (see `Oscillator::homogeneous`).
 #[derive(Debug, Clone, Copy)]
-struct Homogeneous {
+pub(super) struct Homogeneous {
     /// h, m.
-    h: f64,
+    pub h: f64,
     /// h', m/s.
-    hd: f64,
+    pub hd: f64,
     /// The propagated rounding error of the initial conditions in h, m, and in h', m/s.
-    eh: f64,
-    ehd: f64,
+    pub eh: f64,
+    pub ehd: f64,
     /// Sums of the magnitudes of the terms of h, m, and of h', m/s.
-    mag_h: f64,
-    mag_hd: f64,
+    pub mag_h: f64,
+    pub mag_hd: f64,
 }
 
 impl Oscillator {
@@ -312,54 +311,10 @@ impl Oscillator {
         self.force
     }
 
-    /// Whether a polynomial external force drives this flow.
-    #[inline]
-    pub(crate) fn is_driven(&self) -> bool {
-        !self.force.is_zero()
-    }
-
-    /// The response from rest to the polynomial force at time `t` (zero without one): its
-    /// power series while `(2α + ω_n)|t − t0|` ≤ [`SERIES_REACH`], beyond that the particular
-    /// polynomial plus the homogeneous solution that cancels its initial values, well
-    /// conditioned there (see [`super::response`]).
-    #[inline]
-    pub(crate) fn response(&self, t: f64) -> Response {
-        if self.force.is_zero() {
-            return Response::default();
-        }
-        let tau = t - self.t0;
-        if (2.0 * self.alpha + self.wn2.sqrt()) * tau.abs() <= SERIES_REACH {
-            return response::series(&self.force, self.alpha, self.wn2, tau);
-        }
-        let p = self.force.particular(1.0, 2.0 * self.alpha, self.wn2);
-        let (p0, p1) = (p.c[0], p.c[1]);
-        let (pv, pd) = p.value_and_rate(t);
-        let (c, s) = self.propagator(tau);
-        let (hc, hs) = (p0 * c, (p1 + self.alpha * p0) * s);
-        let (dc, ds) = (p1 * c, (self.wn2 * p0 + self.alpha * p1) * s);
-        Response {
-            r: pv - (hc + hs),
-            rd: pd - (dc - ds),
-            mag: p.magnitude_at(t) + hc.abs() + hs.abs(),
-            mag_d: p.derivative().magnitude_at(t) + dc.abs() + ds.abs(),
-        }
-    }
-
-    /// The force per unit mass about `t`, its coefficients `φ⁽ᵏ⁾(t)/k!`, m/s² per sᵏ (zero
-    /// without a force).
-    #[inline]
-    pub(crate) fn force_taylor(&self, t: f64) -> Poly {
-        if self.force.is_zero() {
-            Poly::ZERO
-        } else {
-            self.force.shifted(t)
-        }
-    }
-
     /// Homogeneous part at time `t`: `h` and `h'`, the rounding-error initial conditions
     /// propagated by the same flow, and the magnitudes of the terms of `h` and `h'`.
     #[inline(always)]
-    fn homogeneous(&self, t: f64) -> Homogeneous {
+    pub(super) fn homogeneous(&self, t: f64) -> Homogeneous {
         let (c, s) = self.propagator(t - self.t0);
         let (h0, h1, e0, e1) = (self.h0, self.h1, self.e0, self.e1);
         let (p, q) = (h0 * c, (h1 + self.alpha * h0) * s);
@@ -382,28 +337,9 @@ impl Oscillator {
         (g.h + g.eh, g.hd + g.ehd, g.mag_h, g.mag_hd)
     }
 
-    /// The free motion `u = h + r` at time `t`: the homogeneous part plus the response from
-    /// rest to the polynomial force (which solves `u'' + 2αu' + ω_n²u = f/M`), as
-    /// `(u, u', magnitude of u's terms, magnitude of u''s terms)`. Without a force it is
-    /// [`homogeneous_with_magnitude`](Self::homogeneous_with_magnitude).
-    #[inline]
-    pub(crate) fn free_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
-        let g = self.homogeneous(t);
-        if self.force.is_zero() {
-            return (g.h + g.eh, g.hd + g.ehd, g.mag_h, g.mag_hd);
-        }
-        let r = self.response(t);
-        (
-            (g.h + g.eh) + r.r,
-            (g.hd + g.ehd) + r.rd,
-            g.mag_h + r.mag,
-            g.mag_hd + r.mag_d,
-        )
-    }
-
     /// `e^{−ατ}c(τ)` and `e^{−ατ}s(τ)` of the module docs.
     #[inline]
-    fn propagator(&self, tau: f64) -> (f64, f64) {
+    pub(super) fn propagator(&self, tau: f64) -> (f64, f64) {
         if tau == 0.0 {
             // Every regime's exact value at τ = 0 (what the formulas below round to there),
             // without an exponential and a sine-cosine: every search begins at the start of
@@ -602,20 +538,6 @@ const HOMOGENEOUS_TAIL: f64 =
 /// Tail of the forced part over its next term: `K/(K − 1)`.
 const FORCED_TAIL: f64 = TAIL_K / (TAIL_K - 1.0);
 
-/// Most Taylor terms with tabulated reciprocals.
-pub(super) const RECIPROCALS: usize = 64;
-
-/// `1/j` for `j` in `0..RECIPROCALS` (`1/0` unused).
-pub(super) static INV: [f64; RECIPROCALS] = {
-    let mut t = [0.0; RECIPROCALS];
-    let mut j = 1;
-    while j < RECIPROCALS {
-        t[j] = 1.0 / j as f64;
-        j += 1;
-    }
-    t
-};
-
 /// `a + b` and its exact rounding error (Knuth's TwoSum): `a + b = s + e` exactly.
 #[inline]
 fn two_sum(a: f64, b: f64) -> (f64, f64) {
@@ -784,59 +706,6 @@ mod tests {
                     "c = {c}, x = {x}: {sum} vs {s}"
                 );
             }
-        }
-    }
-
-    /// The response to a polynomial force is summed as a series up to `Λτ = SERIES_REACH`
-    /// and from the particular polynomial beyond: the two formulas agree at the switch, in
-    /// every damping regime, and on a short flow the series keeps its digits where the
-    /// particular polynomial's would cancel (the response of a constant force is
-    /// `2a sin²(ωτ/2)/ω²` undamped).
-    #[test]
-    fn the_response_is_continuous_where_its_formula_changes() {
-        let forcing = Forcing::new(0.05, 30.0);
-        let f = Poly::new(0.0, &[0.3, -2.0, 5.0, 40.0, -100.0, 300.0, 900.0]);
-        for c in [0.0, 0.3, 2.0 * (0.1f64 * 100.0).sqrt(), 20.0] {
-            let k = OscConstants {
-                mass: 0.1,
-                damping: c,
-                stiffness: 100.0,
-                force: 0.0,
-                poly: f,
-            };
-            let osc = Oscillator::new(k, &forcing, 0.0, 0.0, 0.0).unwrap();
-            let lam = 2.0 * osc.alpha + osc.wn2.sqrt();
-            let tau = SERIES_REACH / lam;
-            let series = response::series(&osc.force, osc.alpha, osc.wn2, tau);
-            let closed = osc.response(tau.next_up());
-            assert!(
-                (series.r - closed.r).abs() <= 1e-12 * series.mag.max(closed.mag),
-                "c = {c}: {} vs {}",
-                series.r,
-                closed.r
-            );
-            assert!(
-                (series.rd - closed.rd).abs() <= 1e-12 * series.mag_d.max(closed.mag_d),
-                "c = {c}"
-            );
-        }
-        let k = OscConstants {
-            mass: 0.1,
-            damping: 0.0,
-            stiffness: 100.0,
-            force: 0.0,
-            poly: Poly::new(0.0, &[0.7]),
-        };
-        let osc = Oscillator::new(k, &forcing, 0.0, 0.0, 0.0).unwrap();
-        let w = (100.0f64 / 0.1).sqrt();
-        for tau in [1e-7, 1e-4, 1e-2] {
-            let exact = 2.0 * 7.0 * (0.5 * w * tau).sin().powi(2) / (w * w);
-            let r = osc.response(tau);
-            assert!(
-                (r.r - exact).abs() <= 4.0 * f64::EPSILON * exact,
-                "τ = {tau}: {} vs {exact}",
-                r.r
-            );
         }
     }
 }

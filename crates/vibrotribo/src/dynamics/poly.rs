@@ -184,6 +184,20 @@ pub(crate) fn falling(j: usize, n: usize) -> f64 {
     ((j - n + 1)..=j).fold(1.0, |acc, i| acc * i as f64)
 }
 
+/// Most Taylor terms with tabulated reciprocals.
+pub(crate) const RECIPROCALS: usize = 64;
+
+/// `1/j` for `j` in `0..RECIPROCALS` (`1/0` unused).
+pub(crate) static INV: [f64; RECIPROCALS] = {
+    let mut t = [0.0; RECIPROCALS];
+    let mut j = 1;
+    while j < RECIPROCALS {
+        t[j] = 1.0 / j as f64;
+        j += 1;
+    }
+    t
+};
+
 #[cfg(test)]
 mod tests {
     use super::*;
