@@ -6,12 +6,11 @@ use std::ops::ControlFlow;
 use thiserror::Error;
 
 use super::CouplingOptions;
+use super::host::{ChargeHost, Trial};
 use super::window::{ChargePolynomial, DEGREE, NODES, force_polynomial, nodes, significant_degree};
 use crate::dynamics::response::SERIES_REACH;
-use crate::dynamics::{
-    ContactStatus, Event, EventKind, Flow, Observer, RunEnd, Segment, Simulator, StateView, Verdict,
-};
-use crate::electrical::{ChargeMoments, ChargeSolver, ElectricalError, Electrostatics, NoFieldEnergy};
+use crate::dynamics::{ContactStatus, Event, EventKind, RunEnd, Segment, Simulator, StateView};
+use crate::electrical::{ChargeMoments, ElectricalError, Electrostatics, NoFieldEnergy};
 use crate::error::SimError;
 use crate::model::{ChainState, ForcePolynomial};
 
@@ -53,25 +52,6 @@ pub struct CouplingStats {
     pub shortened: u64,
     /// Windows cut short by an event.
     pub cut_by_event: u64,
-}
-
-/// What a coupled run reports to: an [`Observer`] of the accepted motion that also owns the
-/// charge solver the run advances. Its `flow` must not advance that solver again.
-pub trait ChargeHost: Observer {
-    /// The charge solver (advanced by the coupled run, which also rewinds it).
-    fn charge_solver(&mut self) -> &mut ChargeSolver;
-}
-
-/// A [`ChargeHost`] that only holds the solver (no other observer).
-#[derive(Debug, Clone)]
-pub struct SolverOnly(pub ChargeSolver);
-
-impl Observer for SolverOnly {}
-
-impl ChargeHost for SolverOnly {
-    fn charge_solver(&mut self) -> &mut ChargeSolver {
-        &mut self.0
-    }
 }
 
 /// Windows shorter than this many periods carry a constant charge (its variation there is far
@@ -586,13 +566,24 @@ impl CoupledChain {
                 // An event inside the window: at its last node (the window ends there, with the
                 // event applied) or before it (redo the window up to the event).
                 let at_end = j == NODES - 1 && (times[j] - te).abs() <= 1e-9 * h;
+                let shorter = te - t0;
                 if at_end || cuts >= MAX_CUTS {
                     values[j] = host.charge_solver().charge();
+                } else if shorter > 0.0 && shorter < CONSTANT_BELOW * period {
+                    // The event follows the window's start within CONSTANT_BELOW periods (as
+                    // when two contacts close at one instant to rounding): over so short a time
+                    // the trial's force, which starts at the force of the solver's charge, is
+                    // that force, and the trial up to the event is the window, with a constant
+                    // charge (redoing it would repeat the same motion).
+                    self.stats.cut_by_event += 1;
+                    let q = host.charge_solver().charge();
+                    host.charge_solver().stop_moments();
+                    self.accept(trial, t0, ChargePolynomial::constant(q, shorter), true, None);
+                    return Ok(());
                 } else {
                     host.charge_solver().rewind(&cp);
                     self.stats.cut_by_event += 1;
                     cuts += 1;
-                    let shorter = te - t0;
                     if shorter <= 0.0 {
                         // The event is at the window's start: accept it with no flow.
                         host.charge_solver().stop_moments();
@@ -709,7 +700,19 @@ impl CoupledChain {
             } else {
                 4.0
             };
-            let next = (h * grow).min(self.options.max_window_periods * period);
+            let mut next = (h * grow).min(self.options.max_window_periods * period);
+            if cut.is_some() {
+                // A window that ends at an event is as long as the event allows, not as its
+                // accuracy needs: it only lowers the preferred length, to the length its
+                // estimate predicts (without the growth limit), never to a multiple of its own
+                // length (which after an event just past a window's start would start the next
+                // windows from a few picoseconds).
+                next = if estimate > 0.0 {
+                    h * 0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)
+                } else {
+                    f64::INFINITY
+                };
+            }
             host.charge_solver().stop_moments();
             self.accept(trial, t0, sampled, cut.is_some(), Some(next));
             return Ok(());
@@ -756,35 +759,6 @@ fn polynomial_moments(f: &[f64], h: f64) -> [f64; 2] {
         p *= h;
     }
     [i0, i1]
-}
-
-/// The observer of a trial window: advances the host's solver over the flow, records the
-/// flow and events for the host, and stops at the first event.
-struct Trial<'a, H: ?Sized> {
-    host: &'a mut H,
-    segments: &'a mut Vec<Segment>,
-    events: &'a mut Vec<(Event, Vec<f64>, Vec<f64>)>,
-}
-
-impl<H: ChargeHost + ?Sized> Observer for Trial<'_, H> {
-    fn flow(&mut self, flow: &Flow<'_>) {
-        self.host.charge_solver().flow(flow);
-        self.segments.push(flow.to_segment());
-    }
-
-    fn event(&mut self, event: &Event, state: &StateView<'_>) {
-        self.events
-            .push((*event, state.positions.to_vec(), state.velocities.to_vec()));
-    }
-
-    fn proceed(&mut self) -> Verdict {
-        let _ = self.host.charge_solver().proceed()?;
-        if self.events.is_empty() {
-            Ok(ControlFlow::Continue(()))
-        } else {
-            Ok(ControlFlow::Break(()))
-        }
-    }
 }
 
 // Not `#[from]`: that would also make the inner error the `source()`, which the message

@@ -107,9 +107,11 @@
 //! flow is the closed form with a constant force: the coupling adds nothing but the force.
 
 mod driver;
+mod host;
 mod window;
 
-pub use driver::{ChargeHost, CoupledChain, CouplingError, CouplingStats, SolverOnly};
+pub use driver::{CoupledChain, CouplingError, CouplingStats};
+pub use host::{ChargeHost, SolverOnly};
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
