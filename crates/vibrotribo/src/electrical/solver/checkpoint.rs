@@ -31,7 +31,10 @@ impl ChargeSolver {
         let periods = std::mem::take(&mut self.periods);
         let samples = self.sampler.as_mut().map(|g| std::mem::take(&mut g.data));
         let vq = self.vq.as_mut().map(|g| std::mem::take(&mut g.data));
+        // The expansion of the current piece is scratch, rebuilt for every piece: not saved.
+        let poly = std::mem::take(&mut self.poly);
         let saved = Box::new(self.clone());
+        self.poly = poly;
         let cp = ChargeCheckpoint {
             saved,
             periods: periods.len(),
@@ -61,7 +64,9 @@ impl ChargeSolver {
         }
         let mut samples = self.sampler.as_mut().map(|g| std::mem::take(&mut g.data));
         let mut vq = self.vq.as_mut().map(|g| std::mem::take(&mut g.data));
+        let poly = std::mem::take(&mut self.poly);
         *self = (*cp.saved).clone();
+        self.poly = poly;
         self.periods = periods;
         if let (Some(g), Some(mut d), Some(n)) = (self.sampler.as_mut(), samples.take(), cp.samples) {
             d.truncate(n);
