@@ -534,6 +534,8 @@ impl CoupledChain {
                 };
                 let end = trial.run_until(stop, &mut watcher);
                 let solver = watcher.host.charge_solver();
+                let probed: [Option<f64>; NODES - 2] = std::array::from_fn(|i| solver.probe(i));
+                solver.set_probes(&[]);
                 let reached = match end {
                     Ok(RunEnd::Reached) => NODES,
                     Ok(RunEnd::Stopped { t }) => {
@@ -542,25 +544,19 @@ impl CoupledChain {
                         j
                     }
                     Err(SimError::Observer(_)) => {
-                        let e = solver.status().err();
-                        solver.set_probes(&[]);
-                        return Err(match e {
+                        return Err(match solver.status().err() {
                             Some(e) => e.into(),
                             None => SimError::Observer("coupled run".into()).into(),
                         });
                     }
-                    Err(e) => {
-                        solver.set_probes(&[]);
-                        return Err(e.into());
-                    }
+                    Err(e) => return Err(e.into()),
                 };
                 for (j, v) in values.iter_mut().enumerate().take(reached.min(NODES - 1)).skip(1) {
-                    *v = solver.probe(j - 1).unwrap_or_else(|| solver.charge());
+                    *v = probed[j - 1].unwrap_or_else(|| solver.charge());
                 }
                 if reached == NODES {
                     values[NODES - 1] = solver.charge();
                 }
-                solver.set_probes(&[]);
             }
             if let Some((j, te)) = cut {
                 // An event inside the window: at its last node (the window ends there, with the
@@ -661,7 +657,7 @@ impl CoupledChain {
                     None => (DEGREE + 1) as f64,
                 };
                 too_long = Some((h, estimate));
-                let factor = (0.8 * (tol / estimate).powf(1.0 / order)).clamp(0.02, 0.8);
+                let factor = (0.8 * length_ratio(tol, estimate, order)).clamp(0.02, 0.8);
                 let shorter = h * factor;
                 if shorter <= MIN_WINDOW * period {
                     return Err(CouplingError::WindowCollapsed { t: t0, h: shorter });
@@ -695,24 +691,18 @@ impl CoupledChain {
                 }
                 continue;
             }
-            let grow = if estimate > 0.0 {
-                (0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)).clamp(0.2, 4.0)
-            } else {
-                4.0
-            };
-            let mut next = (h * grow).min(self.options.max_window_periods * period);
-            if cut.is_some() {
+            // The length at which the estimate would meet the tolerance, over this one.
+            let ratio = length_ratio(tol, estimate, (DEGREE + 1) as f64);
+            let next = if cut.is_some() {
                 // A window that ends at an event is as long as the event allows, not as its
                 // accuracy needs: it only lowers the preferred length, to the length its
                 // estimate predicts (without the growth limit), never to a multiple of its own
                 // length (which after an event just past a window's start would start the next
                 // windows from a few picoseconds).
-                next = if estimate > 0.0 {
-                    h * 0.8 * (tol / estimate).powf(1.0 / (DEGREE + 1) as f64)
-                } else {
-                    f64::INFINITY
-                };
-            }
+                h * 0.8 * ratio
+            } else {
+                (h * (0.8 * ratio).clamp(0.2, 4.0)).min(self.options.max_window_periods * period)
+            };
             host.charge_solver().stop_moments();
             self.accept(trial, t0, sampled, cut.is_some(), Some(next));
             return Ok(());
@@ -746,6 +736,17 @@ impl CoupledChain {
                 },
             );
         }
+    }
+}
+
+/// The factor by which a window's length can change for its error `estimate` (C) to meet
+/// `tol` (C) if the estimate goes as the length to the power `order` (callers apply a safety
+/// factor of 0.8); infinite for a zero estimate.
+fn length_ratio(tol: f64, estimate: f64, order: f64) -> f64 {
+    if estimate > 0.0 {
+        (tol / estimate).powf(1.0 / order)
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -155,17 +155,12 @@ impl Oscillator {
     /// [`homogeneous_with_magnitude`](Self::homogeneous_with_magnitude).
     #[inline]
     pub(crate) fn free_with_magnitude(&self, t: f64) -> (f64, f64, f64, f64) {
-        let g = self.homogeneous(t);
+        let free = self.homogeneous_with_magnitude(t);
         if self.force.is_zero() {
-            return (g.h + g.eh, g.hd + g.ehd, g.mag_h, g.mag_hd);
+            return free;
         }
         let r = self.response(t);
-        (
-            (g.h + g.eh) + r.r,
-            (g.hd + g.ehd) + r.rd,
-            g.mag_h + r.mag,
-            g.mag_hd + r.mag_d,
-        )
+        (free.0 + r.r, free.1 + r.rd, free.2 + r.mag, free.3 + r.mag_d)
     }
 }
 

@@ -254,7 +254,9 @@ fn add_driven_term(
     let f_mag = |n: usize| if n < len { FACTORIAL[n] * fk_abs[n] } else { 0.0 };
     let two_a = 2.0 * osc.alpha;
     let wn2 = osc.wn2;
-    let u2 = phi.c.first().copied().unwrap_or(0.0) - two_a * u1 - wn2 * u;
+    // φ(t) (c[0] of the shifted force; 0 for none).
+    let phi0 = phi.c[0];
+    let u2 = phi0 - two_a * u1 - wn2 * u;
     let mut g = [0.0; 6];
     g[0] = a * u + b * u1;
     g[1] = a * u1 + b * u2;
@@ -262,10 +264,9 @@ fn add_driven_term(
         g[n] = -two_a * g[n - 1] - wn2 * g[n - 2] + f_at(n - 2);
     }
     let (aa, bb) = (a.abs(), b.abs());
-    let phi0 = phi.c.first().copied().unwrap_or(0.0).abs();
     let mut m = [0.0; 4];
     m[0] = aa * mag_u + bb * mag_u1;
-    m[1] = aa * mag_u1 + bb * (two_a * mag_u1 + wn2 * mag_u + phi0);
+    m[1] = aa * mag_u1 + bb * (two_a * mag_u1 + wn2 * mag_u + phi0.abs());
     for n in 2..4 {
         m[n] = two_a * m[n - 1] + wn2 * m[n - 2] + f_mag(n - 2);
     }
