@@ -111,6 +111,8 @@ pub struct CoupledChain {
     /// Smallest stiffness, N/m.
     min_stiffness: f64,
     stats: CouplingStats,
+    /// Length of the last accepted first window after an event, s (NaN before one).
+    after_event: f64,
     started: bool,
     /// The time of the last window of length zero (an event at its start), s, and how many
     /// such windows in a row were accepted there.
@@ -165,6 +167,7 @@ impl CoupledChain {
             series_x,
             min_stiffness,
             stats: CouplingStats::default(),
+            after_event: f64::NAN,
             started: false,
             instant: (f64::NAN, 0),
             forces: vec![ForcePolynomial::zero(); n],
@@ -464,6 +467,14 @@ impl CoupledChain {
     ) -> Result<(), CouplingError> {
         let period = self.sim.period();
         let mut h = self.h.min(limit - t0);
+        // The first window after an event starts in the charge's R·C layer (after an impact),
+        // where the preferred length of the smooth stretch before it is far too long: it starts
+        // from at most 1.5× the length the last such window was accepted at (consecutive
+        // impacts of a chatter sequence are alike).
+        let after_cut = matches!(self.previous, Some(p) if p.cut);
+        if after_cut && self.after_event > 0.0 {
+            h = h.min(1.5 * self.after_event);
+        }
         let q0 = host.charge_solver().charge();
         let scale = host.charge_solver().transducer().charge_scale();
         // Whether the window decides a contact: a contact is stuck (or in a chatter sequence)
@@ -703,6 +714,9 @@ impl CoupledChain {
             } else {
                 (h * (0.8 * ratio).clamp(0.2, 4.0)).min(self.options.max_window_periods * period)
             };
+            if after_cut && cut.is_none() {
+                self.after_event = h;
+            }
             host.charge_solver().stop_moments();
             self.accept(trial, t0, sampled, cut.is_some(), Some(next));
             return Ok(());
