@@ -452,6 +452,23 @@ impl ChargeSolver {
         }
     }
 
+    /// The transducer at `t` from the gaps alone: like [`eval`](Self::eval) without the rates
+    /// (the equilibrium current is left 0).
+    pub(super) fn eval_value<W: GapWaveform + ?Sized>(
+        &mut self,
+        t: f64,
+        wave: &W,
+    ) -> Result<TransducerState, ElectricalError> {
+        wave.gap_values(t, &mut self.gaps);
+        self.stats.waveform_evaluations += 1;
+        let ts = self.charge_map.state(&self.gaps);
+        if ts.elastance > 0.0 && ts.elastance.is_finite() && ts.equilibrium_charge.is_finite() {
+            Ok(ts)
+        } else {
+            Err(ElectricalError::InvalidGaps { t })
+        }
+    }
+
     /// The transducer at the stage points `times` of a step: like [`eval`](Self::eval)
     /// without the rates (the equilibrium current is left 0).
     #[inline]

@@ -329,7 +329,8 @@ impl ChargeSolver {
 /// Dense output of a layer step at `t` (module docs): the slow part from its collocation
 /// polynomial (`step.z` holds the true stage increments, slow part plus layer) plus `δ·φ`; the
 /// energy from the slow part's stage powers plus the layer's energy so far.
-pub(super) fn dense_layer(
+/// (The energy only if `ENERGY`, else `step.e0`.)
+pub(super) fn dense_layer<const ENERGY: bool>(
     tab: &Tableau<RESISTOR_STAGES>,
     step: &Step,
     layer: &LayerTerm,
@@ -346,10 +347,14 @@ pub(super) fn dense_layer(
         // the product form of the weights is exact to rounding, the monomial one to ~1e-11.)
         let zi = step.z[0][i] - layer.delta * (layer.phi(tab.c[i]) - 1.0);
         u += wi * zi;
-        e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
+        if ENERGY {
+            e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
+        }
     }
     u += layer.delta * layer.phi(theta);
-    e += layer.energy_until(theta);
+    if ENERGY {
+        e += layer.energy_until(theta);
+    }
     ([u, step.y0[1]], e)
 }
 

@@ -13,12 +13,23 @@ impl ChargeSolver {
     /// quasi-static `u` is smooth where `Q` nearly equals `Q_eq`); a non-stiff one evaluates the
     /// collocation polynomial of `Q` and subtracts the exact `Q_eq(t)`.
     pub(super) fn dense(&self, step: &Step, t: f64, qeq: f64) -> ([f64; 2], f64) {
+        self.dense_inner::<true>(step, t, qeq)
+    }
+
+    /// The state alone at `t` inside an accepted step (as [`dense`](Self::dense), without the
+    /// energy's quadrature).
+    pub(super) fn dense_state(&self, step: &Step, t: f64, qeq: f64) -> [f64; 2] {
+        self.dense_inner::<false>(step, t, qeq).0
+    }
+
+    /// [`dense`](Self::dense), with the energy (else `step.e0` in its place) if `ENERGY`.
+    fn dense_inner<const ENERGY: bool>(&self, step: &Step, t: f64, qeq: f64) -> ([f64; 2], f64) {
         if let Some(layer) = &step.layer {
-            super::layer::dense_layer(&self.tab_resistor, step, layer, t)
+            super::layer::dense_layer::<ENERGY>(&self.tab_resistor, step, layer, t)
         } else if step.stages == RESISTOR_STAGES {
-            dense_with(&self.tab_resistor, step, t, qeq)
+            dense_with::<_, ENERGY>(&self.tab_resistor, step, t, qeq)
         } else {
-            dense_with(&self.tab_rectifier, step, t, qeq)
+            dense_with::<_, ENERGY>(&self.tab_rectifier, step, t, qeq)
         }
     }
 
@@ -56,7 +67,7 @@ impl ChargeSolver {
                     if mid <= lo || mid >= hi {
                         break;
                     }
-                    if self.dense(&step, mid, 0.0).0[1] >= target {
+                    if self.dense_state(&step, mid, 0.0)[1] >= target {
                         hi = mid;
                     } else {
                         lo = mid;
@@ -118,7 +129,7 @@ impl ChargeSolver {
             watch.refine(a, b, |t, gaps| match self.eval(t, wave) {
                 Ok(ts) => {
                     gaps.copy_from_slice(&self.gaps[..gaps.len()]);
-                    let (y, _) = self.dense(&step, t, ts.equilibrium_charge);
+                    let y = self.dense_state(&step, t, ts.equilibrium_charge);
                     Some(y[0] + ts.equilibrium_charge)
                 }
                 Err(e) => {
@@ -240,12 +251,12 @@ impl ChargeSolver {
             let q = if t == tb {
                 self.charge()
             } else {
-                let ts = self.eval(t, wave)?;
-                let (y, e) = match step {
-                    Some(s) => self.dense(s, t, ts.equilibrium_charge),
-                    None => (self.y, self.energy),
+                let ts = self.eval_value(t, wave)?;
+                let y = match step {
+                    Some(s) => self.dense_state(s, t, ts.equilibrium_charge),
+                    None => self.y,
                 };
-                self.row(ts, y, e).charge
+                self.row(ts, y, 0.0).charge
             };
             self.probes.values[self.probes.next] = q;
             self.probes.next += 1;
@@ -254,8 +265,14 @@ impl ChargeSolver {
     }
 }
 
-/// [`ChargeSolver::dense`] with the tableau of the step's method.
-pub(super) fn dense_with<const S: usize>(tab: &Tableau<S>, step: &Step, t: f64, qeq: f64) -> ([f64; 2], f64) {
+/// [`ChargeSolver::dense`] with the tableau of the step's method (the energy only if `ENERGY`,
+/// else `step.e0`).
+pub(super) fn dense_with<const S: usize, const ENERGY: bool>(
+    tab: &Tableau<S>,
+    step: &Step,
+    t: f64,
+    qeq: f64,
+) -> ([f64; 2], f64) {
     debug_assert_eq!(step.stages, S);
     let w = tab.dense_weights((t - step.t0) / step.h);
     let mut y = step.y0;
@@ -263,8 +280,10 @@ pub(super) fn dense_with<const S: usize>(tab: &Tableau<S>, step: &Step, t: f64, 
     for (i, wi) in w.iter().enumerate() {
         y[0] += wi * step.z[0][i];
         y[1] += wi * step.z[1][i];
-        // The energy's stage increment ZEᵢ = h Σⱼ aᵢⱼ pⱼ.
-        e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
+        if ENERGY {
+            // The energy's stage increment ZEᵢ = h Σⱼ aᵢⱼ pⱼ.
+            e += wi * step.h * (0..S).map(|j| tab.a[i][j] * step.power[j]).sum::<f64>();
+        }
     }
     if !step.stiff {
         let interp: f64 = w.iter().zip(&step.dq).map(|(wi, dqi)| wi * dqi).sum();
