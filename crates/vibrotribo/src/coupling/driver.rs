@@ -131,11 +131,14 @@ impl CoupledChain {
     /// [`run_until`](Self::run_until) owns). Refuses a transducer without field energy (the
     /// paper's open-circuit voltage law).
     pub fn new(
-        sim: Simulator,
+        mut sim: Simulator,
         params: &crate::electrical::HarvesterParams,
         options: CouplingOptions,
     ) -> Result<Self, CouplingError> {
         let statics = Electrostatics::new(&params.transducer())?;
+        // Every trial installs its forces (a rebuild) before it runs: re-anchoring the flows
+        // where the last one stopped would be redone at once.
+        sim.set_rebuild_at_stops(false);
         let n = sim.params().len();
         let min_mass = sim.params().masses.iter().copied().fold(f64::INFINITY, f64::min);
         let h = options.max_window_periods * sim.period();

@@ -127,6 +127,10 @@ pub struct Simulator {
     pub(super) scratch_resting: Vec<bool>,
     /// Per contact: the gap search starts no earlier than this (see `handle`).
     search_from: Vec<f64>,
+    /// Whether a run that stops without an event re-anchors the clusters' flows there (the
+    /// default). A caller that installs new forces before every run (which rebuilds anyway)
+    /// turns it off: the flows stay valid past a stop, anchored where they started.
+    rebuild_at_stops: bool,
 }
 
 /// A touch found at the start of a search that changes nothing moves that contact's next
@@ -196,6 +200,7 @@ impl Simulator {
             scratch_events: Vec::new(),
             scratch_resting: vec![false; nc],
             search_from: vec![f64::NEG_INFINITY; nc],
+            rebuild_at_stops: true,
         };
         sim.refresh_tolerances();
         // Start with closed contacts where the masses touch with equal velocity and press.
@@ -248,6 +253,7 @@ impl Simulator {
             scratch_events,
             scratch_resting,
             search_from,
+            rebuild_at_stops,
         } = other;
         self.params = params.clone();
         self.options = options.clone();
@@ -277,6 +283,13 @@ impl Simulator {
         self.scratch_events.clone_from(scratch_events);
         self.scratch_resting.clone_from(scratch_resting);
         self.search_from.clone_from(search_from);
+        self.rebuild_at_stops = *rebuild_at_stops;
+    }
+
+    /// Whether [`run_until`](Self::run_until) re-anchors the flows where it stops without an
+    /// event (on by default; see the field).
+    pub(crate) fn set_rebuild_at_stops(&mut self, on: bool) {
+        self.rebuild_at_stops = on;
     }
 
     /// Excitation period T, s.
@@ -405,7 +418,9 @@ impl Simulator {
                         self.period_index += 1;
                         self.events_in_period = 0;
                     }
-                    self.rebuild()?;
+                    if self.rebuild_at_stops {
+                        self.rebuild()?;
+                    }
                     if halt {
                         return Ok(RunEnd::Stopped { t: self.t });
                     }
