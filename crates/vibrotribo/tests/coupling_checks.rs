@@ -734,14 +734,12 @@ fn force_error_accounts_for_the_residual() {
 /// each window's start: −5.5e-8, 8.6e-10, −1.6e-10, 2.9e-11 J; before the force moments were
 /// matched: 1.4e-6, 5.8e-7, 2.0e-7, −5.4e-7 J). 1e-13 m takes ~5 s of the ~8 s.
 ///
-/// Known to fail since stop 21 (windows sampled in one run, the charge at the inner nodes from
-/// the solver's dense output; windows around events no longer restart short): +3.6e-8,
-/// +9.2e-10, −5.3e-10, −2.7e-12 J, the 1e-12 m residual no smaller than the 1e-11 m one (at
-/// 1e-11 m 3.6e-7 of the electrical terms, 8e-12 of the work; at stop 20's end the table was
-/// +1.3e-8, +4.0e-10, −3.3e-10, −3.2e-12 J, its 1e-11 and 1e-12 m rows already of one size and
-/// opposite signs).
+/// Failed at stop 21 for a while (windows sampled in one run, the charge at the inner nodes from
+/// the solver's dense output: +3.6e-8, +9.2e-10, −5.3e-10, −2.7e-12 J, the 1e-12 m row no
+/// smaller than the 1e-11 m one); passes again from stop 21's last commit (a438b38) on. Stop 22:
+/// +2.8e-9, +1.1e-9, +3.7e-11, −9.6e-12 J (at 1e-11 m 4.1e-7 of the electrical terms, 9.5e-12 of
+/// the work); the four runs take 0.2 s.
 #[test]
-#[ignore = "known: a table over four tolerances whose 1e-12 m row is no smaller than its 1e-11 m row since stop 21"]
 fn energy_balance_against_the_coupling_tolerance() {
     balance_against_the_coupling_tolerance("two-way", |tolerance| {
         default_case("two_way", 20, 1e-10, tolerance)
