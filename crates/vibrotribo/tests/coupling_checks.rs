@@ -563,11 +563,11 @@ fn energy_balance_two_way_rectifier() {
 
 /// The rectifier's balance residual against `coupling_tolerance` (the default case, 20
 /// periods), as [`energy_balance_against_the_coupling_tolerance`] for the resistor: it shrinks
-/// with the tolerance. Measured: −1.85e-8, 9.8e-10, −1.23e-10, −7.5e-11 J at 1e-10, 1e-11,
-/// 1e-12, 1e-13 m (−6.3e-6, 3.4e-7, −4.2e-8, −2.6e-8 of the electrical terms, 2.9 mJ; the last
-/// step is near the charge solver's rtol of 1e-10). ~8 s.
+/// with the tolerance. Measured at stop 20: −1.85e-8, 9.8e-10, −1.23e-10, −7.5e-11 J at 1e-10,
+/// 1e-11, 1e-12, 1e-13 m (−6.3e-6, 3.4e-7, −4.2e-8, −2.6e-8 of the electrical terms, 2.9 mJ; the
+/// last step is near the charge solver's rtol of 1e-10), ~8 s; stop 22: +3.5e-9, −1.7e-9,
+/// −4.3e-10, −1.7e-10 J (1.2e-6, 5.8e-7, 1.5e-7, 5.8e-8 of the electrical terms), 1.3 s.
 #[test]
-#[ignore = "a table over four tolerances, ~8 s"]
 fn energy_balance_rectifier_against_the_coupling_tolerance() {
     balance_against_the_coupling_tolerance("two-way rectifier", |tolerance| {
         rectifier_case(20, 1e-10, tolerance)
