@@ -145,19 +145,23 @@ impl RunObserver for Files {
     }
 
     fn event(&mut self, e: &Event, state: &StateView<'_>) {
-        let fields: Vec<String> = [
-            e.time.to_string(),
-            e.kind.as_str().to_string(),
-            (e.contact + 1).to_string(),
-            e.velocity_before.to_string(),
-            e.velocity_after.to_string(),
-            e.sequence_impacts.to_string(),
-        ]
-        .into_iter()
-        .chain(state.positions.iter().map(f64::to_string))
-        .chain(state.velocities.iter().map(f64::to_string))
-        .collect();
-        let r = self.events.row(fields);
+        use std::fmt::Display;
+        let (kind, contact) = (e.kind.as_str(), e.contact + 1);
+        // Written straight into the row (no string per field).
+        let head: [&dyn Display; 6] = [
+            &e.time,
+            &kind,
+            &contact,
+            &e.velocity_before,
+            &e.velocity_after,
+            &e.sequence_impacts,
+        ];
+        let values = state
+            .positions
+            .iter()
+            .chain(state.velocities)
+            .map(|x| x as &dyn Display);
+        let r = self.events.row(head.into_iter().chain(values));
         self.keep(r);
     }
 }
