@@ -113,15 +113,7 @@ pub fn run_summary(
         obj.insert("harvester".into(), json!(h.params));
         obj.insert("electrical_solver".into(), json!(format!("{:?}", e.solver)));
         if let Some(c) = &e.coupling {
-            obj.insert(
-                "coupling_stats".into(),
-                json!({
-                    "windows": c.windows,
-                    "sweeps": c.sweeps,
-                    "shortened": c.shortened,
-                    "cut_by_event": c.cut_by_event,
-                }),
-            );
+            obj.insert("coupling_stats".into(), json!(c));
         }
     }
     if let Some(base) = base_motion_json(config, spec) {

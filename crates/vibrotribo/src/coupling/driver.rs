@@ -352,8 +352,8 @@ impl CoupledChain {
             // on to the positions and velocities at its end. It vanishes at τ = 0, so that
             // the force at the window's start stays the solver's charge's (see above).
             let h = q.h;
-            let x = (self.omega_n * h).max(self.series_x);
-            let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
+            let budget = self.rounding_budget();
+            let (omega_n, series_x) = (self.omega_n, self.series_x);
             for (f, target) in self.forces.iter_mut().zip(&self.target) {
                 let [i0, i1] = polynomial_moments(&f.coefficients, h);
                 let (d0, d1) = (target[0] - i0, target[1] - i1);
@@ -362,9 +362,7 @@ impl CoupledChain {
                 let mut gamma = 36.0 * d1 / (h * h * h * h) - 24.0 * d0 / (h * h * h);
                 // The terms' rounding, amplified as in `fit`: beyond the budget only the
                 // impulse is matched.
-                let amplified =
-                    beta.abs() * h * (1.0 / x).max(1.0) + gamma.abs() * h * h * (2.0 / (x * x)).max(1.0);
-                if amplified > budget {
+                if amplified_rounding(&[0.0, beta, gamma], h, omega_n, series_x) > budget {
                     beta = 2.0 * d0 / (h * h);
                     gamma = 0.0;
                 }
@@ -376,6 +374,13 @@ impl CoupledChain {
             }
         }
         sim.set_external_forces(&self.forces)
+    }
+
+    /// The most a force polynomial's terms may amplify rounding on a window
+    /// ([`amplified_rounding`]), N: the force of the weakest spring stretched by a hundredth of
+    /// the position tolerance, over the unit roundoff.
+    fn rounding_budget(&self) -> f64 {
+        0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON
     }
 
     /// Per mass, the impulse and first moment of the force of the solver's charge over
@@ -438,20 +443,11 @@ impl CoupledChain {
             return ChargePolynomial::constant(values[0], h);
         }
         let full = ChargePolynomial::new(values, h);
-        let x = (self.omega_n * h).max(self.series_x);
-        let budget = 0.01 * self.options.position_tolerance * self.min_stiffness / f64::EPSILON;
+        let budget = self.rounding_budget();
         for degree in (1..=DEGREE).rev() {
             let q = full.truncated(degree);
             let safe = self.statics.gap_force_polynomials().all(|(_, c)| {
-                let f = force_polynomial(&q, c);
-                let mut amplified = 0.0;
-                let mut factorial = 1.0;
-                for (j, fj) in f.iter().enumerate().skip(1) {
-                    factorial *= j as f64;
-                    let effect = fj.abs() * h.powi(j as i32);
-                    amplified += effect * (factorial / x.powi(j as i32)).max(1.0);
-                }
-                amplified <= budget
+                amplified_rounding(&force_polynomial(&q, c), h, self.omega_n, self.series_x) <= budget
             });
             if safe {
                 return q;
@@ -765,6 +761,24 @@ fn length_ratio(tol: f64, estimate: f64, order: f64) -> f64 {
     } else {
         f64::INFINITY
     }
+}
+
+/// How far the engine may amplify the rounding of the force polynomial `f(τ) = Σ f_j τʲ` (N,
+/// N/sʲ) on a window of length `h`, s, in N: Σ_{j≥1} |f_j| hʲ · max(j!/xʲ, 1) with
+/// x = max(ω_n h, `series_x`). Where the engine sums a term's response from its particular
+/// polynomial (from ω_n τ ≥ `series_x` on; a power series before), that polynomial carries
+/// terms up to j!/(ω_n τ)ʲ times the term's static effect, which the homogeneous part then
+/// cancels (see [`CoupledChain::fit`]).
+fn amplified_rounding(f: &[f64], h: f64, omega_n: f64, series_x: f64) -> f64 {
+    let x = (omega_n * h).max(series_x);
+    let mut amplified = 0.0;
+    let mut factorial = 1.0;
+    for (j, fj) in f.iter().enumerate().skip(1) {
+        factorial *= j as f64;
+        let effect = fj.abs() * h.powi(j as i32);
+        amplified += effect * (factorial / x.powi(j as i32)).max(1.0);
+    }
+    amplified
 }
 
 /// `[∫₀ʰ f, ∫₀ʰ τ f]` of the polynomial `f(τ) = Σ f_j τʲ`.

@@ -461,7 +461,14 @@ impl ChargeSolver {
     ) -> Result<TransducerState, ElectricalError> {
         wave.gap_values(t, &mut self.gaps);
         self.stats.waveform_evaluations += 1;
-        let ts = self.charge_map.state(&self.gaps);
+        self.state_at_gaps(&self.gaps, t)
+    }
+
+    /// The transducer at `gaps` (m, at time `t`, s), checked: an error unless its elastance is
+    /// positive and finite and its equilibrium charge finite.
+    #[inline]
+    fn state_at_gaps(&self, gaps: &[f64], t: f64) -> Result<TransducerState, ElectricalError> {
+        let ts = self.charge_map.state(gaps);
         if ts.elastance > 0.0 && ts.elastance.is_finite() && ts.equilibrium_charge.is_finite() {
             Ok(ts)
         } else {
@@ -482,10 +489,7 @@ impl ChargeSolver {
         self.stats.waveform_evaluations += S as u64;
         let mut nodes = [TransducerState::default(); S];
         for (i, node) in nodes.iter_mut().enumerate() {
-            *node = self.charge_map.state(&self.node_gaps[i * n..(i + 1) * n]);
-            if !(node.elastance > 0.0 && node.elastance.is_finite() && node.equilibrium_charge.is_finite()) {
-                return Err(ElectricalError::InvalidGaps { t: times[i] });
-            }
+            *node = self.state_at_gaps(&self.node_gaps[i * n..(i + 1) * n], times[i])?;
         }
         Ok(nodes)
     }
