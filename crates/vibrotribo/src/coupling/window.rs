@@ -4,7 +4,9 @@
 //! `[t₀, t₀ + h]` (both ends included) and represented by its interpolant of degree `n`
 //! ([`DEGREE`]). Its Chebyshev coefficients give the error estimate
 //! ([`ChargePolynomial::error_estimate`]) and, through the monomial basis in
-//! `τ = t − t₀`, the force polynomials the engine integrates in closed form.
+//! `τ = t − t₀`, the force polynomials the engine integrates in closed form; with them the rules
+//! a window's length and its forces follow (length from an error estimate, rounding
+//! amplified by a force polynomial, its impulse and first moment).
 
 /// Degree of the charge polynomial on a window.
 pub(crate) const DEGREE: usize = 6;
@@ -197,6 +199,47 @@ pub(crate) fn significant_degree(f: &[f64], h: f64, negligible: f64) -> usize {
         degree -= 1;
     }
     degree
+}
+
+/// The factor by which a window's length can change for its error `estimate` (C) to meet
+/// `tol` (C) if the estimate goes as the length to the power `order` (callers apply a safety
+/// factor of 0.8); infinite for a zero estimate.
+pub(crate) fn length_ratio(tol: f64, estimate: f64, order: f64) -> f64 {
+    if estimate > 0.0 {
+        (tol / estimate).powf(1.0 / order)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// How far the engine may amplify the rounding of the force polynomial `f(τ) = Σ f_j τʲ` (N,
+/// N/sʲ) on a window of length `h`, s, in N: Σ_{j≥1} |f_j| hʲ · max(j!/xʲ, 1) with
+/// x = max(ω_n h, `series_x`). Where the engine sums a term's response from its particular
+/// polynomial (from ω_n τ ≥ `series_x` on; a power series before), that polynomial carries
+/// terms up to j!/(ω_n τ)ʲ times the term's static effect, which the homogeneous part then
+/// cancels (see `CoupledChain::fit`).
+pub(crate) fn amplified_rounding(f: &[f64], h: f64, omega_n: f64, series_x: f64) -> f64 {
+    let x = (omega_n * h).max(series_x);
+    let mut amplified = 0.0;
+    let mut factorial = 1.0;
+    for (j, fj) in f.iter().enumerate().skip(1) {
+        factorial *= j as f64;
+        let effect = fj.abs() * h.powi(j as i32);
+        amplified += effect * (factorial / x.powi(j as i32)).max(1.0);
+    }
+    amplified
+}
+
+/// `[∫₀ʰ f, ∫₀ʰ τ f]` of the polynomial `f(τ) = Σ f_j τʲ`.
+pub(crate) fn polynomial_moments(f: &[f64], h: f64) -> [f64; 2] {
+    let (mut i0, mut i1) = (0.0, 0.0);
+    let mut p = h;
+    for (j, fj) in f.iter().enumerate() {
+        i0 += fj * p / (j + 1) as f64;
+        i1 += fj * p * h / (j + 2) as f64;
+        p *= h;
+    }
+    [i0, i1]
 }
 
 #[cfg(test)]
