@@ -562,14 +562,20 @@ fn energy_balance_two_way_rectifier() {
 }
 
 /// The rectifier's balance residual against `coupling_tolerance` (the default case, 20
-/// periods), as [`energy_balance_against_the_coupling_tolerance`] for the resistor: it shrinks
-/// with the tolerance. Measured at stop 20: −1.85e-8, 9.8e-10, −1.23e-10, −7.5e-11 J at 1e-10,
-/// 1e-11, 1e-12, 1e-13 m (−6.3e-6, 3.4e-7, −4.2e-8, −2.6e-8 of the electrical terms, 2.9 mJ; the
-/// last step is near the charge solver's rtol of 1e-10), ~8 s; stop 22: +3.5e-9, −1.7e-9,
-/// −4.3e-10, −1.7e-10 J (1.2e-6, 5.8e-7, 1.5e-7, 5.8e-8 of the electrical terms), 1.3 s.
+/// periods), as [`energy_balance_against_the_coupling_tolerance`] for the resistor. Measured at
+/// stop 20: −1.85e-8, 9.8e-10, −1.23e-10, −7.5e-11 J at 1e-10, 1e-11, 1e-12, 1e-13 m (−6.3e-6,
+/// 3.4e-7, −4.2e-8, −2.6e-8 of the electrical terms, 2.9 mJ; the last step is near the charge
+/// solver's rtol of 1e-10), ~8 s; stop 22: +3.5e-9, −1.7e-9, −4.3e-10, −1.7e-10 J (1.2e-6,
+/// 5.8e-7, 1.5e-7, 5.8e-8 of the electrical terms), 1.3 s; stop 23, after a change of the event
+/// search that moves event times by rounding only: +4.1e-10, −1.4e-9, −4.8e-10, −1.7e-10 J.
+/// The residual at the loosest tolerance is erratic (−1.85e-8, +3.5e-9, +4.1e-10 J across those
+/// versions: the coupling error of 1e-10 m windows, whose edges follow the event times), so
+/// the residual is not monotone decade by decade here; what holds is the envelope: the
+/// tightest tolerance gives the smallest residual, and from 1e-11 m on it is within 1e-6 of
+/// the electrical terms.
 #[test]
 fn energy_balance_rectifier_against_the_coupling_tolerance() {
-    balance_against_the_coupling_tolerance("two-way rectifier", |tolerance| {
+    balance_against_the_coupling_tolerance("two-way rectifier", Shrinks::ToTheTightest, |tolerance| {
         rectifier_case(20, 1e-10, tolerance)
     });
 }
@@ -741,15 +747,24 @@ fn force_error_accounts_for_the_residual() {
 /// the work); the four runs take 0.2 s.
 #[test]
 fn energy_balance_against_the_coupling_tolerance() {
-    balance_against_the_coupling_tolerance("two-way", |tolerance| {
+    balance_against_the_coupling_tolerance("two-way", Shrinks::DecadeByDecade, |tolerance| {
         default_case("two_way", 20, 1e-10, tolerance)
     });
 }
 
+/// How a balance residual is asserted to shrink with the coupling tolerance.
+#[derive(Clone, Copy, PartialEq)]
+enum Shrinks {
+    /// With each tighter tolerance.
+    DecadeByDecade,
+    /// The tightest tolerance's residual is below every looser one's.
+    ToTheTightest,
+}
+
 /// The coupled balance of `case(tolerance)` at coupling tolerances 1e-10 … 1e-13 m, printed as a
-/// table: the residual shrinks with each tighter tolerance, and from 1e-11 m on it is within
-/// 1e-6 of the electrical terms.
-fn balance_against_the_coupling_tolerance(name: &str, case: impl Fn(f64) -> String) {
+/// table: the residual shrinks with the tolerance as `shrinks` says, and from 1e-11 m on it is
+/// within 1e-6 of the electrical terms.
+fn balance_against_the_coupling_tolerance(name: &str, shrinks: Shrinks, case: impl Fn(f64) -> String) {
     let mut rows = Vec::new();
     for tolerance in [1e-10, 1e-11, 1e-12, 1e-13] {
         let started = std::time::Instant::now();
@@ -769,12 +784,17 @@ fn balance_against_the_coupling_tolerance(name: &str, case: impl Fn(f64) -> Stri
             two.full
         );
     }
-    for pair in rows.windows(2) {
+    let (tightest, looser) = rows.split_last().expect("four tolerances");
+    for (i, looser_row) in looser.iter().enumerate() {
+        let tighter = match shrinks {
+            Shrinks::DecadeByDecade => &rows[i + 1],
+            Shrinks::ToTheTightest => tightest,
+        };
         assert!(
-            pair[1].1.full_j.abs() < pair[0].1.full_j.abs(),
+            tighter.1.full_j.abs() < looser_row.1.full_j.abs(),
             "no smaller at {:e} m than at {:e} m",
-            pair[1].0,
-            pair[0].0
+            tighter.0,
+            looser_row.0
         );
     }
     for (tolerance, two, _) in &rows[1..] {

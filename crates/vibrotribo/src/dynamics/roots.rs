@@ -13,8 +13,15 @@
 //! Each is ≤ f(t+h) for all h ≥ 0, so `f` has no zero before the first positive root of any of
 //! them; the search steps to the largest of those roots and repeats. A zero can therefore
 //! never be skipped, including a tangential (grazing) touch, and near a simple zero the steps
-//! converge like a third-order Newton method from the safe side. The last point is polished
-//! onto the zero with the local quadratic model.
+//! converge like a fourth-order Newton method from the safe side (p₃ is solved at every step;
+//! p₂ and p₁ only where they can lengthen it). The last point is polished onto the zero with
+//! the local Taylor model: at a jet on the zero, or, when the certified step ends within the
+//! range where the quartic model is exact far below rounding, from the jet before it
+//! ([`root_within_model`]), which saves the last evaluation of a search.
+//!
+//! The first positive root of a bound with a single sign change in its coefficients is
+//! bracketed directly (Descartes' rule: it is the only positive root); otherwise the critical
+//! points split the half-line into monotone pieces.
 
 use super::signal::Jet;
 
@@ -42,6 +49,12 @@ const STEP_RTOL: f64 = 1e-6;
 
 /// Inflation of the derivative bounds against their own rounding.
 const BOUND_SAFETY: f64 = 1.0 + 1e-9;
+
+/// How far below the rounding noise the quartic model's truncation must stay for
+/// [`root_within_model`] to place a zero from it: the noise allowance is 32 ulps of the summed
+/// magnitudes, the rounding of a direct evaluation about one; 1024 keeps the model's error
+/// below that.
+const MODEL_MARGIN: f64 = 1024.0;
 
 /// First zero of the function described by `eval` in `[t_start, horizon)`.
 ///
@@ -79,10 +92,53 @@ where
                 _ => t,
             }));
         }
+        if let Some(h) = root_within_model(&jet, step) {
+            return Ok(Found::Root(t + h));
+        }
         t = next;
         first = false;
     }
     Err(Stall { t })
+}
+
+/// The first zero, from the jet at t, when the certified step ends where the local quartic
+/// model `m(h) = f + f'h + f''h²/2 + f'''h³/6 + f⁗h⁴/24` is accurate far below the rounding
+/// noise (`B₅h⁵/120 ≤ noise/MODEL_MARGIN`) and the model crosses zero there: what the next
+/// iteration would find from a jet evaluated on the zero, without evaluating that jet.
+///
+/// `f` has no zero before `step` (certified), and on `[step, h_loc]` `|f − m|` is far below
+/// the rounding of a direct evaluation. If `m` descends on `[step, h_loc]` (its slope at `step`
+/// plus the largest change of slope over the range stays negative) and ends below `−noise`
+/// (so `f` is negative there), the first zero of `f` lies in between and is the model's zero,
+/// to the precision [`local_behaviour`] finds it with at a jet on the zero. Anything else (a
+/// touch, a shallow dip, a model that may turn back up, a signal with a polynomial part) is
+/// left to the search.
+fn root_within_model(jet: &Jet, step: f64) -> Option<f64> {
+    let noise = jet.noise[0];
+    let b5 = jet.bound5 * BOUND_SAFETY;
+    if !(b5 > 0.0 && b5.is_finite()) || jet.d[0] <= noise {
+        return None;
+    }
+    let h_loc = (120.0 * noise / (MODEL_MARGIN * b5)).powf(0.2);
+    let within = step < h_loc;
+    if !within {
+        return None;
+    }
+    let [f, d1, d2, d3] = jet.d;
+    let d4 = jet.d4;
+    let m = [f, d1, 0.5 * d2, d3 / 6.0, d4 / 24.0];
+    let slope = d1 + step * (d2 + step * (0.5 * d3 + step * d4 / 6.0));
+    let curvature = d2.abs() + h_loc * (d3.abs() + 0.5 * h_loc * d4.abs());
+    let descends = slope + (h_loc - step) * curvature < 0.0;
+    let ends_below = horner(&m, h_loc) < -noise;
+    if !(descends && ends_below) {
+        return None;
+    }
+    Some(if horner(&m, step) <= 0.0 {
+        step
+    } else {
+        bracket_root(&m, step, h_loc, false, 1e-12)
+    })
 }
 
 /// Derivatives smaller than their rounding noise are zero.
@@ -161,21 +217,18 @@ fn safe_step(jet: &Jet) -> f64 {
     let b = jet.bound.map(|x| x * BOUND_SAFETY);
     let p1 = [f, d1, -0.5 * b[2]];
     let p2 = [f, d1, 0.5 * d2, -b[3] / 6.0];
-    // The quartic bound costs a cubic solve for its critical points; it is needed where the
-    // lower orders give no progress (at zero with vanishing slope and curvature, as after a
-    // release) and is not worth it far from zero. Near zero it usually gives the longest
-    // step, so it goes first there.
-    let mut step = if f <= 1e6 * jet.noise[0] {
-        first_positive_root(&[f, d1, 0.5 * d2, d3 / 6.0, -b[4] / 24.0])
-    } else {
-        0.0
-    };
-    // A bound that is already ≤ 0 at the step found so far has its first root before it and
-    // cannot lengthen the step (a root is returned at or below the true one): skip its solve.
-    // The result is the maximum of the three roots, as if each had been solved.
-    if step == 0.0 || horner(&p2, step) > 0.0 {
+    // The quartic bound goes first: it gives the longest step nearly always (higher order
+    // near a zero, and the only progress at zero with vanishing slope and curvature, as after
+    // a release). The others are solved only where they could lengthen the step; the result
+    // is the largest of the three roots, as if each had been solved.
+    // p3 − p2 = (f''' + B₃)h³/6 − B₄h⁴/24 ≥ 0 for h ≤ 4(f''' + B₃)/B₄: there p2 ≤ p3, so p2
+    // reaches zero no later than p3 and cannot lengthen a step shorter than that.
+    let mut step = first_positive_root(&[f, d1, 0.5 * d2, d3 / 6.0, -b[4] / 24.0]);
+    if step == 0.0 || (b[4] * step >= 4.0 * (d3 + b[3]) && horner(&p2, step) > 0.0) {
         step = step.max(first_positive_root(&p2));
     }
+    // A bound that is already ≤ 0 at the step found so far has its first root before it and
+    // cannot lengthen the step (a root is returned at or below the true one): skip its solve.
     if step == 0.0 || horner(&p1, step) > 0.0 {
         step = step.max(first_positive_root(&p1));
     }
@@ -230,6 +283,14 @@ pub(crate) fn first_positive_root(c: &[f64]) -> f64 {
                     return 0.0;
                 }
             }
+            if c[0] > 0.0 && sign_changes(c) == 1 {
+                // Descartes' rule: one sign change, one positive root, so the whole of
+                // [0, ∞) brackets it and the critical points need not be found.
+                return match upper_bracket(c, 0.0) {
+                    Some(hi) => bracket_root(c, 0.0, hi, true, STEP_RTOL),
+                    None => f64::INFINITY,
+                };
+            }
             let mut dc = [0.0; 4];
             for i in 1..=deg {
                 dc[i - 1] = i as f64 * c[i];
@@ -254,6 +315,22 @@ pub(crate) fn first_positive_root(c: &[f64]) -> f64 {
             f64::INFINITY
         }
     }
+}
+
+/// Sign changes between the nonzero coefficients of `c`. By Descartes' rule of signs the
+/// number of positive roots (with multiplicity) is this number or less by an even number.
+fn sign_changes(c: &[f64]) -> usize {
+    let mut last = 0.0f64;
+    let mut n = 0;
+    for &x in c {
+        if x != 0.0 {
+            if last != 0.0 && (x < 0.0) != (last < 0.0) {
+                n += 1;
+            }
+            last = x;
+        }
+    }
+    n
 }
 
 /// A point beyond `lo` where the polynomial is negative, if the leading coefficient is
@@ -591,6 +668,8 @@ mod tests {
             d: [1.0 + t.cos(), -t.sin(), -t.cos(), t.sin()],
             bound: [0.0, 1.0, 1.0, 1.0, 1.0],
             noise: [1e-15; 4],
+            d4: t.cos(),
+            bound5: 1.0,
         };
         match first_root(eval, 0.0, 10.0).unwrap() {
             Found::Root(t) => assert!((t - std::f64::consts::PI).abs() < 1e-6, "{t}"),
@@ -605,10 +684,51 @@ mod tests {
             d: [t.cos() - 0.3, -t.sin(), -t.cos(), t.sin()],
             bound: [0.0, 1.0, 1.0, 1.0, 1.0],
             noise: [4e-16; 4],
+            d4: t.cos(),
+            bound5: 1.0,
         };
         let Found::Root(t) = first_root(eval, 0.0, 10.0).unwrap() else {
             panic!("missed")
         };
         assert!((t - 0.3f64.acos()).abs() < 2e-15, "{t}");
+    }
+
+    #[test]
+    fn zero_placed_from_the_quartic_model_as_precisely() {
+        // f(t) = 0.7 cos 3t + 0.2 sin t − 0.1 from 0: the zero is placed from the jet before it
+        // (the last jet evaluated is short of it), to the precision of a jet on it. Reference:
+        // Newton on f to convergence from the found zero.
+        let f = |t: f64| 0.7 * (3.0 * t).cos() + 0.2 * t.sin() - 0.1;
+        let last = std::cell::Cell::new(0.0);
+        let eval = |t: f64| {
+            last.set(t);
+            let (s3, c3) = (3.0 * t).sin_cos();
+            let (s1, c1) = t.sin_cos();
+            Jet {
+                d: [
+                    f(t),
+                    -2.1 * s3 + 0.2 * c1,
+                    -6.3 * c3 - 0.2 * s1,
+                    18.9 * s3 - 0.2 * c1,
+                ],
+                bound: [0.0, 2.3, 6.5, 19.1, 56.9],
+                noise: [1e-15, 3e-15, 9e-15, 3e-14],
+                d4: 56.7 * c3 + 0.2 * s1,
+                bound5: 170.3,
+            }
+        };
+        let Found::Root(t) = first_root(eval, 0.0, 10.0).unwrap() else {
+            panic!("missed")
+        };
+        let mut r = t;
+        for _ in 0..5 {
+            r -= f(r) / (-2.1 * (3.0 * r).sin() + 0.2 * r.cos());
+        }
+        assert!((t - r).abs() < 4e-15, "{t} against {r}");
+        assert!(
+            last.get() < t - 1e-9,
+            "last jet at {} for the zero at {t}",
+            last.get()
+        );
     }
 }

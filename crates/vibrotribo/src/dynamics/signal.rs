@@ -9,7 +9,7 @@
 //! - with external force polynomials (see [`super::forces`]), a polynomial in time.
 //!
 //! [`Signal::jet`] returns the value and first three derivatives at a time, and bounds
-//! `B_n ≥ sup_{t ≤ s ≤ H} |f^{(n)}(s)|`, n = 1..4, up to the horizon H of the search (for all
+//! `B_n ≥ sup_{t ≤ s ≤ H} |f^{(n)}(s)|`, n = 2..4, up to the horizon H of the search (for all
 //! the future of the current flow when there is no polynomial part).
 //! The bounds come from an energy argument: any solution `g` of `g'' + 2αg' + ω_n² g = 0` with
 //! α ≥ 0 has non-increasing `E = g'² + ω_n² g²`, and every derivative of `g` is again such a
@@ -52,10 +52,15 @@ pub(crate) struct Signal {
 pub(crate) struct Jet {
     /// f, f', f'', f'''.
     pub d: [f64; 4],
-    /// `bound[n] ≥ sup_{s≥t} |f^{(n)}(s)|` for n = 1..=4 (`bound[0]` unused).
+    /// `bound[n] ≥ sup_{s≥t} |f^{(n)}(s)|` for n = 2..=4, the orders the search's lower bounds
+    /// use (`bound[0]` and `bound[1]` are not computed: zero).
     pub bound: [f64; 5],
     /// Rounding noise of `d[n]`: values below it in magnitude are indistinguishable from 0.
     pub noise: [f64; 4],
+    /// f⁗, for the quartic model that places a zero just ahead (`roots::root_within_model`).
+    pub d4: f64,
+    /// `≥ sup_{s≥t} |f⁽⁵⁾(s)|`; infinite (no such model) for signals with a polynomial part.
+    pub bound5: f64,
 }
 
 /// Relative rounding allowance used for noise estimates.
@@ -131,6 +136,7 @@ impl Signal {
         let f1 = omega * (self.fs * ph.cos - self.fc * ph.sin);
         let w2 = omega * omega;
         let mut d = [self.constant + f0, f1, -w2 * f0, -w2 * f1];
+        let mut d4 = w2 * w2 * f0;
         let mut bound = [0.0; 5];
         let mut mag = [
             self.constant_mag + self.forced_mag,
@@ -138,15 +144,17 @@ impl Signal {
             self.forced_mag * w2,
             self.forced_mag * w2 * omega,
         ];
-        let mut wn = 1.0;
-        for b in bound.iter_mut().skip(1) {
+        let mut wn = omega;
+        for b in bound.iter_mut().skip(2) {
             wn *= omega;
             *b = amp * wn;
         }
+        let mut bound5 = amp * wn * omega;
         for term in &self.terms[..self.nterms] {
             let osc = &clusters[term.osc].oscillator;
             if osc.is_driven() {
                 add_driven_term(term, osc, t, horizon, &mut d, &mut bound, &mut mag);
+                bound5 = f64::INFINITY;
                 continue;
             }
             let (h, h1, mag_h, mag_h1) = osc.homogeneous_with_magnitude(t);
@@ -154,10 +162,10 @@ impl Signal {
             let wn2 = osc.wn2;
             // g = a h + b h' solves the homogeneous ODE; g_{n+2} = −2α g_{n+1} − ω_n² g_n.
             let h2 = -two_a * h1 - wn2 * h;
-            let mut g = [0.0; 6];
+            let mut g = [0.0; 7];
             g[0] = term.a * h + term.b * h1;
             g[1] = term.a * h1 + term.b * h2;
-            for n in 2..6 {
+            for n in 2..7 {
                 g[n] = -two_a * g[n - 1] - wn2 * g[n - 2];
             }
             let inv_wn2 = 1.0 / wn2;
@@ -173,19 +181,27 @@ impl Signal {
                 d[n] += g[n];
                 mag[n] += m[n];
             }
-            for n in 1..5 {
+            let energy_bound = |n: usize| {
                 let up = (g[n] * g[n] + g[n + 1] * g[n + 1] * inv_wn2).sqrt();
                 let down = (g[n] * g[n] + wn2 * g[n - 1] * g[n - 1]).sqrt();
-                bound[n] += up.min(down);
+                up.min(down)
+            };
+            for (n, b) in bound.iter_mut().enumerate().skip(2) {
+                *b += energy_bound(n);
             }
+            d4 += g[4];
+            bound5 += energy_bound(5);
         }
         if !self.poly.is_zero() {
             self.add_poly_jet(t, horizon, &mut d, &mut bound, &mut mag);
+            bound5 = f64::INFINITY;
         }
         Jet {
             d,
             bound,
             noise: mag.map(|m| NOISE * m),
+            d4,
+            bound5,
         }
     }
 
@@ -203,7 +219,7 @@ impl Signal {
                 mag[n] += f * babs[n];
             }
         }
-        for (n, bn) in bound.iter_mut().enumerate().skip(1) {
+        for (n, bn) in bound.iter_mut().enumerate().skip(2) {
             // Σ_{k≥n} |b_k| k!/(k−n)! span^{k−n}, by Horner in span.
             let mut acc = 0.0;
             for k in (n..len).rev() {
@@ -290,7 +306,7 @@ fn add_driven_term(
         }
     }
     let inv_wn = 1.0 / wn2.sqrt();
-    for n in 1..5 {
+    for n in 2..5 {
         let up = (g[n] * g[n] + g[n + 1] * g[n + 1] / wn2).sqrt() + integral[n] * inv_wn;
         let down = (g[n] * g[n] + wn2 * g[n - 1] * g[n - 1]).sqrt() + integral[n - 1];
         bound[n] += up.min(down);
