@@ -119,11 +119,13 @@ fn root_within_model(jet: &Jet, step: f64) -> Option<f64> {
     if !(b5 > 0.0 && b5.is_finite()) || jet.d[0] <= noise {
         return None;
     }
-    let h_loc = (120.0 * noise / (MODEL_MARGIN * b5)).powf(0.2);
-    let within = step < h_loc;
+    // step < h_loc without a fifth root first: most steps are far longer.
+    let reach = 120.0 * noise / (MODEL_MARGIN * b5);
+    let within = step * step * step * step * step < reach;
     if !within {
         return None;
     }
+    let h_loc = reach.powf(0.2);
     let [f, d1, d2, d3] = jet.d;
     let d4 = jet.d4;
     let m = [f, d1, 0.5 * d2, d3 / 6.0, d4 / 24.0];
@@ -264,6 +266,17 @@ fn horner(c: &[f64], x: f64) -> f64 {
 /// a value slightly below it; `+∞` if there is none. Zero if `c[0] == 0` and the polynomial
 /// decreases from 0.
 pub(crate) fn first_positive_root(c: &[f64]) -> f64 {
+    // The quartic bound of every step, with a nonzero leading coefficient, gets its own copy
+    // with the length known (Horner passes unrolled); anything else takes the general one.
+    match <&[f64; 5]>::try_from(c) {
+        Ok(quartic) if quartic[4] != 0.0 => first_positive_root_of(quartic),
+        _ => first_positive_root_of(c),
+    }
+}
+
+/// [`first_positive_root`]'s body, inlined into each caller.
+#[inline(always)]
+fn first_positive_root_of(c: &[f64]) -> f64 {
     let mut deg = c.len() - 1;
     while deg > 0 && c[deg] == 0.0 {
         deg -= 1;
@@ -370,13 +383,30 @@ fn root_bound(c: &[f64]) -> f64 {
         let root = match n - i {
             1 => ratio,
             2 => ratio.sqrt(),
-            3 => ratio.cbrt(),
+            3 => cbrt_above(ratio),
             4 => ratio.sqrt().sqrt(),
             k => ratio.powf(1.0 / k as f64),
         };
         b = b.max(root);
     }
     2.0 * b
+}
+
+/// A value at or slightly above `x^(1/3)` (x ≥ 0), much cheaper than `cbrt`: an exponent-based
+/// start and two Newton steps `y ← (2y + x/y²)/3`, each ≥ ∛x by the inequality of arithmetic
+/// and geometric means whatever the start, then a margin against rounding. Within 1e-4 of
+/// ∛x after the two steps.
+fn cbrt_above(x: f64) -> f64 {
+    if !(x > 0.0 && x.is_finite()) {
+        return x.cbrt();
+    }
+    // ∛x = 2^(e/3) · ∛m for x = m·2^e: the bits of x with the exponent divided by three.
+    let bits = x.to_bits();
+    let mut y = f64::from_bits(bits / 3 + 0x2A9F_7893_782D_A1CE);
+    for _ in 0..2 {
+        y = (2.0 * y + x / (y * y)) / 3.0;
+    }
+    y * (1.0 + 1e-12)
 }
 
 /// All positive real roots of `c` (degree ≤ 3) in increasing order; returns how many.
@@ -461,7 +491,24 @@ fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
 
 /// A root of `c` in `[lo, hi]` where `c` is monotone and changes sign, to relative precision
 /// `rtol`. With `safe_left` the result lies on the side of `lo` (never beyond the root).
-fn bracket_root(c: &[f64], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64) -> f64 {
+fn bracket_root(c: &[f64], lo: f64, hi: f64, safe_left: bool, rtol: f64) -> f64 {
+    // Dispatched on the length so that each degree's Horner passes are unrolled.
+    match c.len() {
+        3 => bracket_root_n::<3>(c.try_into().expect("length 3"), lo, hi, safe_left, rtol),
+        4 => bracket_root_n::<4>(c.try_into().expect("length 4"), lo, hi, safe_left, rtol),
+        5 => bracket_root_n::<5>(c.try_into().expect("length 5"), lo, hi, safe_left, rtol),
+        _ => {
+            // Degrees up to 7 with leading zeros (the same polynomial); none above arise here.
+            let mut padded = [0.0; 8];
+            let n = c.len().min(8);
+            padded[..n].copy_from_slice(&c[..n]);
+            bracket_root_n::<8>(&padded, lo, hi, safe_left, rtol)
+        }
+    }
+}
+
+/// [`bracket_root`] for a polynomial of length `N`.
+fn bracket_root_n<const N: usize>(c: &[f64; N], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64) -> f64 {
     let before_negative = horner(c, lo) < 0.0;
     // Start Newton at the root of the local quadratic model at `lo` when it falls inside the
     // bracket (within a step or two of the root when the bracket is wide, as the Fujiwara
@@ -521,6 +568,7 @@ fn bracket_root(c: &[f64], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64)
 
 /// The smallest positive root of the quadratic Taylor model of `c` at `x`,
 /// `p(x) + p'(x)h + p''(x)h²/2` (sign-flipped first when `p(x) < 0`), if it has one.
+#[inline]
 fn quadratic_model_step(c: &[f64], x: f64, negative: bool) -> Option<f64> {
     // p, p' and p''/2 in one Horner pass (the first three coefficients of the Taylor shift).
     let n = c.len();
@@ -691,6 +739,23 @@ mod tests {
             panic!("missed")
         };
         assert!((t - 0.3f64.acos()).abs() < 2e-15, "{t}");
+    }
+
+    #[test]
+    fn cbrt_above_is_an_upper_bound_within_1e_4() {
+        let mut x = 1e-300;
+        while x < 1e300 {
+            for m in [1.0, 1.37, 2.0, 3.99, 7.5] {
+                let v = x * m;
+                let (y, exact) = (cbrt_above(v), v.cbrt());
+                assert!(
+                    y >= exact && y <= exact * (1.0 + 1e-4),
+                    "{v}: {y} against {exact}"
+                );
+            }
+            x *= 10.0;
+        }
+        assert_eq!(cbrt_above(0.0), 0.0);
     }
 
     #[test]
