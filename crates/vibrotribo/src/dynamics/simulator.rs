@@ -17,7 +17,6 @@ use super::contact::Closure;
 use super::forces::ExternalForces;
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
 use super::oscillator::{Forcing, OscConstants, Oscillator, Phase};
-use super::roots::{Found, Stall, first_root};
 use crate::error::{ParamError, SimError};
 use crate::model::{ChainParams, ChainState, ForcePolynomial, SimOptions};
 
@@ -50,7 +49,7 @@ pub enum ContactStatus {
 
 /// What the search found next.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Pending {
+pub(super) enum Pending {
     /// Gap zero at contact k; `at_start` if found at the very start of the search.
     Impact {
         contact: usize,
@@ -126,7 +125,9 @@ pub struct Simulator {
     scratch_events: Vec<Event>,
     pub(super) scratch_resting: Vec<bool>,
     /// Per contact: the gap search starts no earlier than this (see `handle`).
-    search_from: Vec<f64>,
+    pub(super) search_from: Vec<f64>,
+    /// Scratch for the race of the event searches (`search.rs`).
+    pub(super) scratch_racers: Vec<super::search::Racer>,
     /// Whether a run that stops without an event re-anchors the clusters' flows there (the
     /// default). A caller that installs new forces before every run (which rebuilds anyway)
     /// turns it off: the flows stay valid past a stop, anchored where they started.
@@ -200,6 +201,7 @@ impl Simulator {
             scratch_events: Vec::new(),
             scratch_resting: vec![false; nc],
             search_from: vec![f64::NEG_INFINITY; nc],
+            scratch_racers: Vec::with_capacity(nc),
             rebuild_at_stops: true,
         };
         sim.refresh_tolerances();
@@ -253,6 +255,8 @@ impl Simulator {
             scratch_events,
             scratch_resting,
             search_from,
+            // Scratch of the event search, empty between searches: nothing to copy.
+            scratch_racers: _,
             rebuild_at_stops,
         } = other;
         self.params = params.clone();
@@ -604,92 +608,6 @@ impl Simulator {
     /// Index of the cluster containing mass `i`.
     pub(in crate::dynamics) fn cluster_of(&self, i: usize) -> usize {
         self.clusters.partition_point(|c| c.last < i)
-    }
-
-    /// The earliest event in `(t, stop]`, if any.
-    fn next_event(&self, stop: f64) -> Result<Option<(f64, Pending)>, SimError> {
-        let mut best: Option<(f64, Pending)> = None;
-        let mut horizon = stop;
-        let w = self.forcing.omega;
-        for k in 0..self.closure.len() {
-            if self.absent(k) {
-                continue;
-            }
-            if let Closure::Chatter { t_acc, .. } = self.closure[k]
-                && t_acc < horizon
-            {
-                horizon = t_acc.max(self.t);
-                best = Some((horizon, Pending::ChatterEnd(k)));
-            }
-            let (sig, start) = match self.closure[k] {
-                Closure::Open => (self.gap_signal(k), self.t.max(self.search_from[k])),
-                Closure::Resting => {
-                    if let Some(found) = self.resting_event(k, horizon)? {
-                        horizon = found.0;
-                        best = Some(found);
-                    }
-                    continue;
-                }
-                _ => (self.force_signal(k), self.t),
-            };
-            let amp = sig.harmonic_amplitude();
-            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon, amp);
-            match first_root(eval, start, horizon) {
-                Ok(Found::Root(te)) if te < horizon => {
-                    horizon = te.max(self.t);
-                    let what = match self.closure[k] {
-                        Closure::Open => Pending::Impact {
-                            contact: k,
-                            at_start: te <= start,
-                        },
-                        _ => Pending::Release(k),
-                    };
-                    best = Some((horizon, what));
-                }
-                Ok(_) => {}
-                Err(stall) => return Err(self.stalled(k, stall)),
-            }
-        }
-        Ok(best)
-    }
-
-    /// The earliest event of resting contact k before `horizon`, if any: its force falls to
-    /// minus its band (it parts) or rises to plus its band (it sticks).
-    #[cold]
-    fn resting_event(&self, k: usize, horizon: f64) -> Result<Option<(f64, Pending)>, SimError> {
-        let band = self.rest_band(k);
-        let mut part = self.force_signal(k);
-        part.add_constant(band);
-        let mut press = part.negated();
-        press.add_constant(2.0 * band);
-        let w = self.forcing.omega;
-        let mut best = None;
-        let mut horizon = horizon;
-        for (sig, what) in [(part, Pending::Part(k)), (press, Pending::Press(k))] {
-            let amp = sig.harmonic_amplitude();
-            let eval = |t: f64| sig.jet(t, self.phase_at(t), &self.clusters, w, horizon, amp);
-            match first_root(eval, self.t, horizon) {
-                Ok(Found::Root(te)) if te < horizon => {
-                    horizon = te.max(self.t);
-                    best = Some((horizon, what));
-                }
-                Ok(_) => {}
-                Err(stall) => return Err(self.stalled(k, stall)),
-            }
-        }
-        Ok(best)
-    }
-
-    /// The error for a search of contact k that could not separate a zero from its start.
-    #[cold]
-    fn stalled(&self, k: usize, stall: Stall) -> SimError {
-        SimError::Stalled {
-            t: stall.t,
-            what: match self.closure[k] {
-                Closure::Open => format!("the gap of {}", self.contact_name(k)),
-                _ => format!("the contact force of {}", self.contact_name(k)),
-            },
-        }
     }
 
     fn handle(&mut self, what: Pending) -> Result<(), SimError> {
