@@ -64,7 +64,7 @@ REF_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "crates
 # cases
 # --------------------------------------------------------------------------
 
-def make_case(name):
+def make_case(name, omega_ratio=None):
     if name == "default":  # paper Sect. 4.1, configuration (1), R_m = 2.5
         m = [0.048, 0.12, 0.048]
         delta = [0.020, 0.020]
@@ -75,6 +75,8 @@ def make_case(name):
         Omega = 0.60
     else:
         raise ValueError(name)
+    if omega_ratio is not None:
+        Omega = omega_ratio
     k = [120.0, 120.0, 120.0]
     c = [0.02, 0.02, 0.02]
     A = 0.08
@@ -520,6 +522,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--case", choices=["default", "chatter"], default="default")
     ap.add_argument("--periods", type=float, default=100)
+    ap.add_argument("--omega-ratio", type=float, default=None,
+                    help="excitation frequency ratio Ω = ω/√(k1/m1) instead of the case's own")
     ap.add_argument("--method", default="DOP853", choices=["DOP853", "RK45", "Radau", "LSODA"])
     ap.add_argument("--rtol", type=float, default=1e-10)
     ap.add_argument("--atol", type=float, default=1e-12)
@@ -542,7 +546,9 @@ def main():
     if args.check_reference:
         sys.exit(check_reference(args))
 
-    case = make_case(args.case)
+    if args.omega_ratio is not None and not (args.omega_ratio > 0 and math.isfinite(args.omega_ratio)):
+        sys.exit("--omega-ratio must be a positive number")
+    case = make_case(args.case, args.omega_ratio)
     status, err, walls, cpus = "ok", None, [], []
     for _ in range(max(1, args.repeat)):
         sim = make_sim(case, args)      # fresh simulator for every run
@@ -554,7 +560,7 @@ def main():
             break
     wall = float(np.median(walls)) if status == "ok" else None
     events = sim.counts["impacts"] + sim.counts["sticks"] + sim.counts["releases"]
-    res = dict(tool="scipy-solve_ivp", case=args.case, status=status, error=err,
+    res = dict(tool="scipy-solve_ivp", case=args.case, omega_ratio=case["Omega"], status=status, error=err,
                method=sim.method, rtol=sim.rtol, atol=sim.atol,
                max_step=None if sim.max_step == np.inf else sim.max_step,
                periods=args.periods, events=events, impacts=sim.counts["impacts"],
