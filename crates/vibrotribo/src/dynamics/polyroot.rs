@@ -73,12 +73,8 @@ fn first_positive_root_of(c: &[f64]) -> f64 {
                     None => f64::INFINITY,
                 };
             }
-            let mut dc = [0.0; 4];
-            for i in 1..=deg {
-                dc[i - 1] = i as f64 * c[i];
-            }
             let mut crit = [0.0; 4];
-            let ncrit = positive_roots(&dc[..deg], &mut crit);
+            let ncrit = critical_points(c, &mut crit);
             let mut lo = 0.0;
             for &hi in crit[..ncrit].iter().chain(std::iter::once(&f64::INFINITY)) {
                 let hi = if hi.is_infinite() {
@@ -178,6 +174,18 @@ fn cbrt_above(x: f64) -> f64 {
     y * (1.0 + 1e-12)
 }
 
+/// The positive critical points of `c` (degree 2 to 4, trimmed), in increasing order: the
+/// positive roots of its derivative. Returns how many.
+#[inline]
+fn critical_points(c: &[f64], out: &mut [f64; 4]) -> usize {
+    let deg = c.len() - 1;
+    let mut dc = [0.0; 4];
+    for i in 1..=deg {
+        dc[i - 1] = i as f64 * c[i];
+    }
+    positive_roots(&dc[..deg], out)
+}
+
 /// All positive real roots of `c` (degree ≤ 3) in increasing order; returns how many.
 pub(super) fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
     let mut deg = c.len() - 1;
@@ -214,12 +222,8 @@ pub(super) fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
             n
         }
         _ => {
-            let mut dc = [0.0; 4];
-            for i in 1..=deg {
-                dc[i - 1] = i as f64 * c[i];
-            }
             let mut crit = [0.0; 4];
-            let ncrit = positive_roots(&dc[..deg], &mut crit);
+            let ncrit = critical_points(c, &mut crit);
             let mut n = 0;
             let mut lo = 0.0;
             let mut plo = c[0];
