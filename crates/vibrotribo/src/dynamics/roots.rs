@@ -23,7 +23,7 @@
 //! are raced by time through [`Search`] (see `search.rs`).
 
 use super::polyroot::{bracket_root, first_positive_root, horner, positive_roots};
-use super::signal::Jet;
+use super::signal::{Jet, Signal};
 
 /// Outcome of a search.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -138,6 +138,23 @@ impl Search {
         self.first = false;
         Ok(None)
     }
+}
+
+/// One contact's search in the simulator's race of searches (`search.rs`).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Racer {
+    /// The contact whose event function this is.
+    pub(super) contact: usize,
+    /// Its gap (open) or contact force (closed).
+    pub(super) signal: Signal,
+    /// The harmonic part's amplitude ([`Signal::harmonic_amplitude`]).
+    pub(super) amp: f64,
+    /// Where the search started, s (a zero there is an impact at the start).
+    pub(super) start: f64,
+    /// The search's progress.
+    pub(super) search: Search,
+    /// What its zero is: an impact for a gap, a release for a force.
+    pub(super) gap: bool,
 }
 
 /// The first zero, from the jet at t, when the certified step ends where the local quartic

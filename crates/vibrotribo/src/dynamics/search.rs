@@ -11,8 +11,7 @@
 //! end or a resting contact's change before its force's zero).
 
 use super::contact::Closure;
-use super::roots::{Found, Search, Stall, first_root};
-use super::signal::Signal;
+use super::roots::{Found, Racer, Search, Stall, first_root};
 use super::simulator::{Pending, Simulator};
 use crate::error::SimError;
 
@@ -32,19 +31,6 @@ impl Candidate {
     fn precedes(&self, other: &Candidate) -> bool {
         self.t < other.t || (self.t == other.t && (self.contact, self.rank) < (other.contact, other.rank))
     }
-}
-
-/// One contact's search in the race.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Racer {
-    contact: usize,
-    signal: Signal,
-    /// The harmonic part's amplitude ([`Signal::harmonic_amplitude`]).
-    amp: f64,
-    start: f64,
-    search: Search,
-    /// What its zero is: an impact for a gap, a release for a force.
-    gap: bool,
 }
 
 /// The horizon of a search of `contact` (rank 1) given the best candidate so far: a zero must

@@ -127,7 +127,7 @@ pub struct Simulator {
     /// Per contact: the gap search starts no earlier than this (see `handle`).
     pub(super) search_from: Vec<f64>,
     /// Scratch for the race of the event searches (`search.rs`).
-    pub(super) scratch_racers: Vec<super::search::Racer>,
+    pub(super) scratch_racers: Vec<super::roots::Racer>,
     /// Whether a run that stops without an event re-anchors the clusters' flows there (the
     /// default). A caller that installs new forces before every run (which rebuilds anyway)
     /// turns it off: the flows stay valid past a stop, anchored where they started.
