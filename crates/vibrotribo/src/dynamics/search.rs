@@ -66,7 +66,10 @@ impl Simulator {
             if self.absent(k) {
                 continue;
             }
-            if let Closure::Chatter { t_acc, .. } = self.closure[k] {
+            // A jump whose accumulation point lies beyond the stop goes on after it.
+            if let Closure::Chatter { t_acc, .. } = self.closure[k]
+                && t_acc < stop
+            {
                 let c = Candidate {
                     t: t_acc.max(self.t),
                     contact: k,
