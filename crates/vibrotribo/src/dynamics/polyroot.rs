@@ -265,23 +265,20 @@ pub(super) fn positive_roots(c: &[f64], out: &mut [f64; 4]) -> usize {
 /// A root of `c` in `[lo, hi]` where `c` is monotone and changes sign, to relative precision
 /// `rtol`. With `safe_left` the result lies on the side of `lo` (never beyond the root).
 pub(super) fn bracket_root(c: &[f64], lo: f64, hi: f64, safe_left: bool, rtol: f64) -> f64 {
-    // Dispatched on the length so that each degree's Horner passes are unrolled.
-    match c.len() {
-        3 => bracket_root_n::<3>(c.try_into().expect("length 3"), lo, hi, safe_left, rtol),
-        4 => bracket_root_n::<4>(c.try_into().expect("length 4"), lo, hi, safe_left, rtol),
-        5 => bracket_root_n::<5>(c.try_into().expect("length 5"), lo, hi, safe_left, rtol),
-        _ => {
-            // Degrees up to 7 with leading zeros (the same polynomial); none above arise here.
-            let mut padded = [0.0; 8];
-            let n = c.len().min(8);
-            padded[..n].copy_from_slice(&c[..n]);
-            bracket_root_n::<8>(&padded, lo, hi, safe_left, rtol)
-        }
+    // The lengths that arise (the cubic and quartic bounds and models) get their own copies
+    // with the length known (Horner passes unrolled), as in `first_positive_root`.
+    if let Ok(cubic) = <&[f64; 4]>::try_from(c) {
+        bracket_root_of(cubic, lo, hi, safe_left, rtol)
+    } else if let Ok(quartic) = <&[f64; 5]>::try_from(c) {
+        bracket_root_of(quartic, lo, hi, safe_left, rtol)
+    } else {
+        bracket_root_of(c, lo, hi, safe_left, rtol)
     }
 }
 
-/// [`bracket_root`] for a polynomial of length `N`.
-fn bracket_root_n<const N: usize>(c: &[f64; N], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64) -> f64 {
+/// [`bracket_root`]'s body, inlined into each caller.
+#[inline(always)]
+fn bracket_root_of(c: &[f64], mut lo: f64, mut hi: f64, safe_left: bool, rtol: f64) -> f64 {
     let before_negative = horner(c, lo) < 0.0;
     // Start Newton at the root of the local quadratic model at `lo` when it falls inside the
     // bracket (within a step or two of the root when the bracket is wide, as the Fujiwara

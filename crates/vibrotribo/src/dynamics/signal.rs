@@ -8,9 +8,10 @@
 //! - homogeneous parts `a h(t) + b h'(t)` of at most two oscillators,
 //! - with external force polynomials (see [`super::forces`]), a polynomial in time.
 //!
-//! [`Signal::jet`] returns the value and first three derivatives at a time, and bounds
-//! `B_n ≥ sup_{t ≤ s ≤ H} |f^{(n)}(s)|`, n = 2..4, up to the horizon H of the search (for all
-//! the future of the current flow when there is no polynomial part).
+//! [`Signal::jet`] returns the value and first four derivatives at a time, and bounds
+//! `B_n ≥ sup_{t ≤ s ≤ H} |f^{(n)}(s)|`, n = 2..5, up to the horizon H of the search (for all
+//! the future of the current flow when there is no polynomial part; `B₅` is infinite when
+//! there is one).
 //! The bounds come from an energy argument: any solution `g` of `g'' + 2αg' + ω_n² g = 0` with
 //! α ≥ 0 has non-increasing `E = g'² + ω_n² g²`, and every derivative of `g` is again such a
 //! solution, so `|g^{(n)}(s)| ≤ √(g^{(n)}(t)² + g^{(n+1)}(t)²/ω_n²)` for all s ≥ t. The
