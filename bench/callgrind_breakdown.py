@@ -29,7 +29,6 @@ PARTS = [
      [r"GapPolynomial::build$", r"Oscillator::taylor$"]),
     ("    Radau stage solves (trial_resistor, trial_rectifier)", 0,
      [r"ChargeSolver>::trial_resistor$", r"ChargeSolver>::trial_rectifier$"]),
-    ("    quasi-static fast path (trial_quasi_static)", 0, [r"ChargeSolver>::trial_quasi_static$"]),
     ("    outputs of steps: samples, breakdown (record)", 0, [r"ChargeSolver>::record$"]),
     ("      of which the air-breakdown check (BreakdownMargin::add)", 0, [r"BreakdownMargin::add$"]),
     ("  mechanical samples (Flow::state_at)", 0, [r"Flow::state_at$"]),
