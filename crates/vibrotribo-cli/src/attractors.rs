@@ -15,10 +15,10 @@ use vibrotribo::sweep::grid;
 
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
+use crate::job::{RunArgs, check_all, check_distinct, set_threads};
 use crate::output::{CsvFile, create_dir, csv_text, numbered, read_csv, read_json, si, write_json};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};
-use crate::sweep::{RunArgs, check_all, check_distinct, set_threads};
 
 /// Options of `vibrotribo attractors`.
 #[derive(Debug, clap::Args)]
@@ -374,7 +374,7 @@ pub fn plot_attractors(dir: &Path) -> Result<()> {
         param.clone(),
         "basin fraction",
     );
-    crate::plots::both(dir, "attractor_fractions", |path| {
+    crate::plot::both(dir, "attractor_fractions", |path| {
         plot::stacked_bands(
             path,
             &fig,
@@ -407,7 +407,7 @@ pub fn plot_attractors(dir: &Path) -> Result<()> {
         if lo > 0.0 && hi > 10.0 * lo {
             fig.y_scale = Scale::Log;
         }
-        crate::plots::both(dir, "attractor_power", |path| {
+        crate::plot::both(dir, "attractor_power", |path| {
             plot::line_plot(path, &fig, &series)
         })?;
     }

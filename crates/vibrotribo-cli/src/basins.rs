@@ -16,11 +16,11 @@ use vibrotribo::sweep::grid;
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
+use crate::job::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
 use crate::limits;
 use crate::output::{CsvFile, csv_text, numbered, read_csv, read_json, si};
 use crate::plot::{self, CategoryMap, Figure};
 use crate::progress::Interrupted;
-use crate::sweep::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
 
 /// `NXxNY`: the nodes of a basin grid along x and y.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -525,7 +525,7 @@ pub fn plot_basins(dir: &Path) -> Result<()> {
         label("x"),
         label("y"),
     );
-    crate::plots::both(dir, "basins", |path| plot::category_map(path, &fig, &map))
+    crate::plot::both(dir, "basins", |path| plot::category_map(path, &fig, &map))
 }
 
 /// Merges the shards of a basins job (`vibrotribo merge`) and classifies the result.

@@ -17,8 +17,7 @@ use vibrotribo::study::{
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, read_json, write_json};
-use crate::plot::{self, Figure, Legend, Series};
-use crate::plots::both;
+use crate::plot::{self, Figure, Legend, Series, both};
 use crate::progress::{Interrupted, Progress, Watch};
 
 /// `--sweep`: how the frequency moves.

@@ -18,8 +18,7 @@ use vibrotribo::{ChainParams, ChainState, Simulator};
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
-use crate::plot::{self, Figure, Legend, Series};
-use crate::plots::both;
+use crate::plot::{self, Figure, Legend, Series, both};
 
 /// Options of `vibrotribo continue`.
 #[derive(Debug, clap::Args)]

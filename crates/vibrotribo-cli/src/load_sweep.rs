@@ -10,8 +10,7 @@ use vibrotribo::study::{LoadStudyOptions, load_study};
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, si, write_json};
-use crate::plot;
-use crate::plots::both;
+use crate::plot::{self, both};
 use crate::progress::{Interrupted, Progress, Watch};
 
 /// Options of `vibrotribo load-sweep`.

@@ -193,7 +193,7 @@ pub fn plot_lyapunov(dir: &Path) -> Result<()> {
         "λ [1/s]",
     );
     fig.legend = Legend::UpperRight;
-    crate::plots::both(dir, "lyapunov_running", |path| {
+    crate::plot::both(dir, "lyapunov_running", |path| {
         plot::line_plot(path, &fig, &series)
     })
 }

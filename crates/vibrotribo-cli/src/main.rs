@@ -12,6 +12,7 @@ mod limits;
 mod load_sweep;
 mod lyapunov;
 mod map;
+mod merge;
 mod output;
 mod periodic;
 mod plot;
@@ -49,7 +50,7 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Combine the shards of one sweep, map or basins job (`--shard I/N`) into the unsharded
     /// output.
-    Merge(sweep::MergeArgs),
+    Merge(job::MergeArgs),
     /// Frequency-sweep experiment: a slow chirp of the base up and down in Ω, the response
     /// per cycle (amplitudes, impacts, power), its jumps and the hysteresis between them.
     Chirp(chirp::ChirpArgs),
@@ -94,7 +95,7 @@ fn run() -> anyhow::Result<()> {
         Command::Periodic(args) => periodic::run(&args),
         Command::Continue(args) => continuation::run(&args),
         Command::Sweep(args) => sweep::run(&args),
-        Command::Merge(args) => sweep::merge(&args),
+        Command::Merge(args) => merge::run(&args),
         Command::Chirp(args) => chirp::run(&args),
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),

@@ -11,14 +11,14 @@ use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
+use crate::job::{
+    MergeArgs, RunArgs, Shard, check_all, check_distinct, estimate_point_memory, estimate_point_output,
+    floquet_of, header_len, point_columns, run_points, set_threads,
+};
 use crate::limits;
 use crate::output::{CsvFile, PointColumns, create_dir, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
-use crate::sweep::{
-    MergeArgs, RunArgs, Shard, check_all, check_distinct, estimate_point_memory, estimate_point_output,
-    floquet_of, header_len, point_columns, run_points, set_threads,
-};
 use vibrotribo::sweep::grid;
 
 /// Options of `vibrotribo map`.
@@ -162,8 +162,8 @@ pub fn run(args: &MapArgs) -> Result<()> {
     if o.floquet {
         settings["floquet"] = json!(true);
     }
-    crate::sweep::add_settle_settings(&mut settings, o);
-    crate::sweep::add_base_motion(&mut settings, runner.base());
+    crate::job::add_settle_settings(&mut settings, o);
+    crate::job::add_base_motion(&mut settings, runner.base());
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -522,7 +522,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             }),
         )?;
         if args.plot {
-            crate::plots::both(dir, "optimal_mass_ratio", |path| {
+            crate::plot::both(dir, "optimal_mass_ratio", |path| {
                 plot_optimal_mass_ratio(path, &ws, &rs, fit.as_ref(), (args.omega_from, args.omega_to))
             })?;
         }

@@ -15,8 +15,7 @@ use vibrotribo::{EventKind, UniformSampler};
 
 use crate::config::ConfigArgs;
 use crate::output::{create_dir, numbered, si, write_json};
-use crate::plot::{self, Figure, Legend, Series};
-use crate::plots::both;
+use crate::plot::{self, Figure, Legend, Series, both};
 
 /// Options of `vibrotribo periodic`.
 #[derive(Debug, clap::Args)]

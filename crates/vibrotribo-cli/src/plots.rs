@@ -8,15 +8,7 @@ use anyhow::{Context, Result, bail};
 use vibrotribo::analysis::{WelchOptions, welch_psd};
 
 use crate::output::{CsvFile, column, numbers, read_csv, read_json, si};
-use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series};
-
-/// Writes `name.png` and `name.svg` in `dir` with `draw`.
-pub(crate) fn both(dir: &Path, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<()> {
-    for ext in ["png", "svg"] {
-        draw(&dir.join(format!("{name}.{ext}")))?;
-    }
-    Ok(())
-}
+use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series, both};
 
 /// Draws whatever `dir` holds: a `simulate`, `sweep` or `map` output directory.
 pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {

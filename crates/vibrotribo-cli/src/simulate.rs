@@ -15,10 +15,10 @@ use vibrotribo::study::{
 use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
+use crate::job::{SETTLE_CAP, Settle};
 use crate::limits;
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Interrupted, Progress, Watch};
-use crate::sweep::{SETTLE_CAP, Settle};
 
 /// Options of `vibrotribo simulate`.
 #[derive(Debug, clap::Args)]

@@ -1,142 +1,27 @@
-//! `vibrotribo sweep` and `vibrotribo merge`: one-parameter sweeps (orbit diagrams,
-//! impact-velocity diagrams, power curves), parallel, continued, or sharded across machines.
+//! `vibrotribo sweep`: one-parameter sweeps (orbit diagrams, impact-velocity diagrams, power
+//! curves), parallel, continued, or sharded across machines (and the merge of a sweep's
+//! shards).
 
 use std::ops::ControlFlow;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 use serde_json::json;
 use vibrotribo::ChainState;
-use vibrotribo::config::Config;
 use vibrotribo::lyapunov::LyapunovOptions;
-use vibrotribo::study::{AutoSettle, PointOptions, PointResult, SettleMode};
-use vibrotribo::sweep::{Continuation, Delivery, PointRunner, error_text, grid, run_chunks, run_continued};
+use vibrotribo::study::{PointOptions, PointResult};
+use vibrotribo::sweep::{Continuation, PointRunner, error_text, grid, run_continued};
 
 use crate::config::ConfigArgs;
-use crate::job::{CsvSpec, GridOutput, Layout};
+use crate::job::{
+    CsvSpec, GridOutput, Layout, MergeArgs, RunArgs, Shard, add_base_motion, add_settle_settings, check_all,
+    check_distinct, estimate_point_memory, estimate_point_output, floquet_of, header_len, point_columns,
+    run_points, set_threads,
+};
 use crate::limits;
 use crate::output::{PointColumns, numbered};
 use crate::progress::{Interrupted, Progress, interrupted};
-
-/// `I/N`: the I-th (0-based) of N interleaved slices of the grid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Shard {
-    /// This slice, 0 ≤ index < count.
-    pub index: usize,
-    /// Number of slices.
-    pub count: usize,
-}
-
-impl std::str::FromStr for Shard {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let (i, n) = s
-            .split_once('/')
-            .ok_or_else(|| format!("--shard takes I/N (e.g. 3/16), got {s:?}"))?;
-        let index: usize = i
-            .trim()
-            .parse()
-            .map_err(|_| format!("--shard: bad index {i:?}"))?;
-        let count: usize = n
-            .trim()
-            .parse()
-            .map_err(|_| format!("--shard: bad count {n:?}"))?;
-        if count == 0 || index >= count {
-            return Err(format!(
-                "--shard {s}: need 0 ≤ I < N (Slurm: --array=0-{})",
-                count.max(1) - 1
-            ));
-        }
-        Ok(Shard { index, count })
-    }
-}
-
-/// `--settle`: how long each point runs before its recorded window.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Settle {
-    /// Until the motion repeats, finishing a geometric approach by Newton shooting, at most
-    /// `--settle-cap` periods ([`SettleMode::Auto`]).
-    #[default]
-    Auto,
-    /// The fixed `--transient` ([`SettleMode::Fixed`]).
-    Fixed,
-}
-
-impl std::str::FromStr for Settle {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(Settle::Auto),
-            "fixed" => Ok(Settle::Fixed),
-            other => Err(format!("unknown --settle {other:?}: expected auto or fixed")),
-        }
-    }
-}
-
-impl Settle {
-    /// `auto` or `fixed`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Settle::Auto => "auto",
-            Settle::Fixed => "fixed",
-        }
-    }
-
-    /// The library's settle mode, with at most `cap` periods for `auto`.
-    pub fn mode(self, cap: u64) -> SettleMode {
-        match self {
-            Settle::Auto => SettleMode::Auto(AutoSettle {
-                cap_periods: cap,
-                ..AutoSettle::default()
-            }),
-            Settle::Fixed => SettleMode::Fixed,
-        }
-    }
-}
-
-/// The default of `--settle-cap`, periods.
-pub const SETTLE_CAP: u64 = 2000;
-
-/// Settings shared by sweeps and maps.
-#[derive(Debug, clap::Args)]
-pub struct RunArgs {
-    /// Transient periods per value (default: the configuration's run.transient_periods).
-    #[arg(long)]
-    pub transient: Option<u64>,
-    /// Recorded periods per value (default: run.periods − run.transient_periods).
-    #[arg(long)]
-    pub recorded: Option<u64>,
-    /// Mechanics only: no harvester, average_power_w left empty (faster).
-    #[arg(long)]
-    pub mechanics_only: bool,
-    /// Relative tolerance of the period detection.
-    #[arg(long, default_value_t = 1e-4)]
-    pub period_tolerance: f64,
-    /// Also find the periodic orbit of each point's detected period by shooting and write
-    /// its largest Floquet multiplier modulus (column `max_abs_multiplier`; < 1: stable).
-    #[arg(long)]
-    pub floquet: bool,
-    /// How long each point runs before its recorded window: `auto` until the motion repeats
-    /// within the period tolerance (checked every 50 periods; a geometric approach to a
-    /// periodic orbit is finished by Newton shooting; a motion whose returns do not shrink
-    /// stops after --transient periods), at most --settle-cap periods; `fixed` exactly
-    /// --transient periods (the results of earlier versions).
-    #[arg(long, default_value = "auto", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
-    pub settle: Settle,
-    /// Most periods `--settle auto` runs before the recorded window.
-    #[arg(long, default_value_t = SETTLE_CAP, value_name = "PERIODS")]
-    pub settle_cap: u64,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// No progress bar.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
-    #[arg(long)]
-    pub allow_large: bool,
-}
 
 /// Options of `vibrotribo sweep`.
 #[derive(Debug, clap::Args)]
@@ -182,160 +67,6 @@ pub struct SweepArgs {
     pub lyapunov: bool,
     #[command(flatten)]
     pub run: RunArgs,
-}
-
-impl RunArgs {
-    /// The point runner of these settings on `base` (transient and recorded periods by
-    /// default from its `[run]` table).
-    pub fn runner(&self, base: Config) -> Result<PointRunner> {
-        let settings = base.run();
-        let defaults = (settings.transient(), settings.periods - settings.transient());
-        self.runner_or(base, defaults)
-    }
-
-    /// The point runner of these settings on `base`, with `(transient, recorded)` periods
-    /// where the options do not give them.
-    pub fn runner_or(&self, base: Config, (transient, recorded): (u64, u64)) -> Result<PointRunner> {
-        let transient = self.transient.unwrap_or(transient);
-        let recorded = self.recorded.unwrap_or(recorded);
-        if recorded == 0 {
-            bail!("--recorded must be at least 1");
-        }
-        if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
-            bail!(
-                "--period-tolerance must lie in (0, 1), got {}",
-                self.period_tolerance
-            );
-        }
-        if self.settle_cap == 0 {
-            bail!("--settle-cap must be at least 1");
-        }
-        if self.floquet {
-            base.check_periodic("--floquet (Floquet multipliers)")?;
-        }
-        // Under a base motion that is not periodic there is no periodic motion to settle to
-        // or classify: each point runs exactly `transient + recorded` periods.
-        let periodic = base.is_periodic();
-        let options = PointOptions {
-            transient_periods: transient,
-            recorded_periods: recorded,
-            period_tolerance: self.period_tolerance,
-            floquet: self.floquet,
-            settle: if periodic {
-                self.settle.mode(self.settle_cap)
-            } else {
-                vibrotribo::study::SettleMode::Fixed
-            },
-            classify: periodic,
-            ..PointOptions::default()
-        };
-        Ok(PointRunner::new(base, options, self.mechanics_only))
-    }
-}
-
-/// Checks every point of a grid (`keys` gives each point's settings); the error names the
-/// first bad point.
-pub fn check_all<'k, P>(
-    runner: &PointRunner,
-    points: &[P],
-    keys: impl Fn(&P) -> Vec<(&'k str, f64)>,
-) -> Result<()> {
-    for p in points {
-        let k = keys(p);
-        runner.configure(&k).with_context(|| {
-            k.iter()
-                .map(|(key, v)| format!("{key} = {v}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        })?;
-    }
-    Ok(())
-}
-
-/// Runs `points` in parallel chunks (see [`vibrotribo::sweep::run_grid`]), calling `write`
-/// with each point's result in grid order and with `None` after each chunk, ticking a
-/// progress bar (label, points done before, points in all) and stopping after the current
-/// chunk on SIGINT/SIGTERM, keeping what was written. Returns how many were written.
-pub fn run_points<'k, P, W>(
-    runner: &PointRunner,
-    points: &[P],
-    keys: impl Fn(&P) -> Vec<(&'k str, f64)> + Sync,
-    progress: (&str, u64, u64),
-    quiet: bool,
-    mut write: W,
-) -> Result<usize>
-where
-    P: Sync,
-    W: FnMut(Option<(&P, &Result<PointResult, String>)>) -> Result<()>,
-{
-    run_chunked(
-        points,
-        |p| runner.run(&keys(p), None).map_err(|e| error_text(&e)),
-        progress,
-        quiet,
-        |d| match d {
-            Some((p, r)) => write(Some((p, &r))),
-            None => write(None),
-        },
-    )
-}
-
-/// Runs `work` on `points` in parallel chunks ([`vibrotribo::sweep::run_chunks`]), calling
-/// `write` with each result in order and with `None` after each chunk, with a progress bar
-/// (label, points done before, points in all) and a stop after the current chunk on
-/// SIGINT/SIGTERM. Returns how many were written.
-pub fn run_chunked<P, R, W, F>(
-    points: &[P],
-    work: W,
-    (what, before, total): (&str, u64, u64),
-    quiet: bool,
-    mut write: F,
-) -> Result<usize>
-where
-    P: Sync,
-    R: Send,
-    W: Fn(&P) -> R + Sync,
-    F: FnMut(Option<(&P, R)>) -> Result<()>,
-{
-    let progress = Progress::new(total, what, quiet).starting_at(before);
-    let mut failure = None;
-    let done = run_chunks(points, rayon::current_num_threads() * 4, work, |d| {
-        let (written, checkpoint) = match d {
-            Delivery::Point(p, r) => {
-                progress.inc(1);
-                (write(Some((p, r))), false)
-            }
-            Delivery::Chunk(_) => (write(None), true),
-        };
-        if let Err(e) = written {
-            failure = Some(e);
-            return ControlFlow::Break(());
-        }
-        if checkpoint && interrupted() {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
-    });
-    progress.finish();
-    match failure {
-        Some(e) => Err(e),
-        None => Ok(done),
-    }
-}
-
-/// Installs the worker-thread count (once per process).
-pub fn set_threads(threads: Option<usize>) -> Result<()> {
-    if let Some(n) = threads {
-        if n == 0 {
-            bail!("--threads must be at least 1");
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .map_err(|e| anyhow!("cannot set up {n} threads: {e}"))?;
-    }
-    Ok(())
 }
 
 /// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
@@ -401,16 +132,6 @@ fn write_value(
     out.row(2, row)
 }
 
-/// The point columns of a chain with `contacts` contacts
-/// ([`ChainParams::contact_count`](vibrotribo::ChainParams::contact_count)).
-pub fn point_columns(contacts: usize, floquet: bool, lyapunov: bool) -> PointColumns {
-    PointColumns {
-        contacts,
-        floquet,
-        lyapunov,
-    }
-}
-
 /// The settings a sweep records in `sweep.json` (everything that determines its output).
 fn settings_json(
     args: &SweepArgs,
@@ -448,59 +169,6 @@ fn settings_json(
         settings["lyapunov"] = json!(true);
     }
     settings
-}
-
-/// Records the base motion of `config` in a manifest (`base_motion`, when it is not the
-/// chain's own harmonic: kind, how it was run, spline accuracy, record scaling).
-pub fn add_base_motion(settings: &mut serde_json::Value, config: &vibrotribo::config::Config) {
-    if let Some(b) = vibrotribo::report::base_motion_json(config, &config.run_spec(true)) {
-        settings["base_motion"] = b;
-    }
-}
-
-/// Records the settling of `options` in a manifest (`sweep.json`, `map.json`): `settle`
-/// (`auto` or `fixed`), and for `auto` `settle_cap_periods` and `settle_block_periods`.
-pub fn add_settle_settings(settings: &mut serde_json::Value, options: &PointOptions) {
-    settings["settle"] = json!(options.settle.as_str());
-    if let SettleMode::Auto(a) = &options.settle {
-        settings["settle_cap_periods"] = json!(a.cap_periods);
-        settings["settle_block_periods"] = json!(a.block);
-        settings["settle_newton"] = json!(a.shoot);
-    }
-}
-
-/// Checks that a grid's values are distinct: rows are keyed by their value.
-pub fn check_distinct(what: &str, values: &[f64]) -> Result<()> {
-    let mut seen = std::collections::HashSet::new();
-    for v in values {
-        if !seen.insert(v.to_bits()) {
-            bail!("{what}: the grid repeats the value {v} (use --steps 1 for a single value)");
-        }
-    }
-    Ok(())
-}
-
-/// Estimated bytes written per point of a sweep or map (the orbit rows dominate).
-pub fn estimate_point_output(runner: &PointRunner, orbit: bool) -> f64 {
-    let o = runner.options();
-    let n = runner.masses() as f64;
-    let orbit_bytes = if orbit {
-        o.recorded_periods as f64 * (n + 2.0) * limits::CSV_NUMBER_BYTES
-    } else {
-        0.0
-    };
-    orbit_bytes + (n + 8.0) * limits::CSV_NUMBER_BYTES
-}
-
-/// Estimated memory of one point's run (stroboscopic samples and per-period counts).
-pub fn estimate_point_memory(runner: &PointRunner) -> f64 {
-    let o = runner.options();
-    let n = runner.masses() as f64;
-    let before = match &o.settle {
-        SettleMode::Auto(a) => a.cap_periods.max(o.transient_periods),
-        SettleMode::Fixed => o.transient_periods,
-    };
-    (before + o.recorded_periods) as f64 * (8.0 * n + 96.0)
 }
 
 /// Runs `vibrotribo sweep`.
@@ -696,17 +364,6 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     Ok(())
 }
 
-/// Options of `vibrotribo merge`.
-#[derive(Debug, clap::Args)]
-pub struct MergeArgs {
-    /// Output directories of the shards of one sweep or map (`--shard I/N`).
-    #[arg(required = true)]
-    pub shards: Vec<PathBuf>,
-    /// Where to write the merged files (a new or empty directory).
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
-}
-
 /// The keys (`param` values as written) of a sweep's grid from its `sweep.json`.
 fn sweep_keys(settings: &serde_json::Value) -> Result<Vec<String>> {
     settings["values"]
@@ -721,42 +378,23 @@ fn sweep_keys(settings: &serde_json::Value) -> Result<Vec<String>> {
         .collect()
 }
 
-/// Runs `vibrotribo merge`.
+/// Combines the shards of one sweep (`vibrotribo merge` of `sweep.json` directories).
 pub fn merge(args: &MergeArgs) -> Result<()> {
     let first = &args.shards[0];
-    if first.join("map.json").exists() {
-        crate::map::merge(args)?;
-    } else if first.join("basins.json").exists() {
-        crate::basins::merge(args)?;
-    } else {
-        // orbit.csv: param, period, x1_m, …, xN_m.
-        let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
-        let floquet = floquet_of(first, "sweep.json")?;
-        let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
-        // summary.csv: param, then the point columns.
-        let columns = PointColumns::from_width(
-            header_len(&first.join("summary.csv"))?.saturating_sub(1),
-            floquet,
-            lyapunov,
-        );
-        crate::job::merge(
-            &args.shards,
-            &args.out,
-            &sweep_layout(masses, columns),
-            sweep_keys,
-        )?;
-    }
-    println!("merged {} shards into {}", args.shards.len(), args.out.display());
-    Ok(())
-}
-
-/// Whether the job in `dir` (manifest `manifest`) has the Floquet column.
-pub fn floquet_of(dir: &Path, manifest: &str) -> Result<bool> {
-    Ok(crate::output::read_json(&dir.join(manifest))?["floquet"].as_bool() == Some(true))
-}
-
-/// The number of columns of the CSV file `path` (from its header).
-pub fn header_len(path: &Path) -> Result<usize> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    Ok(text.lines().next().unwrap_or("").split(',').count())
+    // orbit.csv: param, period, x1_m, …, xN_m.
+    let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
+    let floquet = floquet_of(first, "sweep.json")?;
+    let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
+    // summary.csv: param, then the point columns.
+    let columns = PointColumns::from_width(
+        header_len(&first.join("summary.csv"))?.saturating_sub(1),
+        floquet,
+        lyapunov,
+    );
+    crate::job::merge(
+        &args.shards,
+        &args.out,
+        &sweep_layout(masses, columns),
+        sweep_keys,
+    )
 }

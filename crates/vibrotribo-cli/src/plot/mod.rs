@@ -20,6 +20,7 @@
 
 mod category;
 mod figure;
+mod files;
 mod heat;
 #[cfg(test)]
 mod tests;
@@ -30,3 +31,4 @@ pub use figure::{
     Figure, HeatMap, Legend, Scale, Series, heat_map, line_plot, lines_and_points, phase_portrait,
     scatter_plot,
 };
+pub use files::both;

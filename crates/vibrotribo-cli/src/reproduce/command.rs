@@ -16,9 +16,9 @@ use super::orbits::periodic_orbits;
 use super::report::write_report;
 use super::spacing::{fig_12, figs_7_11};
 use super::vibration::vibration;
+use crate::job::set_threads;
 use crate::output::create_dir;
 use crate::progress::check_interrupt;
-use crate::sweep::set_threads;
 
 /// Options of `vibrotribo reproduce`.
 #[derive(Debug, clap::Args)]

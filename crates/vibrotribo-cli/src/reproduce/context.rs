@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::sweep::RunArgs;
+use crate::job::RunArgs;
 
 /// Work sizes of one mode.
 #[derive(Debug, Clone, Copy)]
@@ -107,8 +107,8 @@ impl Ctx {
             floquet: false,
             // Settled before recording, so that "not periodic" is a finding, not a short
             // transient; the motions are classified.
-            settle: crate::sweep::Settle::Auto,
-            settle_cap: crate::sweep::SETTLE_CAP,
+            settle: crate::job::Settle::Auto,
+            settle_cap: crate::job::SETTLE_CAP,
             threads: None,
             quiet: true,
             allow_large: false,

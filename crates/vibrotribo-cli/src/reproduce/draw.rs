@@ -12,7 +12,7 @@ use crate::plot::{self, Figure, Legend, Scale, Series};
 
 /// Draws `draw` as PNG and SVG in the output directory; returns the PNG's file name.
 pub(super) fn both(ctx: &Ctx, name: &str, draw: impl Fn(&Path) -> Result<()>) -> Result<String> {
-    crate::plots::both(&ctx.out, name, draw)?;
+    crate::plot::both(&ctx.out, name, draw)?;
     Ok(format!("{name}.png"))
 }
 

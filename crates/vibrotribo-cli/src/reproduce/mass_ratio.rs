@@ -9,10 +9,10 @@ use vibrotribo::study::PointResult;
 use super::context::{Ctx, Verdict};
 use super::draw::{both, closing_speeds, impact_figure, lines, orbit_figure, return_map, running_power};
 use super::runs::{arr, config, describe_motions, f, motion_of, run_series, sweep, with};
+use crate::job::RunArgs;
 use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
-use crate::sweep::RunArgs;
 use vibrotribo::sweep::grid;
 
 pub(super) fn fig_13(ctx: &mut Ctx) -> Result<()> {

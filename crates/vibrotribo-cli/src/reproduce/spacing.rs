@@ -8,9 +8,9 @@ use vibrotribo::study::PointResult;
 use super::context::{Ctx, Verdict};
 use super::draw::{closing_speeds, d1_figures, impact_figure, lines, orbit_figure, return_map, scatter};
 use super::runs::{arr, config, f, mean, motion_of, run_series, sweep, with};
+use crate::job::RunArgs;
 use crate::output::si;
 use crate::plot::{Figure, Legend, Scale};
-use crate::sweep::RunArgs;
 use vibrotribo::sweep::grid;
 
 pub(super) fn figs_7_11(ctx: &mut Ctx) -> Result<()> {

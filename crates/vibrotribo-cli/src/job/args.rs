@@ -1,0 +1,188 @@
+//! The options every grid job shares: shards, settling, the per-point run settings and the
+//! shards `merge` combines.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use vibrotribo::config::Config;
+use vibrotribo::study::{AutoSettle, PointOptions, SettleMode};
+use vibrotribo::sweep::PointRunner;
+
+/// `I/N`: the I-th (0-based) of N interleaved slices of the grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// This slice, 0 ≤ index < count.
+    pub index: usize,
+    /// Number of slices.
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("--shard takes I/N (e.g. 3/16), got {s:?}"))?;
+        let index: usize = i
+            .trim()
+            .parse()
+            .map_err(|_| format!("--shard: bad index {i:?}"))?;
+        let count: usize = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("--shard: bad count {n:?}"))?;
+        if count == 0 || index >= count {
+            return Err(format!(
+                "--shard {s}: need 0 ≤ I < N (Slurm: --array=0-{})",
+                count.max(1) - 1
+            ));
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+/// `--settle`: how long each point runs before its recorded window.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Settle {
+    /// Until the motion repeats, finishing a geometric approach by Newton shooting, at most
+    /// `--settle-cap` periods ([`SettleMode::Auto`]).
+    #[default]
+    Auto,
+    /// The fixed `--transient` ([`SettleMode::Fixed`]).
+    Fixed,
+}
+
+impl std::str::FromStr for Settle {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Settle::Auto),
+            "fixed" => Ok(Settle::Fixed),
+            other => Err(format!("unknown --settle {other:?}: expected auto or fixed")),
+        }
+    }
+}
+
+impl Settle {
+    /// `auto` or `fixed`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Settle::Auto => "auto",
+            Settle::Fixed => "fixed",
+        }
+    }
+
+    /// The library's settle mode, with at most `cap` periods for `auto`.
+    pub fn mode(self, cap: u64) -> SettleMode {
+        match self {
+            Settle::Auto => SettleMode::Auto(AutoSettle {
+                cap_periods: cap,
+                ..AutoSettle::default()
+            }),
+            Settle::Fixed => SettleMode::Fixed,
+        }
+    }
+}
+
+/// The default of `--settle-cap`, periods.
+pub const SETTLE_CAP: u64 = 2000;
+
+/// Settings shared by sweeps and maps.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// Transient periods per value (default: the configuration's run.transient_periods).
+    #[arg(long)]
+    pub transient: Option<u64>,
+    /// Recorded periods per value (default: run.periods − run.transient_periods).
+    #[arg(long)]
+    pub recorded: Option<u64>,
+    /// Mechanics only: no harvester, average_power_w left empty (faster).
+    #[arg(long)]
+    pub mechanics_only: bool,
+    /// Relative tolerance of the period detection.
+    #[arg(long, default_value_t = 1e-4)]
+    pub period_tolerance: f64,
+    /// Also find the periodic orbit of each point's detected period by shooting and write
+    /// its largest Floquet multiplier modulus (column `max_abs_multiplier`; < 1: stable).
+    #[arg(long)]
+    pub floquet: bool,
+    /// How long each point runs before its recorded window: `auto` until the motion repeats
+    /// within the period tolerance (checked every 50 periods; a geometric approach to a
+    /// periodic orbit is finished by Newton shooting; a motion whose returns do not shrink
+    /// stops after --transient periods), at most --settle-cap periods; `fixed` exactly
+    /// --transient periods (the results of earlier versions).
+    #[arg(long, default_value = "auto", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
+    pub settle: Settle,
+    /// Most periods `--settle auto` runs before the recorded window.
+    #[arg(long, default_value_t = SETTLE_CAP, value_name = "PERIODS")]
+    pub settle_cap: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
+    #[arg(long)]
+    pub allow_large: bool,
+}
+
+impl RunArgs {
+    /// The point runner of these settings on `base` (transient and recorded periods by
+    /// default from its `[run]` table).
+    pub fn runner(&self, base: Config) -> Result<PointRunner> {
+        let settings = base.run();
+        let defaults = (settings.transient(), settings.periods - settings.transient());
+        self.runner_or(base, defaults)
+    }
+
+    /// The point runner of these settings on `base`, with `(transient, recorded)` periods
+    /// where the options do not give them.
+    pub fn runner_or(&self, base: Config, (transient, recorded): (u64, u64)) -> Result<PointRunner> {
+        let transient = self.transient.unwrap_or(transient);
+        let recorded = self.recorded.unwrap_or(recorded);
+        if recorded == 0 {
+            bail!("--recorded must be at least 1");
+        }
+        if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
+            bail!(
+                "--period-tolerance must lie in (0, 1), got {}",
+                self.period_tolerance
+            );
+        }
+        if self.settle_cap == 0 {
+            bail!("--settle-cap must be at least 1");
+        }
+        if self.floquet {
+            base.check_periodic("--floquet (Floquet multipliers)")?;
+        }
+        // Under a base motion that is not periodic there is no periodic motion to settle to
+        // or classify: each point runs exactly `transient + recorded` periods.
+        let periodic = base.is_periodic();
+        let options = PointOptions {
+            transient_periods: transient,
+            recorded_periods: recorded,
+            period_tolerance: self.period_tolerance,
+            floquet: self.floquet,
+            settle: if periodic {
+                self.settle.mode(self.settle_cap)
+            } else {
+                vibrotribo::study::SettleMode::Fixed
+            },
+            classify: periodic,
+            ..PointOptions::default()
+        };
+        Ok(PointRunner::new(base, options, self.mechanics_only))
+    }
+}
+
+/// Options of `vibrotribo merge`.
+#[derive(Debug, clap::Args)]
+pub struct MergeArgs {
+    /// Output directories of the shards of one sweep or map (`--shard I/N`).
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Where to write the merged files (a new or empty directory).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
