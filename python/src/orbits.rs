@@ -7,13 +7,14 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use vibrotribo::ChainState;
+use vibrotribo::branch::{BranchError, BranchOptions, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::nalgebra::Complex;
 use vibrotribo::orbits::{
     BifurcationKind, Branch, BranchEnd, BranchPoint, ContinuationOptions, OrbitError, PeriodicOrbit,
-    ShootingOptions, continue_orbit, find_periodic_orbit, periodic_orbit_from_transient,
+    ShootingOptions, find_periodic_orbit, periodic_orbit_from_transient,
 };
-use vibrotribo::{ChainParams, ChainState};
 
 use crate::config::{config_error, config_of};
 use crate::convert::{array1, array2};
@@ -282,7 +283,7 @@ fn branch_to_py<'py>(py: Python<'py>, b: &Branch, n: usize) -> PyResult<Bound<'p
 
 /// Continues a periodic orbit in a configuration key (see the Python `vibrotribo.continue_`).
 #[pyfunction]
-#[pyo3(signature = (config, param, start, stop, *, period = None, transient = 100, guess = None, max_points = None, doubling_depth = None, initial_step = None, max_step = None))]
+#[pyo3(signature = (config, param, start, stop, *, period = None, transient = None, guess = None, max_points = None, doubling_depth = None, initial_step = None, max_step = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn continue_<'py>(
     py: Python<'py>,
@@ -291,7 +292,7 @@ pub fn continue_<'py>(
     start: f64,
     stop: f64,
     period: Option<u32>,
-    transient: u32,
+    transient: Option<u32>,
     guess: Option<(Vec<f64>, Vec<f64>)>,
     max_points: Option<usize>,
     doubling_depth: Option<u32>,
@@ -302,33 +303,19 @@ pub fn continue_<'py>(
     base.check_uncoupled("continue_").map_err(config_error)?;
     base.check_periodic("continuation of periodic orbits")
         .map_err(config_error)?;
-    for v in [start, stop] {
-        base.with(&param, toml::Value::Float(v)).map_err(config_error)?;
-    }
-    let at_start = base
-        .with(&param, toml::Value::Float(start))
-        .map_err(config_error)?;
-    let d = ContinuationOptions::default();
-    let options = ContinuationOptions {
-        max_points: max_points.unwrap_or(d.max_points),
-        doubling_depth: doubling_depth.unwrap_or(d.doubling_depth),
-        initial_step: initial_step.unwrap_or(d.initial_step),
-        max_step: max_step.unwrap_or(d.max_step),
-        shooting: shooting(&base, None, None),
-        ..d
+    let d = BranchOptions::default();
+    let options = BranchOptions {
+        transient: transient.unwrap_or(d.transient),
+        period,
+        continuation: ContinuationOptions {
+            max_points: max_points.unwrap_or(d.continuation.max_points),
+            doubling_depth: doubling_depth.unwrap_or(d.continuation.doubling_depth),
+            initial_step: initial_step.unwrap_or(d.continuation.initial_step),
+            max_step: max_step.unwrap_or(d.continuation.max_step),
+            ..d.continuation
+        },
     };
     let n = base.chain().len();
-    // A value inside the range that makes an invalid chain gives a chain that fails its
-    // validation, so the corrector fails there and the branch ends.
-    let invalid = || ChainParams {
-        masses: vec![f64::NAN; n],
-        ..base.chain().clone()
-    };
-    let family = |v: f64| {
-        base.with(&param, toml::Value::Float(v))
-            .map_or_else(|_| invalid(), |c| c.chain().clone())
-    };
-    let chain = at_start.chain().clone();
     let guess = match guess {
         Some(g) => Some((
             state_of(g, n)?,
@@ -337,23 +324,12 @@ pub fn continue_<'py>(
         None => None,
     };
     let c = py
-        .detach(|| {
-            let (state, period) = match guess {
-                Some(g) => g,
-                None => {
-                    let o = periodic_orbit_from_transient(
-                        &chain,
-                        at_start.initial_state(),
-                        transient,
-                        period,
-                        &options.shooting,
-                    )?;
-                    (o.state, o.period)
-                }
-            };
-            continue_orbit(&param, family, start, stop, &state, period, &options)
-        })
-        .map_err(orbit_error)?;
+        .detach(|| continue_config(&base, &param, start, stop, guess, &options))
+        .map_err(|e| match e {
+            BranchError::Value { source, .. } => config_error(source),
+            BranchError::FirstOrbit { source, .. } | BranchError::Continuation(source) => orbit_error(source),
+            other => PyRuntimeError::new_err(other.to_string()),
+        })?;
     let out = PyDict::new(py);
     out.set_item("parameter", &c.parameter)?;
     let branches = PyList::empty(py);

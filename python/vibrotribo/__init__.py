@@ -258,15 +258,16 @@ def continue_(
     stop: float,
     *,
     period: Optional[int] = None,
-    transient: int = 100,
+    transient: Optional[int] = None,
     guess: Optional[tuple] = None,
     max_points: Optional[int] = None,
     doubling_depth: Optional[int] = None,
     initial_step: Optional[float] = None,
     max_step: Optional[float] = None,
 ) -> Continuation:
-    """Follows the periodic orbit found at ``param = start`` (as :func:`periodic` finds it)
-    to ``param = stop`` by pseudo-arclength continuation, locating folds, period doublings
+    """Follows the periodic orbit found at ``param = start`` (after ``transient`` periods
+    from the configured initial state, default 200, as ``vibrotribo continue`` finds it; or
+    near ``guess`` with ``period``) to ``param = stop`` by pseudo-arclength continuation, locating folds, period doublings
     (following the doubled branches to ``doubling_depth`` levels, default 3),
     Neimark–Sacker points, grazings and sticking onsets. ``param`` is any numeric
     configuration key or derived key. Steps are in scaled arclength (defaults: initial 0.02,

@@ -5,12 +5,12 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use serde_json::json;
+use vibrotribo::branch::{BranchOptions, config_family, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
-    Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions, ShootingOptions,
-    continue_orbit, periodic_orbit_from_transient,
+    Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
 };
 use vibrotribo::study::{Harvester, PointOptions, power_on_periodic_state};
 use vibrotribo::sweep::{PointRunner, grid};
@@ -40,13 +40,13 @@ pub struct ContinueArgs {
     #[arg(long)]
     pub period: Option<u32>,
     /// Periods simulated at `--from` from the configured initial state before shooting.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = BranchOptions::default().transient)]
     pub transient: u32,
     /// Period doublings followed onto the doubled branch (a cascade P → 2P → 4P … this deep).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = BranchOptions::default().continuation.doubling_depth)]
     pub doublings: u32,
     /// Most points per branch.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = BranchOptions::default().continuation.max_points)]
     pub max_points: usize,
     /// Mechanics only: no power along the branches.
     #[arg(long)]
@@ -87,44 +87,18 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     if mass == 0 || mass > config.chain().len() {
         bail!("--mass must be between 1 and {}", config.chain().len());
     }
-    let (lo, hi) = (args.from.min(args.to), args.from.max(args.to));
-    let at = |p: f64| -> Result<Config> {
-        crate::config::with(&config, &args.param, p).with_context(|| format!("{} = {p}", args.param))
+    let d = BranchOptions::default();
+    let options = BranchOptions {
+        transient: args.transient,
+        period: args.period,
+        continuation: ContinuationOptions {
+            doubling_depth: args.doublings,
+            max_points: args.max_points,
+            ..d.continuation
+        },
     };
-    // Both ends must make valid chains; the family stays between them.
-    let start = at(args.from)?;
-    at(args.to)?;
-    let base_chain = start.chain();
-    let family = |p: f64| -> ChainParams {
-        at(p.clamp(lo, hi)).map_or_else(|_| base_chain.clone(), |c| c.chain().clone())
-    };
-    let shooting = ShootingOptions {
-        sim: config.sim_options().clone(),
-        ..ShootingOptions::default()
-    };
-    let first = periodic_orbit_from_transient(
-        start.chain(),
-        start.initial_state(),
-        args.transient,
-        args.period,
-        &shooting,
-    )
-    .with_context(|| format!("no periodic orbit found at {} = {}", args.param, args.from))?;
-    let options = ContinuationOptions {
-        doubling_depth: args.doublings,
-        max_points: args.max_points,
-        shooting,
-        ..ContinuationOptions::default()
-    };
-    let result = continue_orbit(
-        &args.param,
-        family,
-        args.from,
-        args.to,
-        &first.state,
-        first.period,
-        &options,
-    )?;
+    let result = continue_config(&config, &args.param, args.from, args.to, None, &options)?;
+    let family = config_family(&config, &args.param);
     let power = if args.mechanics_only {
         None
     } else {

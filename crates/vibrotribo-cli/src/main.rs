@@ -11,6 +11,7 @@ mod job;
 mod limits;
 mod load_sweep;
 mod lyapunov;
+mod manifest;
 mod map;
 mod merge;
 mod output;

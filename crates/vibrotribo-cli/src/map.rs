@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
+use serde::Deserialize;
 use serde_json::json;
 use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 
@@ -13,9 +14,10 @@ use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::job::{
     MergeArgs, RunArgs, Shard, check_all, check_distinct, estimate_point_memory, estimate_point_output,
-    floquet_of, header_len, point_columns, run_points, set_threads,
+    header_len, point_columns, run_points, set_threads,
 };
 use crate::limits;
+use crate::manifest::{Axis, Kind, MapManifest, SettleRecord, ShardRecord, base_motion_of, to_value};
 use crate::output::{CsvFile, PointColumns, create_dir, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
@@ -148,22 +150,30 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     let columns = point_columns(runner.contacts(), runner.options().floquet, false);
     let o = runner.options();
-    let mut settings = json!({
-        "command": "map",
-        "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": args.x_steps, "values": xs},
-        "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": args.y_steps, "values": ys},
-        "transient_periods": o.transient_periods,
-        "recorded_periods": o.recorded_periods,
-        "period_tolerance": o.period_tolerance,
-        "mechanics_only": args.run.mechanics_only,
-        "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
-        "settings": runner.base().table(),
-    });
-    if o.floquet {
-        settings["floquet"] = json!(true);
-    }
-    crate::job::add_settle_settings(&mut settings, o);
-    crate::job::add_base_motion(&mut settings, runner.base());
+    let axis = |param: &str, from: f64, to: f64, steps: usize, values: &[f64]| Axis {
+        param: param.to_string(),
+        from,
+        to,
+        steps,
+        values: values.to_vec(),
+    };
+    let settings = to_value(&MapManifest {
+        command: Kind::Map,
+        x: axis(&args.x, args.x_from, args.x_to, args.x_steps, &xs),
+        y: axis(&args.y, args.y_from, args.y_to, args.y_steps, &ys),
+        transient_periods: o.transient_periods,
+        recorded_periods: o.recorded_periods,
+        period_tolerance: o.period_tolerance,
+        mechanics_only: args.run.mechanics_only,
+        shard: args.shard.map(|s| ShardRecord {
+            index: s.index,
+            count: s.count,
+        }),
+        settings: serde_json::to_value(runner.base().table()).context("the configuration as JSON")?,
+        floquet: o.floquet,
+        settle: SettleRecord::of(o),
+        base_motion: base_motion_of(runner.base()),
+    })?;
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -231,25 +241,15 @@ pub fn run(args: &MapArgs) -> Result<()> {
 /// Merges the shards of a map (`vibrotribo merge`).
 pub fn merge(args: &MergeArgs) -> Result<()> {
     // map.csv: x, y, then the point columns.
-    let floquet = floquet_of(&args.shards[0], "map.json")?;
+    let first: MapManifest = crate::manifest::read(&args.shards[0].join("map.json"))?;
     let columns = PointColumns::from_width(
         header_len(&args.shards[0].join("map.csv"))?.saturating_sub(2),
-        floquet,
+        first.floquet,
         false,
     );
     let keys = |m: &serde_json::Value| -> Result<Vec<String>> {
-        let axis = |a: &str| -> Result<Vec<f64>> {
-            m[a]["values"]
-                .as_array()
-                .ok_or_else(|| anyhow!("map.json lacks the {a} values"))?
-                .iter()
-                .map(|v| {
-                    v.as_f64()
-                        .ok_or_else(|| anyhow!("map.json: a {a} value is not a number"))
-                })
-                .collect()
-        };
-        Ok(map_points(&axis("x")?, &axis("y")?)
+        let m = MapManifest::deserialize(m).context("map.json")?;
+        Ok(map_points(&m.x.values, &m.y.values)
             .iter()
             .map(point_key)
             .collect())

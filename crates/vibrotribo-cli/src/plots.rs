@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use vibrotribo::analysis::{WelchOptions, welch_psd};
 
+use crate::manifest::{Kind, MapManifest, SweepManifest, kind_of, read};
 use crate::output::{CsvFile, column, numbers, read_csv, read_json, si};
 use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series, both};
 
@@ -21,34 +22,29 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
             dir.display()
         );
     }
-    if dir.join("sweep.json").exists() {
-        plot_sweep(dir)
-    } else if dir.join("map.json").exists() {
-        plot_map(dir)
-    } else if dir.join("basins.json").exists() {
-        crate::basins::finish(dir)?;
-        crate::basins::plot_basins(dir)
-    } else if dir.join("attractors.json").exists() {
-        crate::attractors::plot_attractors(dir)
-    } else if dir.join("chirp.json").exists() {
-        crate::chirp::plot_chirp(dir)
-    } else if dir.join("lyapunov.json").exists() {
-        crate::lyapunov::plot_lyapunov(dir)
-    } else if dir.join("summary.json").exists() && dir.join("trajectory.csv").exists() {
-        analyze_run(dir, psd_mass)
-    } else {
-        bail!(
+    match kind_of(dir)? {
+        Some(Kind::Sweep) => plot_sweep(dir),
+        Some(Kind::Map) => plot_map(dir),
+        Some(Kind::Basins) => {
+            crate::basins::finish(dir)?;
+            crate::basins::plot_basins(dir)
+        }
+        Some(Kind::Attractors) => crate::attractors::plot_attractors(dir),
+        Some(Kind::Chirp) => crate::chirp::plot_chirp(dir),
+        Some(Kind::Lyapunov) => crate::lyapunov::plot_lyapunov(dir),
+        Some(Kind::Simulate) => analyze_run(dir, psd_mass),
+        Some(Kind::Continue) | None => bail!(
             "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json, chirp.json, basins.json, attractors.json or lyapunov.json)",
             dir.display()
-        )
+        ),
     }
 }
 
 /// Orbit diagrams, impact-velocity diagrams and the summary curves of a sweep.
 pub fn plot_sweep(dir: &Path) -> Result<()> {
-    let settings = read_json(&dir.join("sweep.json"))?;
-    let param = settings["param"].as_str().unwrap_or("parameter").to_string();
-    let delta1 = settings["settings"]["oscillator"]["gaps"]
+    let m: SweepManifest = read(&dir.join("sweep.json"))?;
+    let param = m.param;
+    let delta1 = m.settings["oscillator"]["gaps"]
         .as_array()
         .and_then(|g| g.first())
         .and_then(|g| g.as_f64())
@@ -217,15 +213,9 @@ fn by_motion<'a>(motions: &[&str], x: &[f64], y: &[f64]) -> Vec<(&'a str, usize,
 
 /// Heat maps of a two-parameter map.
 pub fn plot_map(dir: &Path) -> Result<()> {
-    let settings = read_json(&dir.join("map.json"))?;
-    let (xk, yk) = (
-        settings["x"]["param"].as_str().unwrap_or("x").to_string(),
-        settings["y"]["param"].as_str().unwrap_or("y").to_string(),
-    );
-    let xs: Vec<f64> =
-        serde_json::from_value(settings["x"]["values"].clone()).context("map.json x values")?;
-    let ys: Vec<f64> =
-        serde_json::from_value(settings["y"]["values"].clone()).context("map.json y values")?;
+    let m: MapManifest = read(&dir.join("map.json"))?;
+    let (xk, yk) = (m.x.param, m.y.param);
+    let (xs, ys) = (m.x.values, m.y.values);
     let (h, rows) = read_csv(&dir.join("map.csv"))?;
     for (col, title, label, log) in [
         ("average_power_w", "Average power", "log10(P_a / W)", true),

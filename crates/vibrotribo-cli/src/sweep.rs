@@ -6,7 +6,8 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow, bail};
+use serde::Deserialize;
 use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::lyapunov::LyapunovOptions;
@@ -15,11 +16,11 @@ use vibrotribo::sweep::{Continuation, PointRunner, error_text, grid, run_continu
 
 use crate::config::ConfigArgs;
 use crate::job::{
-    CsvSpec, GridOutput, Layout, MergeArgs, RunArgs, Shard, add_base_motion, add_settle_settings, check_all,
-    check_distinct, estimate_point_memory, estimate_point_output, floquet_of, header_len, point_columns,
-    run_points, set_threads,
+    CsvSpec, GridOutput, Layout, MergeArgs, RunArgs, Shard, check_all, check_distinct, estimate_point_memory,
+    estimate_point_output, header_len, point_columns, run_points, set_threads,
 };
 use crate::limits;
+use crate::manifest::{Kind, SettleRecord, ShardRecord, SweepManifest, base_motion_of, to_value};
 use crate::output::{PointColumns, numbered};
 use crate::progress::{Interrupted, Progress, interrupted};
 
@@ -132,43 +133,40 @@ fn write_value(
     out.row(2, row)
 }
 
-/// The settings a sweep records in `sweep.json` (everything that determines its output).
-fn settings_json(
+/// The manifest `sweep.json` of a sweep (everything that determines its output).
+fn manifest(
     args: &SweepArgs,
     runner: &PointRunner,
     values: &[f64],
     shard: Option<Shard>,
-) -> serde_json::Value {
+) -> Result<SweepManifest> {
     let o = runner.options();
-    let mut settings = json!({
-        "command": "sweep",
-        "param": args.param,
-        "from": args.from,
-        "to": args.to,
-        "steps": args.steps,
-        "values": values,
-        "continuation": args.continuation,
-        "transient_periods": o.transient_periods,
-        "recorded_periods": o.recorded_periods,
-        "period_tolerance": o.period_tolerance,
-        "max_period_detected": o.period_options().max_period,
-        "grazing_ratio": o.grazing_ratio,
-        "electrical_warmup_periods": o.electrical_warmup_periods,
-        "mechanics_only": args.run.mechanics_only,
-        "shard": shard.map(|s| json!({"index": s.index, "count": s.count})),
-        "settings": runner.base().table(),
-        "vibrotribo_version": env!("CARGO_PKG_VERSION"),
-    });
-    if o.floquet {
-        settings["floquet"] = json!(true);
-    }
-    add_settle_settings(&mut settings, o);
-    add_base_motion(&mut settings, runner.base());
-    if args.lyapunov {
-        // Only with the option, so that other sweeps' manifests stay as they were.
-        settings["lyapunov"] = json!(true);
-    }
-    settings
+    Ok(SweepManifest {
+        command: Kind::Sweep,
+        param: args.param.clone(),
+        from: args.from,
+        to: args.to,
+        steps: args.steps,
+        values: values.to_vec(),
+        continuation: args.continuation,
+        transient_periods: o.transient_periods,
+        recorded_periods: o.recorded_periods,
+        period_tolerance: o.period_tolerance,
+        max_period_detected: o.period_options().max_period,
+        grazing_ratio: o.grazing_ratio,
+        electrical_warmup_periods: o.electrical_warmup_periods,
+        mechanics_only: args.run.mechanics_only,
+        shard: shard.map(|s| ShardRecord {
+            index: s.index,
+            count: s.count,
+        }),
+        settings: serde_json::to_value(runner.base().table()).context("the configuration as JSON")?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        floquet: o.floquet,
+        settle: SettleRecord::of(o),
+        base_motion: base_motion_of(runner.base()),
+        lyapunov: args.lyapunov,
+    })
 }
 
 /// Runs `vibrotribo sweep`.
@@ -236,7 +234,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         )?;
     }
     let keys: Vec<String> = order.iter().map(|&j| values[j].to_string()).collect();
-    let settings = settings_json(args, &runner, &values, args.shard);
+    let settings = to_value(&manifest(args, &runner, &values, args.shard)?)?;
     let continued = args.continuation != Continuation::None;
     let mut state: Option<ChainState> = None;
     let (mut out, skip) = match &args.out {
@@ -366,16 +364,8 @@ pub fn run(args: &SweepArgs) -> Result<()> {
 
 /// The keys (`param` values as written) of a sweep's grid from its `sweep.json`.
 fn sweep_keys(settings: &serde_json::Value) -> Result<Vec<String>> {
-    settings["values"]
-        .as_array()
-        .ok_or_else(|| anyhow!("sweep.json lacks the values"))?
-        .iter()
-        .map(|v| {
-            v.as_f64()
-                .map(|x| x.to_string())
-                .ok_or_else(|| anyhow!("sweep.json: a value is not a number"))
-        })
-        .collect()
+    let m = SweepManifest::deserialize(settings).context("sweep.json")?;
+    Ok(m.values.iter().map(f64::to_string).collect())
 }
 
 /// Combines the shards of one sweep (`vibrotribo merge` of `sweep.json` directories).
@@ -383,13 +373,12 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let first = &args.shards[0];
     // orbit.csv: param, period, x1_m, …, xN_m.
     let masses = header_len(&first.join("orbit.csv"))?.saturating_sub(2);
-    let floquet = floquet_of(first, "sweep.json")?;
-    let lyapunov = crate::output::read_json(&first.join("sweep.json"))?["lyapunov"] == json!(true);
+    let m: SweepManifest = crate::manifest::read(&first.join("sweep.json"))?;
     // summary.csv: param, then the point columns.
     let columns = PointColumns::from_width(
         header_len(&first.join("summary.csv"))?.saturating_sub(1),
-        floquet,
-        lyapunov,
+        m.floquet,
+        m.lyapunov,
     );
     crate::job::merge(
         &args.shards,

@@ -42,6 +42,8 @@
 pub mod analysis;
 pub mod attractors;
 #[cfg(feature = "config")]
+pub mod branch;
+#[cfg(feature = "config")]
 pub mod config;
 pub mod coupling;
 pub mod dynamics;

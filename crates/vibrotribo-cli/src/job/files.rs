@@ -1,11 +1,8 @@
-//! What a grid job's manifest and files record: the point columns, the settling and base
-//! motion written into a manifest, and what a finished directory's files say about its job.
+//! What a grid job's files hold: the point columns, and the width of a finished file.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use serde_json::json;
-use vibrotribo::study::{PointOptions, SettleMode};
 
 use crate::output::PointColumns;
 
@@ -17,30 +14,6 @@ pub fn point_columns(contacts: usize, floquet: bool, lyapunov: bool) -> PointCol
         floquet,
         lyapunov,
     }
-}
-
-/// Records the base motion of `config` in a manifest (`base_motion`, when it is not the
-/// chain's own harmonic: kind, how it was run, spline accuracy, record scaling).
-pub fn add_base_motion(settings: &mut serde_json::Value, config: &vibrotribo::config::Config) {
-    if let Some(b) = vibrotribo::report::base_motion_json(config, &config.run_spec(true)) {
-        settings["base_motion"] = b;
-    }
-}
-
-/// Records the settling of `options` in a manifest (`sweep.json`, `map.json`): `settle`
-/// (`auto` or `fixed`), and for `auto` `settle_cap_periods` and `settle_block_periods`.
-pub fn add_settle_settings(settings: &mut serde_json::Value, options: &PointOptions) {
-    settings["settle"] = json!(options.settle.as_str());
-    if let SettleMode::Auto(a) = &options.settle {
-        settings["settle_cap_periods"] = json!(a.cap_periods);
-        settings["settle_block_periods"] = json!(a.block);
-        settings["settle_newton"] = json!(a.shoot);
-    }
-}
-
-/// Whether the job in `dir` (manifest `manifest`) has the Floquet column.
-pub fn floquet_of(dir: &Path, manifest: &str) -> Result<bool> {
-    Ok(crate::output::read_json(&dir.join(manifest))?["floquet"].as_bool() == Some(true))
 }
 
 /// The number of columns of the CSV file `path` (from its header).

@@ -8,7 +8,7 @@ mod grid;
 mod run;
 
 pub use args::{MergeArgs, RunArgs, SETTLE_CAP, Settle, Shard};
-pub use files::{add_base_motion, add_settle_settings, floquet_of, header_len, point_columns};
+pub use files::{header_len, point_columns};
 pub use grid::{CHECKPOINT, CsvSpec, GridOutput, Layout, merge, read_checkpoint};
 pub use run::{
     check_all, check_distinct, estimate_point_memory, estimate_point_output, run_chunked, run_points,

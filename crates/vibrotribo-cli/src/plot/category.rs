@@ -4,7 +4,8 @@
 
 use super::figure::{Figure, Format};
 use super::heat::MISSING;
-use super::xy::{LABEL_PX, PALETTE, Render, TICK_PX, err, font, tick_label, titled, write};
+use super::style::{LABEL_PX, PALETTE, TICK_PX, err, font, tick_label, titled};
+use super::xy::{Render, write};
 use anyhow::{Result, ensure};
 use plotters::coord::Shift;
 use plotters::prelude::*;

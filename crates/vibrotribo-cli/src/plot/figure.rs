@@ -1,25 +1,8 @@
-//! The figures: their description (title, axes, scales, legend), the data series, and the
-//! four kinds of plot.
+//! The figures: their description (title, axes, scales, legend, output format), the data
+//! series and the heat-map grid.
 
-use super::xy::{HeatChart, Layers, finite_bounds, widen, write, xy_chart};
-use anyhow::{Result, anyhow, bail, ensure};
-use plotters::style::{FontStyle, register_font};
+use anyhow::{Result, bail};
 use std::path::Path;
-use std::sync::OnceLock;
-
-/// DejaVu Sans, embedded (see `assets/DejaVuSans-LICENSE`).
-pub(super) static FONT_DATA: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
-
-/// The font family every text element asks for; the embedded font is registered under it.
-pub(super) const FAMILY: &str = "sans-serif";
-
-/// Registers the embedded font once per process.
-pub(super) fn ensure_font() -> Result<()> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT_DATA).is_ok());
-    ensure!(ok, "the embedded plot font could not be loaded");
-    Ok(())
-}
 
 /// Output format, from the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -162,62 +145,6 @@ impl<'a> Series<'a> {
     }
 }
 
-/// Lines (solid or dashed) with marks of `marker_px` pixels on top, each series in its
-/// colour: e.g. branches of periodic orbits over an orbit diagram.
-pub fn lines_and_points(
-    path: &Path,
-    figure: &Figure,
-    lines: &[Series<'_>],
-    points: &[Series<'_>],
-    marker_px: u32,
-) -> Result<()> {
-    let layers = Layers {
-        lines,
-        points,
-        marker_px,
-    };
-    write(path, figure.size, &xy_chart(figure, layers)?)
-}
-
-/// Lines through each series, one colour per series.
-pub fn line_plot(path: &Path, figure: &Figure, series: &[Series<'_>]) -> Result<()> {
-    let layers = Layers {
-        lines: series,
-        points: &[],
-        marker_px: 1,
-    };
-    write(path, figure.size, &xy_chart(figure, layers)?)
-}
-
-/// Each series as points of `marker_px` pixels (1 = single pixels, the usual choice for
-/// orbit diagrams), one colour per series. Fast for millions of points: each occupied pixel
-/// is drawn once.
-pub fn scatter_plot(path: &Path, figure: &Figure, series: &[Series<'_>], marker_px: u32) -> Result<()> {
-    let layers = Layers {
-        lines: &[],
-        points: series,
-        marker_px,
-    };
-    write(path, figure.size, &xy_chart(figure, layers)?)
-}
-
-/// Phase portrait: each trajectory (x = position, y = velocity) as a line, and the
-/// Poincaré `section` points (if any) as black 5-pixel marks on top.
-pub fn phase_portrait(
-    path: &Path,
-    figure: &Figure,
-    trajectories: &[Series<'_>],
-    section: Option<Series<'_>>,
-) -> Result<()> {
-    let points: Vec<Series<'_>> = section.into_iter().collect();
-    let layers = Layers {
-        lines: trajectories,
-        points: &points,
-        marker_px: 5,
-    };
-    write(path, figure.size, &xy_chart(figure, layers)?)
-}
-
 /// Values on a regular grid of `nx × ny` cells covering `[x_edges.0, x_edges.1] ×
 /// [y_edges.0, y_edges.1]`. Non-finite values are drawn grey.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -268,50 +195,4 @@ impl<'a> HeatMap<'a> {
             colour_range: None,
         }
     }
-}
-
-/// A heat map of `map` with a colour bar on the right.
-pub fn heat_map(path: &Path, figure: &Figure, map: &HeatMap<'_>) -> Result<()> {
-    ensure!(
-        map.nx > 0 && map.ny > 0,
-        "heat map grid is empty ({} × {} cells)",
-        map.nx,
-        map.ny
-    );
-    ensure!(
-        map.values.len() == map.nx * map.ny,
-        "heat map has {} values for {} × {} cells",
-        map.values.len(),
-        map.nx,
-        map.ny
-    );
-    for (name, (a, b)) in [("x", map.x_edges), ("y", map.y_edges)] {
-        ensure!(
-            a.is_finite() && b.is_finite() && a < b,
-            "heat map {name} edges must be finite and increasing, got {a} to {b}"
-        );
-    }
-    let (lo, hi) = match map.colour_range {
-        Some((lo, hi)) => {
-            ensure!(
-                lo.is_finite() && hi.is_finite() && lo < hi,
-                "colour range must be finite and increasing, got {lo} to {hi}"
-            );
-            (lo, hi)
-        }
-        None => {
-            let (lo, hi) = finite_bounds(map.values.iter().copied())
-                .ok_or_else(|| anyhow!("heat map has no finite value to colour"))?;
-            widen(lo, hi)
-        }
-    };
-    write(
-        path,
-        figure.size,
-        &HeatChart {
-            figure,
-            map,
-            range: (lo, hi),
-        },
-    )
 }

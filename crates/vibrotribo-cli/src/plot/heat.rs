@@ -1,7 +1,7 @@
 //! Heat maps: the viridis colour scale and the grid with its colour bar.
 
 use super::figure::{Figure, HeatMap};
-use super::xy::{LABEL_PX, TICK_PX, err, font, tick_label, titled};
+use super::style::{LABEL_PX, TICK_PX, err, font, tick_label, titled};
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -19,16 +19,16 @@
 //! name the font family `sans-serif` and leave the glyphs to the viewer.
 
 mod category;
+mod draw;
 mod figure;
 mod files;
 mod heat;
+mod style;
 #[cfg(test)]
 mod tests;
 mod xy;
 
 pub use category::{Bands, CategoryMap, category_map, stacked_bands};
-pub use figure::{
-    Figure, HeatMap, Legend, Scale, Series, heat_map, line_plot, lines_and_points, phase_portrait,
-    scatter_plot,
-};
+pub use draw::{heat_map, line_plot, lines_and_points, phase_portrait, scatter_plot};
+pub use figure::{Figure, HeatMap, Legend, Scale, Series};
 pub use files::both;

@@ -1,10 +1,9 @@
 //! Tests of the plots.
 
-use super::figure::{
-    Figure, Format, HeatMap, Legend, Scale, Series, ensure_font, heat_map, line_plot, phase_portrait,
-    scatter_plot,
-};
-use super::xy::{Layers, clip_polyline, draw_xy, tick_label, xy_chart};
+use super::draw::{heat_map, line_plot, phase_portrait, scatter_plot};
+use super::figure::{Figure, Format, HeatMap, Legend, Scale, Series};
+use super::style::{ensure_font, tick_label};
+use super::xy::{Layers, clip_polyline, draw_xy, xy_chart};
 use plotters::prelude::*;
 use std::f64::consts::TAU;
 use std::path::Path;

@@ -1,8 +1,11 @@
-//! Rendering: the font, the PNG and SVG backends, axis ranges and ticks, and x–y charts
-//! (lines, rasterised points, clipping).
+//! Rendering: the PNG and SVG backends, axis ranges and ticks, and x–y charts (lines,
+//! rasterised points, clipping).
 
-use super::figure::{FAMILY, Figure, Format, HeatMap, Legend, Scale, Series, ensure_font};
+use super::figure::{Figure, Format, HeatMap, Legend, Scale, Series};
 use super::heat::draw_heat_map;
+use super::style::{
+    LABEL_PX, PALETTE, TICK_PX, ensure_font, err, finite_bounds, font, tick_label, titled, widen,
+};
 use anyhow::{Context, Result, anyhow, ensure};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
@@ -21,28 +24,6 @@ impl Layers<'_, '_> {
     fn all(&self) -> impl Iterator<Item = &Series<'_>> {
         self.lines.iter().chain(self.points)
     }
-}
-
-/// Line colours: the Tableau 10 palette, distinguishable and colour-blind aware.
-pub(super) const PALETTE: [RGBColor; 10] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-];
-
-pub(super) const TITLE_PX: u32 = 28;
-pub(super) const LABEL_PX: u32 = 22;
-pub(super) const TICK_PX: u32 = 17;
-
-pub(super) fn font(px: u32) -> TextStyle<'static> {
-    (FAMILY, px).into_font().color(&BLACK)
 }
 
 /// Something that can draw itself on any plotters backend.
@@ -103,29 +84,6 @@ pub(super) fn write(path: &Path, size: (u32, u32), chart: &impl Render) -> Resul
     Ok(())
 }
 
-/// Maps a plotters error (whose backend error need not be `Send`) to `anyhow`.
-pub(super) fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
-    anyhow!("plotting failed: {e}")
-}
-
-/// Smallest and largest finite value, if any.
-pub(super) fn finite_bounds(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    values.filter(|v| v.is_finite()).fold(None, |acc, v| match acc {
-        None => Some((v, v)),
-        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
-    })
-}
-
-/// Gives an empty range some width.
-pub(super) fn widen(lo: f64, hi: f64) -> (f64, f64) {
-    if hi > lo {
-        (lo, hi)
-    } else {
-        let d = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
-        (lo - d, hi + d)
-    }
-}
-
 /// The axis range: as given, or the data's range with 3 % margins (on a log axis, a factor
 /// margin over the positive values).
 pub(super) fn axis_range(
@@ -160,34 +118,6 @@ pub(super) fn axis_range(
             let m = (hi / lo).powf(0.03);
             Ok(lo / m..hi * m)
         }
-    }
-}
-
-/// Fills `root` white and sets the title in a band at its top; returns the area below.
-pub(super) fn titled<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    title: &str,
-) -> Result<DrawingArea<DB, Shift>> {
-    root.fill(&WHITE).map_err(err)?;
-    root.margin(10, 0, 0, 0)
-        .titled(title, font(TITLE_PX))
-        .map_err(err)
-}
-
-/// Compact tick label: plain decimals for moderate magnitudes, else scientific notation.
-pub(super) fn tick_label(v: f64) -> String {
-    let a = v.abs();
-    if v == 0.0 {
-        "0".to_string()
-    } else if (1e-3..1e5).contains(&a) {
-        let s = format!("{v:.6}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" { "0".to_string() } else { s.to_string() }
-    } else {
-        let s = format!("{v:.3e}");
-        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
-        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
-        format!("{mantissa}e{exponent}")
     }
 }
 

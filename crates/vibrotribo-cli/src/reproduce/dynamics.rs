@@ -167,10 +167,10 @@ fn chatter_range(ctx: &mut Ctx) -> Result<()> {
     })?;
     let mut chaotic = Vec::new();
     let mut largest = f64::NEG_INFINITY;
-    let mut chatter = 0;
+    let mut chatters = Vec::with_capacity(values.len());
     for (r, v) in results.into_iter().zip(&values) {
         let r = r.with_context(|| format!("omega_ratio = {v}"))?;
-        chatter += usize::from(r.chatter);
+        chatters.push(r.chatter);
         let s = match r.lyapunov {
             Some(Ok(s)) => s,
             Some(Err(e)) => bail!("omega_ratio = {v}: {e}"),
@@ -185,8 +185,9 @@ fn chatter_range(ctx: &mut Ctx) -> Result<()> {
         "20 (exponents)",
         "Chatter at low Ω: many consecutive impacts per period, a band of points in Fig. 20's orbit diagram.",
         format!(
-            "Largest Lyapunov exponent at {} values of Ω in [0.30, 0.65] (chatter at {chatter} of them): chaotic at {}; the largest λ1 is {largest:+.4} 1/s. Chatter that ends in sticking collapses two directions (λ = −∞): the band of Fig. 20 is {}.",
+            "Largest Lyapunov exponent at {} values of Ω in [0.30, 0.65] (chatter at {} of them): chaotic at {}; the largest λ1 is {largest:+.4} 1/s. Chatter that ends in sticking collapses two directions (λ = −∞): the band of Fig. 20 is {}.",
             values.len(),
+            chatters.iter().filter(|&&c| c).count(),
             if chaotic.is_empty() { "none".to_string() } else { chaotic.join(", ") },
             if chaotic.is_empty() {
                 "periodic chatter orbits (many impacts per period), not chaos"
@@ -194,7 +195,7 @@ fn chatter_range(ctx: &mut Ctx) -> Result<()> {
                 "periodic chatter orbits except where chaotic"
             }
         ),
-        Verdict::Agrees,
+        chatter_verdict(&chatters),
     );
     Ok(())
 }
@@ -443,15 +444,12 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
             ("expected + 2 SE", &omega, &hi),
         ],
     )?;
+    let matters = start_matters(&expected, &se, &from_rest);
     let differ: Vec<String> = omega
         .iter()
-        .zip(expected.iter().zip(&se))
-        .zip(&from_rest)
-        .filter(|((_, (p, e)), r)| {
-            let d = (*r - *p).abs();
-            d > 2.0 * **e && d > 0.01 * p.abs()
-        })
-        .map(|((w, _), _)| format!("{w:.3}"))
+        .zip(&matters)
+        .filter(|(_, m)| **m)
+        .map(|(w, _)| format!("{w:.3}"))
         .collect();
     ctx.finding(
         "20, 23 (expected power)",
@@ -460,7 +458,7 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
             "{samples} random starts per value at {steps} values of Ω in [0.55, 0.80]: the expected power of an unknown start differs from the power from rest by more than two standard errors and 1 % at Ω = {}; elsewhere the start does not matter within that.",
             if differ.is_empty() { "none".to_string() } else { differ.join(", ") }
         ),
-        Verdict::Agrees,
+        one_start_verdict(&matters),
     );
     ctx.figure(
         "20 (expected power)",
@@ -471,6 +469,34 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
         vec![img, "attractors_fig20/attractor_fractions.png".into()],
     );
     Ok(())
+}
+
+/// Whether the chatter of Fig. 20 sits at low Ω, as the paper says, from whether each value
+/// of an increasing Ω grid chattered: chatter at every value of the grid's lower half
+/// agrees, at some of them partly, at none differs.
+fn chatter_verdict(chatters: &[bool]) -> Verdict {
+    let low = &chatters[..chatters.len().div_ceil(2)];
+    Verdict::of(low.iter().filter(|&&c| c).count(), low.len())
+}
+
+/// At each value, whether the start matters: the expected power of a random start differs
+/// from the power from rest by more than two standard errors and 1 %.
+fn start_matters(expected: &[f64], se: &[f64], from_rest: &[f64]) -> Vec<bool> {
+    expected
+        .iter()
+        .zip(se)
+        .zip(from_rest)
+        .map(|((p, e), r)| {
+            let d = (r - p).abs();
+            d > 2.0 * e && d > 0.01 * p.abs()
+        })
+        .collect()
+}
+
+/// How far the paper's power from one start (rest) stands for the power of any start: at
+/// every value where the start does not matter it agrees, at none it differs.
+fn one_start_verdict(matters: &[bool]) -> Verdict {
+    Verdict::of(matters.iter().filter(|&&m| !m).count(), matters.len())
 }
 
 /// Ω, the expected power and its standard error from `expected_power.csv`.
@@ -493,4 +519,44 @@ fn read_expected(path: &Path) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
         rows.iter().map(|r| num(r, e)).collect(),
         rows.iter().map(|r| num(r, s)).collect(),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chatter_verdict_follows_the_low_omega_values() {
+        // No chatter anywhere contradicts "chatter at low Ω".
+        assert_eq!(chatter_verdict(&[false; 6]), Verdict::Differs);
+        // Chatter only at high Ω: the lower half has none.
+        assert_eq!(
+            chatter_verdict(&[false, false, false, true, true, true]),
+            Verdict::Differs
+        );
+        assert_eq!(
+            chatter_verdict(&[true, false, false, true, true, true]),
+            Verdict::Partly
+        );
+        assert_eq!(
+            chatter_verdict(&[true, true, true, false, false, false]),
+            Verdict::Agrees
+        );
+    }
+
+    #[test]
+    fn one_start_verdict_counts_the_values_where_the_start_matters() {
+        // Expected power 1 ± 0.01 W: from rest 0.5 W is far off, 1.001 W within the error.
+        let expected = [1.0, 1.0, 1.0];
+        let se = [0.01, 0.01, 0.01];
+        let matters = start_matters(&expected, &se, &[0.5, 0.5, 0.5]);
+        assert_eq!(matters, [true, true, true]);
+        assert_eq!(one_start_verdict(&matters), Verdict::Differs);
+        let matters = start_matters(&expected, &se, &[1.001, 0.5, 1.001]);
+        assert_eq!(one_start_verdict(&matters), Verdict::Partly);
+        let matters = start_matters(&expected, &se, &[1.001, 0.999, 1.0]);
+        assert_eq!(one_start_verdict(&matters), Verdict::Agrees);
+        // A difference beyond two errors but within 1 % does not count.
+        assert_eq!(start_matters(&[1.0], &[0.001], &[1.005]), [false]);
+    }
 }

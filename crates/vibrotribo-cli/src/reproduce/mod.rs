@@ -20,6 +20,8 @@ mod orbits;
 mod report;
 mod runs;
 mod spacing;
+#[cfg(test)]
+mod tests;
 mod vibration;
 
 pub use command::{ReproduceArgs, run};
