@@ -40,8 +40,8 @@ def test_python_and_cli_continue_give_the_same_branch(cli, tmp_path):
             assert_bits(pts["v"][:, k], numbers(cols[f"v{k + 1}_m_s"])[rows], f"{what} v{k + 1}")
         stable = np.array([s == "true" for s in np.array(cols["stable"])[rows]])
         assert (np.asarray(pts["stable"], dtype=bool) == stable).all(), f"{what}: stability differs"
-        sticks = numbers(cols["sticks"])[rows]
-        assert (np.asarray(pts["sticks"], dtype=np.float64) == sticks).all(), f"{what}: sticks differ"
+        sticks = np.array([s == "true" for s in np.array(cols["sticks"])[rows]])
+        assert (np.asarray(pts["sticks"], dtype=bool) == sticks).all(), f"{what}: sticking differs"
         assert b.period == int(numbers(cols["period"])[rows][0]), f"{what}: period differs"
     _, bif = read_csv(out / "bifurcations.csv")
     got = [(b["branch"], b["parameter"]) for b in c.bifurcations]

@@ -401,7 +401,8 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         &dir.join("poincare_impacts.csv"),
         &["time_s", "phase", "contact", "rel_velocity_m_s"],
     )?;
-    let mut per_contact: Vec<(Vec<f64>, Vec<f64>)> = vec![(vec![], vec![]); masses - 1];
+    // Contacts 1 … N − 1 between the masses, N the lower stop, N + 1 the upper stop.
+    let mut per_contact: Vec<(Vec<f64>, Vec<f64>)> = vec![(vec![], vec![]); masses + 1];
     for r in erows.iter().filter(|r| r[kc] == "impact") {
         let te: f64 = r[tc].parse().unwrap_or(f64::NAN);
         if te < transient {
@@ -417,11 +418,20 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         }
     }
     csv.flush()?;
-    let names: Vec<String> = (1..masses).map(|k| format!("V{}{}", k, k + 1)).collect();
+    let names: Vec<String> = (1..=masses + 1)
+        .map(|k| match k {
+            k if k < masses => format!("V{}{}", k, k + 1),
+            k if k == masses => format!("V{masses} (lower stop)"),
+            _ => "V1 (upper stop)".to_string(),
+        })
+        .collect();
+    // Every contact between masses; a stop's only where it was hit.
     let series: Vec<Series> = per_contact
         .iter()
         .zip(&names)
-        .map(|((p, v), n)| Series::new(n, p, v))
+        .enumerate()
+        .filter(|(k, ((p, _), _))| *k + 1 < masses || !p.is_empty())
+        .map(|(_, ((p, v), n))| Series::new(n, p, v))
         .collect();
     both(dir, "poincare_impacts", |path| {
         plot::scatter_plot(
