@@ -121,9 +121,9 @@ def sweep(
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = None,
-    period_tolerance: float = 1e-4,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
     settle: str = "auto",
-    settle_cap: int = 2000,
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
 ) -> Sweep:
     """A one-parameter sweep: the configuration with ``param`` set to each of ``values``,
     simulated for ``transient`` periods (default ``run.transient_periods``) and then
@@ -172,9 +172,9 @@ def map(  # noqa: A001 - the command's name
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = None,
-    period_tolerance: float = 1e-4,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
     settle: str = "auto",
-    settle_cap: int = 2000,
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
 ) -> Map:
     """A two-parameter map: every point (x, y) of the grid (y outer, x inner), each run as a
     sweep point (see :func:`sweep`); its ``summary`` is ``vibrotribo map``'s ``map.csv``."""

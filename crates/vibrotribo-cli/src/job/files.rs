@@ -6,8 +6,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde_json::json;
 use vibrotribo::study::{PointOptions, SettleMode};
-
-use crate::output::PointColumns;
+use vibrotribo::sweep::PointColumns;
 
 /// The point columns of a chain with `contacts` contacts
 /// ([`ChainParams::contact_count`](vibrotribo::ChainParams::contact_count)).
