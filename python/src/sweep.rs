@@ -10,8 +10,8 @@ use pyo3::types::PyDict;
 use vibrotribo::config::Config;
 use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, SettleMode};
 use vibrotribo::sweep::{
-    Continuation, Delivery, PointColumns, PointRequest, PointRequestError, PointRunner, SweepColumns, run_continued,
-    run_grid_on,
+    Continuation, Delivery, PointColumns, PointRequest, PointRequestError, PointRunner, SweepColumns,
+    run_continued, run_grid_on,
 };
 
 use crate::config::{config_error, config_of, table_to_dict};

@@ -209,7 +209,9 @@ def load_sweep(
     (Ω; default ``steps`` log-spaced from ``low`` to ``high``, as ``vibrotribo load-sweep``)
     solved along it, the optimum refined, the power at the configured load, and the V–Q
     cycles of the last period at the configured and optimal loads (``vq_points`` points;
-    None for none). Returns a :class:`LoadSweep` equal to the command's files."""
+    None for none). Under ``harvester.coupling = "two_way"`` every load is a whole coupled
+    run instead (the power at a load is what :func:`simulate` reports with it). Returns a
+    :class:`LoadSweep` equal to the command's files."""
     raw = _vibrotribo.load_sweep(
         _config(config),
         resistances=None if resistances is None else _values(resistances, "resistances"),

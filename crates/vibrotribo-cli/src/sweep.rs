@@ -12,8 +12,8 @@ use vibrotribo::ChainState;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
 use vibrotribo::sweep::{
-    Cell, Continuation, IMPACT_COLUMNS, PointColumns, PointRunner, SweepError, grid, impact_rows, orbit_columns,
-    orbit_rows, run_continued,
+    Cell, Continuation, IMPACT_COLUMNS, PointColumns, PointRunner, SweepError, grid, impact_rows,
+    orbit_columns, orbit_rows, run_continued,
 };
 
 use crate::config::ConfigArgs;
@@ -32,7 +32,8 @@ pub struct SweepArgs {
     pub input: ConfigArgs,
     /// The swept parameter: a configuration key (`excitation.omega_ratio`,
     /// `oscillator.gaps[1]`, `harvester.load_resistance`, …) or a derived one (`mass_ratio`,
-    /// `gap_ratio`, `gap`, `omega_ratio`, `restitution`, …).
+    /// `gap_ratio`, `gap`, `omega_ratio`, `restitution`, …); an integer key
+    /// (`excitation.seed`) takes whole values.
     #[arg(long)]
     pub param: String,
     /// First value.

@@ -51,11 +51,17 @@ fn typed_parameters_equal_the_toml_path() {
             assert_eq!(typed, tree, "{key} = {value}");
         }
         // Two keys in order, as a map's point sets them.
-        let (x, y) = (Param::new(base, "omega_ratio").unwrap(), Param::new(base, "mass_ratio").unwrap());
+        let (x, y) = (
+            Param::new(base, "omega_ratio").unwrap(),
+            Param::new(base, "mass_ratio").unwrap(),
+        );
         let typed = base.with_values(&[(&x, 0.75), (&y, 2.0)]).unwrap();
         let mut tree = base.clone();
-        tree.set_all([("omega_ratio", Value::Float(0.75)), ("mass_ratio", Value::Float(2.0))])
-            .unwrap();
+        tree.set_all([
+            ("omega_ratio", Value::Float(0.75)),
+            ("mass_ratio", Value::Float(2.0)),
+        ])
+        .unwrap();
         assert_eq!(typed, tree);
         // A bad value is the same error either way.
         let param = Param::new(base, "oscillator.masses[1]").unwrap();

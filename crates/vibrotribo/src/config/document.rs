@@ -7,8 +7,8 @@ use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
 use super::error::ConfigError;
-use super::param::Param;
 use super::keys::{self, PerMass};
+use super::param::Param;
 use crate::electrical::{ChargeOptions, HarvesterParams, TransducerMode};
 use crate::excitation::{BaseMotion, ExcitationKind, ExcitationSpec, Harmonic, Quantity, Sweep};
 use crate::model::{ChainParams, ChainState, Excitation, Frequency, SimOptions, Stops};
@@ -241,7 +241,11 @@ impl Config {
     /// The configuration of the document `doc` read from `table`: the chain, the initial
     /// state and the base motion derived, everything validated (see
     /// [`read_table`](Self::read_table) for `previous`).
-    pub(super) fn resolve(table: Table, doc: Document, previous: Option<&Config>) -> Result<Self, ConfigError> {
+    pub(super) fn resolve(
+        table: Table,
+        doc: Document,
+        previous: Option<&Config>,
+    ) -> Result<Self, ConfigError> {
         let chain = chain_of(&doc).map_err(|e| e.renamed(keys::chain_key))?;
         let mut harvester = doc.harvester.clone().unwrap_or_default();
         let mode_given = table.get("harvester").and_then(|h| h.get("mode")).is_some();

@@ -312,7 +312,8 @@ pub(super) fn excitation_of(
             // Build once to report a record that cannot be scaled or integrated now (done
             // already if the record was read before with the same quantity and scaling).
             if !before.is_some_and(|r| r.quantity == quantity && r.scaling == scaling) {
-                record_displacement(&samples, quantity, scaling).map_err(|e| conflict("file", e.to_string()))?;
+                record_displacement(&samples, quantity, scaling)
+                    .map_err(|e| conflict("file", e.to_string()))?;
             }
             ExcitationSpec::Record(RecordSpec {
                 samples,

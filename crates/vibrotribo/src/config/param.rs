@@ -193,7 +193,9 @@ impl Param {
                     Array::Forces => chain.forces,
                 };
                 let len = values.len();
-                let slot = values.get_mut(i).ok_or_else(|| out_of_range(&self.key, array, i, len))?;
+                let slot = values
+                    .get_mut(i)
+                    .ok_or_else(|| out_of_range(&self.key, array, i, len))?;
                 *slot = value;
                 set_array(doc, table, array, values)
             }
@@ -226,7 +228,11 @@ fn element(key: &str, config: &Config) -> Result<Option<Target>, ConfigError> {
         return Ok(None);
     };
     let n = config.chain().len();
-    let len = if array == Array::Gaps { n.saturating_sub(1) } else { n };
+    let len = if array == Array::Gaps {
+        n.saturating_sub(1)
+    } else {
+        n
+    };
     if i >= len {
         return Err(out_of_range(key, array, i, len));
     }
@@ -252,7 +258,12 @@ fn section_mut<'a>(table: &'a mut Table, section: &str) -> Result<&'a mut Table,
 }
 
 /// Sets the `[oscillator]` array `array` to `values` in the document and the tree.
-fn set_array(doc: &mut Document, table: &mut Table, array: Array, values: Vec<f64>) -> Result<(), ConfigError> {
+fn set_array(
+    doc: &mut Document,
+    table: &mut Table,
+    array: Array,
+    values: Vec<f64>,
+) -> Result<(), ConfigError> {
     section_mut(table, "oscillator")?.insert(
         array.name().into(),
         Value::Array(values.iter().copied().map(Value::Float).collect()),

@@ -9,7 +9,9 @@ use super::settings::{Harvester, RunSpec, Sampling};
 use super::simulate::{Ending, StudyError, simulate};
 use crate::coupling::Coupling;
 use crate::electrical::breakdown::BreakdownMargin;
-use crate::electrical::{ElectricalSamples, HarvesterParams, Load, LoadPoint, LoadSweep, best_load, load_sweep};
+use crate::electrical::{
+    ElectricalSamples, HarvesterParams, Load, LoadPoint, LoadSweep, best_load, load_sweep,
+};
 use crate::error::ParamError;
 use crate::{ChainParams, Trajectory};
 

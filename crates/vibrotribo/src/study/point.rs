@@ -193,6 +193,10 @@ pub enum PointError {
     /// The run could not be set up (or failed otherwise).
     #[error(transparent)]
     Study(#[from] StudyError),
+    /// The stroboscopic section could not be set up (a chain without masses, a period that
+    /// is not positive and finite).
+    #[error(transparent)]
+    Analysis(#[from] crate::analysis::AnalysisError),
 }
 
 /// Records impacts after the transient and flags grazing.
@@ -432,8 +436,7 @@ fn record(
             phase_time: 0.0,
             transient_periods: transient + 1,
         },
-    )
-    .expect("valid stroboscopic options");
+    )?;
     let lyapunov = match lyapunov {
         Some(o) => Some(LyapunovObserver::new(params, transient, o).map_err(StudyError::from)?),
         None => None,

@@ -48,7 +48,10 @@ impl SettleMode {
     /// [`SettleMode::Auto`].
     pub fn with_cap(self, cap: u64) -> Self {
         match self {
-            SettleMode::Auto(a) => SettleMode::Auto(AutoSettle { cap_periods: cap, ..a }),
+            SettleMode::Auto(a) => SettleMode::Auto(AutoSettle {
+                cap_periods: cap,
+                ..a
+            }),
             SettleMode::Fixed => SettleMode::Fixed,
         }
     }
@@ -212,8 +215,7 @@ pub fn settle(
                 phase_time: 0.0,
                 transient_periods: 1,
             },
-        )
-        .expect("valid stroboscopic options");
+        )?;
         let mut watch = Mechanics::new(strobe);
         let outcome = simulate(&spec, &mut watch)?;
         match outcome.ending {

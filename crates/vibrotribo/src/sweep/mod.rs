@@ -14,6 +14,6 @@ pub use runner::{
     Continuation, Delivery, PointRunner, SweepError, grid, run_chunks, run_continued, run_grid, run_grid_on,
 };
 pub use table::{
-    Cell, Column, IMPACT_COLUMNS, Kind, LYAPUNOV_COLUMNS, MOTION_COLUMNS, PointColumns, SweepColumns, Table, error_text,
-    impact_rows, orbit_columns, orbit_rows, point_columns,
+    Cell, Column, IMPACT_COLUMNS, Kind, LYAPUNOV_COLUMNS, MOTION_COLUMNS, PointColumns, SweepColumns, Table,
+    error_text, impact_rows, orbit_columns, orbit_rows, point_columns,
 };

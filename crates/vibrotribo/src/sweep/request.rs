@@ -60,7 +60,11 @@ impl PointRequest {
     /// where the request does not give them. Under a base motion that is not periodic there
     /// is no periodic motion to settle to or classify: each point then runs exactly
     /// `transient + recorded` periods ([`SettleMode::Fixed`]) and is not classified.
-    pub fn options(&self, base: &Config, (transient, recorded): (u64, u64)) -> Result<PointOptions, PointRequestError> {
+    pub fn options(
+        &self,
+        base: &Config,
+        (transient, recorded): (u64, u64),
+    ) -> Result<PointOptions, PointRequestError> {
         let recorded = self.recorded.unwrap_or(recorded);
         if recorded == 0 {
             return Err(PointRequestError::NoRecordedPeriods);

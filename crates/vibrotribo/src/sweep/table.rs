@@ -186,7 +186,9 @@ impl PointColumns {
                 ];
                 row.extend(p.impacts_per_period.iter().map(|&c| Cell::Float(c)));
                 row.push(Cell::Text(
-                    p.electrical_error.as_ref().map_or(String::new(), ToString::to_string),
+                    p.electrical_error
+                        .as_ref()
+                        .map_or(String::new(), ToString::to_string),
                 ));
                 row
             }
@@ -357,7 +359,10 @@ impl Table {
     pub fn new(names: Vec<String>, kinds: Vec<Kind>) -> Self {
         debug_assert_eq!(names.len(), kinds.len());
         Table {
-            columns: names.into_iter().zip(kinds.into_iter().map(Column::new)).collect(),
+            columns: names
+                .into_iter()
+                .zip(kinds.into_iter().map(Column::new))
+                .collect(),
         }
     }
 
