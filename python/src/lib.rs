@@ -32,6 +32,11 @@ fn log_spaced(start: f64, stop: f64, steps: usize) -> Vec<f64> {
 #[pymodule]
 fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add(
+        "DEFAULT_PERIOD_TOLERANCE",
+        vibrotribo::study::DEFAULT_PERIOD_TOLERANCE,
+    )?;
+    m.add("DEFAULT_SETTLE_CAP", vibrotribo::study::DEFAULT_SETTLE_CAP)?;
     m.add_class::<config::PyConfig>()?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;

@@ -1,5 +1,6 @@
-//! `vibrotribo.load_sweep`: power against the load resistance on one mechanical run
-//! ([`vibrotribo::study::load_study`]), as `vibrotribo load-sweep` writes it.
+//! `vibrotribo.load_sweep`: power against the load resistance (on one mechanical run, or a
+//! coupled run per load under two-way coupling: [`vibrotribo::study::load_study`]), as
+//! `vibrotribo load-sweep` writes it.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

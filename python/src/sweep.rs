@@ -8,8 +8,11 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vibrotribo::config::Config;
-use vibrotribo::study::{AutoSettle, PointOptions, SettleMode};
-use vibrotribo::sweep::{Continuation, Delivery, PointRunner, SweepColumns, run_continued, run_grid_on};
+use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, SettleMode};
+use vibrotribo::sweep::{
+    Continuation, Delivery, PointColumns, PointRequest, PointRequestError, PointRunner, SweepColumns,
+    run_continued, run_grid_on,
+};
 
 use crate::config::{config_error, config_of, table_to_dict};
 use crate::convert::table_to_py;
@@ -29,39 +32,23 @@ pub struct PointSettings {
 }
 
 impl PointSettings {
-    /// The point runner on `base`, the options checked.
+    /// The point runner on `base`, the options checked by the library ([`PointRequest`]).
     fn runner(&self, base: Config) -> PyResult<PointRunner> {
-        let settle = match self.settle.as_str() {
-            "fixed" => SettleMode::Fixed,
-            "auto" if self.settle_cap > 0 => SettleMode::Auto(AutoSettle {
-                cap_periods: self.settle_cap,
-                ..AutoSettle::default()
-            }),
-            "auto" => return Err(PyValueError::new_err("settle_cap must be at least 1")),
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "settle must be \"auto\" or \"fixed\", got {other:?}"
-                )));
-            }
-        };
-        // Under a base motion that is not periodic there is no periodic motion to settle to
-        // or classify: each point runs exactly `transient + recorded` periods.
-        let periodic = base.is_periodic();
-        let options = PointOptions {
+        let settle: SettleMode = self
+            .settle
+            .parse()
+            .map_err(|e: vibrotribo::study::UnknownSettleMode| PyValueError::new_err(e.to_string()))?;
+        let request = PointRequest {
+            transient: self.transient,
+            recorded: self.recorded,
             period_tolerance: self.period_tolerance,
-            settle: if periodic { settle } else { SettleMode::Fixed },
-            classify: periodic,
-            ..PointOptions::from_run(base.run(), self.transient, self.recorded)
+            floquet: false,
+            settle: settle.with_cap(self.settle_cap),
         };
-        if options.recorded_periods == 0 {
-            return Err(PyValueError::new_err("recorded must be at least 1"));
-        }
-        if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
-            return Err(PyValueError::new_err(format!(
-                "period_tolerance must lie in (0, 1), got {}",
-                self.period_tolerance
-            )));
-        }
+        let options = request.options_of_run(&base).map_err(|e| match e {
+            PointRequestError::Config(e) => config_error(e),
+            e => PyValueError::new_err(e.to_string()),
+        })?;
         Ok(PointRunner::new(base, options, self.mechanics_only))
     }
 
@@ -142,7 +129,7 @@ fn run_points(
 
 /// Runs a one-parameter sweep (see the Python `vibrotribo.sweep`).
 #[pyfunction]
-#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4, settle = String::from("auto"), settle_cap = 2000))]
+#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = DEFAULT_PERIOD_TOLERANCE, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -177,7 +164,8 @@ pub fn sweep<'py>(
     let runner = settings_of.runner(base)?;
     let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
     check_points(&runner, &points)?;
-    let mut table = SweepColumns::new(&["param"], runner.masses(), runner.contacts(), true);
+    let columns = PointColumns::of_contacts(runner.contacts());
+    let mut table = SweepColumns::new(&["param"], runner.masses(), columns, true);
     match continuation {
         Continuation::None => {
             let pool = settings_of.pool()?;
@@ -218,7 +206,7 @@ pub fn sweep<'py>(
 
 /// Runs a two-parameter map (see the Python `vibrotribo.map`).
 #[pyfunction]
-#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = 1e-4, settle = String::from("auto"), settle_cap = 2000))]
+#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = DEFAULT_PERIOD_TOLERANCE, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP))]
 #[allow(clippy::too_many_arguments)]
 pub fn map<'py>(
     py: Python<'py>,
@@ -252,7 +240,8 @@ pub fn map<'py>(
         .flat_map(|&yv| x_values.iter().map(move |&xv| vec![(xk, xv), (yk, yv)]))
         .collect();
     check_points(&runner, &points)?;
-    let mut table = SweepColumns::new(&["x", "y"], runner.masses(), runner.contacts(), false);
+    let columns = PointColumns::of_contacts(runner.contacts());
+    let mut table = SweepColumns::new(&["x", "y"], runner.masses(), columns, false);
     let pool = settings_of.pool()?;
     py.detach(|| run_points(&pool, &runner, &points, &mut table))?;
     let out = PyDict::new(py);

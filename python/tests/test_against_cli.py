@@ -217,3 +217,51 @@ def test_lyapunov_rejects_bad_input():
         vt.lyapunov(None, periods=0)
     with pytest.raises(ValueError, match="batches"):
         vt.lyapunov(None, periods=10, batches=1)
+
+
+IMPACT = CONFIGS / "impact_oscillator.toml"
+
+
+def test_sweep_with_a_stop_equals_the_files(cli, tmp_path):
+    """A single mass below a rigid stop: contacts N - 1 = 0 between masses, N + 1 = 2 with
+    the stops; the tables have a column per contact and equal the command line's files."""
+    run_cli(cli, "sweep", IMPACT, "--param", "omega_ratio", "--from", "2.4", "--to", "2.8",
+            "--steps", "5", "--mechanics-only", "--transient", "100", "--recorded", "16",
+            "--out", tmp_path)
+    r = vt.sweep(vt.Config(IMPACT), "omega_ratio", vt.grid(2.4, 2.8, 5), mechanics_only=True,
+                 transient=100, recorded=16)
+    compare_tables(
+        [r.summary, r.orbit, r.impacts], tmp_path, ["summary.csv", "orbit.csv", "impacts.csv"]
+    )
+    assert "impacts_per_period_2" in r.summary.columns
+    # The stop is above the mass: every impact is on the upper stop, contact N + 1 = 2.
+    assert len(r.impacts["contact"]) > 0 and (r.impacts["contact"] == 2).all()
+
+
+def test_map_with_a_stop_equals_the_file(cli, tmp_path):
+    run_cli(
+        cli, "map", IMPACT, "--x", "omega_ratio", "--x-from", "2.4", "--x-to", "2.8", "--x-steps", "3",
+        "--y", "amplitude", "--y-from", "0.008", "--y-to", "0.012", "--y-steps", "2",
+        "--mechanics-only", "--transient", "100", "--recorded", "16", "--out", tmp_path,
+    )
+    r = vt.map(vt.Config(IMPACT), "omega_ratio", vt.grid(2.4, 2.8, 3), "amplitude",
+               vt.grid(0.008, 0.012, 2), mechanics_only=True, transient=100, recorded=16)
+    compare_tables([r.summary], tmp_path, ["map.csv"])
+    assert r.summary.rows == 6
+
+
+def test_mass_ratio_on_one_mass_is_an_error():
+    with pytest.raises(ValueError, match="mass_ratio needs at least 2"):
+        vt.sweep(vt.Config(IMPACT), "mass_ratio", [1.5, 2.0], mechanics_only=True)
+
+
+def test_an_integer_key_can_be_swept():
+    config = vt.Config({
+        "excitation": {"kind": "random", "rms_acceleration": 5.0, "f_low_hz": 3.0, "f_high_hz": 9.0},
+        "run": {"periods": 4, "transient_periods": 2},
+    })
+    r = vt.sweep(config, "excitation.seed", [0, 1, 2], mechanics_only=True, threads=1)
+    assert list(r.summary["error"]) == ["", "", ""]
+    one = vt.sweep(config.replace(**{"excitation.seed": 1}), "restitution", [0.6],
+                   mechanics_only=True, threads=1)
+    assert_bits(r.orbit["x1_m"][r.orbit["param"] == 1.0], one.orbit["x1_m"], "seed 1")

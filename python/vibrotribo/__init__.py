@@ -121,9 +121,9 @@ def sweep(
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = None,
-    period_tolerance: float = 1e-4,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
     settle: str = "auto",
-    settle_cap: int = 2000,
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
 ) -> Sweep:
     """A one-parameter sweep: the configuration with ``param`` set to each of ``values``,
     simulated for ``transient`` periods (default ``run.transient_periods``) and then
@@ -172,9 +172,9 @@ def map(  # noqa: A001 - the command's name
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = None,
-    period_tolerance: float = 1e-4,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
     settle: str = "auto",
-    settle_cap: int = 2000,
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
 ) -> Map:
     """A two-parameter map: every point (x, y) of the grid (y outer, x inner), each run as a
     sweep point (see :func:`sweep`); its ``summary`` is ``vibrotribo map``'s ``map.csv``."""
@@ -209,7 +209,9 @@ def load_sweep(
     (Ω; default ``steps`` log-spaced from ``low`` to ``high``, as ``vibrotribo load-sweep``)
     solved along it, the optimum refined, the power at the configured load, and the V–Q
     cycles of the last period at the configured and optimal loads (``vq_points`` points;
-    None for none). Returns a :class:`LoadSweep` equal to the command's files."""
+    None for none). Under ``harvester.coupling = "two_way"`` every load is a whole coupled
+    run instead (the power at a load is what :func:`simulate` reports with it). Returns a
+    :class:`LoadSweep` equal to the command's files."""
     raw = _vibrotribo.load_sweep(
         _config(config),
         resistances=None if resistances is None else _values(resistances, "resistances"),

@@ -26,7 +26,7 @@ from typing import Any, Iterable, List, Optional
 
 import numpy as np
 
-from . import Config, Sweep, Table, _config, _values
+from . import Config, Sweep, Table, _config, _values, _vibrotribo
 from . import sweep as _serial_sweep
 
 __all__ = ["sweep"]
@@ -48,9 +48,9 @@ def sweep(
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = 1,
-    period_tolerance: float = 1e-4,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
     settle: str = "auto",
-    settle_cap: int = 2000,
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
     chunk_size: Optional[int] = None,
 ) -> Sweep:
     """:func:`vibrotribo.sweep` with its values spread over the workers of the Dask

@@ -1,5 +1,5 @@
-//! `vibrotribo load-sweep`: average power against load resistance on one mechanical run, the
-//! optimal load, and the V–Q cycle.
+//! `vibrotribo load-sweep`: average power against load resistance (on one mechanical run, or a
+//! coupled run per load under two-way coupling), the optimal load, and the V–Q cycle.
 
 use std::path::PathBuf;
 
@@ -59,7 +59,8 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
     let config = args.input.load()?;
     let spec = config.run_spec(false);
 
-    // The coupling is one-way: the mechanics is simulated once and replayed for every load.
+    // One-way coupling: the mechanics is simulated once and replayed for every load; two-way:
+    // every load is a whole coupled run (the progress bar then counts each run's periods).
     let mut watch = Watch {
         progress: Progress::new(spec.periods, "mechanics", args.quiet),
     };

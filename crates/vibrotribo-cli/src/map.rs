@@ -18,10 +18,10 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{Axis, Kind, MapManifest, SettleRecord, ShardRecord, base_motion_of, to_value};
-use crate::output::{CsvFile, PointColumns, create_dir, write_json};
+use crate::output::{CsvFile, create_dir, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
-use vibrotribo::sweep::grid;
+use vibrotribo::sweep::{Cell, PointColumns, grid};
 
 /// Options of `vibrotribo map`.
 #[derive(Debug, clap::Args)]
@@ -196,9 +196,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
             let Some((&(x, y), r)) = point else {
                 return out.commit();
             };
-            let mut row = vec![x.to_string(), y.to_string()];
+            let mut row = vec![Cell::Float(x), Cell::Float(y)];
             row.extend(columns.cells(r));
-            out.row(0, row)
+            out.row(0, row.iter().map(ToString::to_string).collect())
         },
     )?;
     let done = skip + computed;
@@ -427,10 +427,10 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             if let Some(csv) = grid_csv.as_mut() {
                 // Of the point's columns: average_power_w, impacts_per_period, period, error.
                 let mut cells = point_columns(contacts, false, false).cells(res);
-                let error = cells.get(6 + contacts).cloned().unwrap_or_default();
+                let error = cells.get(6 + contacts).cloned().unwrap_or(Cell::Missing);
                 cells.truncate(3);
                 csv.row(
-                    [w.to_string(), r.to_string()]
+                    [Cell::Float(w), Cell::Float(r)]
                         .into_iter()
                         .chain(cells)
                         .chain([error]),

@@ -5,8 +5,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use vibrotribo::study::PointResult;
-use vibrotribo::sweep::{MOTION_COLUMNS, MotionCells, point_columns};
+use vibrotribo::sweep::Cell;
 
 /// A CSV file written row by row.
 pub struct CsvFile {
@@ -120,13 +119,10 @@ pub fn numbered(prefix: &str, n: usize, suffix: &str) -> Vec<String> {
     (1..=n).map(|i| format!("{prefix}{i}{suffix}")).collect()
 }
 
-/// A text field for CSV: quoted (with quotes doubled) if it holds a comma, quote or newline.
+/// A text field for CSV: quoted (with quotes doubled) if it holds a comma, quote or newline
+/// (the library's [`Cell`] text).
 pub fn csv_text(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_string()
-    }
+    Cell::Text(text.to_string()).to_string()
 }
 
 /// Reads a CSV file written by this program: header and rows of fields (quoted fields are
@@ -215,111 +211,6 @@ pub fn si(value: f64, unit: &str) -> String {
         3
     };
     format!("{x:.digits$} {prefix}{unit}")
-}
-
-/// The columns describing one sweep or map point, after its key columns ([`point_columns`]): `average_power_w`,
-/// `impacts_per_period`, `period` (0 = non-periodic), `chatter`, `sticking`, `grazing`,
-/// `impacts_per_period_1..contacts`, `error`, with `floquet` `max_abs_multiplier`, with
-/// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`, and last the motion columns
-/// ([`MOTION_COLUMNS`]: `motion`, `average_power_se_w`, `settle_periods`, `settle_rate`,
-/// `residual`, `settle_periods_needed`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PointColumns {
-    /// Contacts of the chain (N − 1, or N + 1 with stops).
-    pub contacts: usize,
-    /// Whether the largest Floquet multiplier modulus is a column (`--floquet`).
-    pub floquet: bool,
-    /// Whether the largest Lyapunov exponent and its spread are columns (`--lyapunov`).
-    pub lyapunov: bool,
-}
-
-/// The columns `--lyapunov` adds at the end: the largest Lyapunov exponent over the recorded
-/// periods and its batch-means standard error, 1/s.
-const LYAPUNOV_COLUMNS: [&str; 2] = ["lyapunov_max_1_s", "lyapunov_spread_1_s"];
-
-impl PointColumns {
-    /// The columns of a file whose point columns are `width` wide (its header less its key
-    /// columns), with or without the Floquet and Lyapunov columns: the contacts are what the
-    /// other columns leave.
-    pub fn from_width(width: usize, floquet: bool, lyapunov: bool) -> Self {
-        let fixed = PointColumns {
-            contacts: 0,
-            floquet,
-            lyapunov,
-        }
-        .names()
-        .len();
-        PointColumns {
-            contacts: width.saturating_sub(fixed),
-            floquet,
-            lyapunov,
-        }
-    }
-
-    /// The column names.
-    pub fn names(&self) -> Vec<String> {
-        let mut cols = point_columns(self.contacts);
-        if self.floquet {
-            cols.push("max_abs_multiplier".into());
-        }
-        if self.lyapunov {
-            cols.extend(LYAPUNOV_COLUMNS.map(String::from));
-        }
-        cols.extend(MOTION_COLUMNS.map(String::from));
-        cols
-    }
-
-    /// The cells for one point: its results, or blanks and the reason it failed. `error`
-    /// also holds an electrical failure of a point whose mechanics succeeded;
-    /// `max_abs_multiplier` is blank where shooting failed or no period was detected.
-    pub fn cells(&self, result: &Result<PointResult, String>) -> Vec<String> {
-        let mut row = match result {
-            Ok(p) => {
-                let mut row = vec![
-                    p.average_power_w.map_or(String::new(), |v| v.to_string()),
-                    p.total_impacts_per_period().to_string(),
-                    p.period().to_string(),
-                    p.chatter.to_string(),
-                    p.sticking.to_string(),
-                    p.grazing.to_string(),
-                ];
-                row.extend(p.impacts_per_period.iter().map(f64::to_string));
-                row.push(p.electrical_error.as_deref().map_or(String::new(), csv_text));
-                row
-            }
-            Err(e) => {
-                let mut row = vec![String::new(); 6 + self.contacts];
-                row.push(csv_text(e));
-                row
-            }
-        };
-        if self.floquet {
-            let m = result
-                .as_ref()
-                .ok()
-                .and_then(|p| p.max_abs_multiplier.as_ref())
-                .and_then(|m| m.as_ref().ok());
-            row.push(m.map_or(String::new(), f64::to_string));
-        }
-        if self.lyapunov {
-            // Blank if the point failed or no period could be averaged.
-            row.extend(match result {
-                Ok(PointResult {
-                    lyapunov: Some(Ok(s)),
-                    ..
-                }) => [s.largest().to_string(), s.largest_spread().to_string()],
-                _ => [String::new(), String::new()],
-            });
-        }
-        row.extend(
-            match result {
-                Ok(p) => MotionCells::of(p),
-                Err(_) => MotionCells::missing(),
-            }
-            .texts(),
-        );
-        row
-    }
 }
 
 #[cfg(test)]

@@ -15,7 +15,6 @@ use vibrotribo::study::{
 use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
-use crate::job::{SETTLE_CAP, Settle};
 use crate::limits;
 use crate::output::{CsvFile, create_dir, numbered, si, write_json};
 use crate::progress::{Interrupted, Progress, Watch};
@@ -46,10 +45,10 @@ pub struct SimulateArgs {
     /// configured run from the settled state (the files start there; summary.json's
     /// `settle_periods` says how many periods came before). Either way the motion after the
     /// transient is classified (`motion` in summary.json).
-    #[arg(long, default_value = "fixed", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
-    pub settle: Settle,
+    #[arg(long, default_value = "fixed", value_name = "auto|fixed")]
+    pub settle: SettleMode,
     /// Most periods `--settle auto` runs before the configured run.
-    #[arg(long, default_value_t = SETTLE_CAP, value_name = "PERIODS")]
+    #[arg(long, default_value_t = vibrotribo::study::DEFAULT_SETTLE_CAP, value_name = "PERIODS")]
     pub settle_cap: u64,
 }
 
@@ -182,7 +181,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     };
     let started = Instant::now();
     let mut run_motion = RunMotion::new(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mode = args.settle.mode(args.settle_cap);
+    let mode = args.settle.with_cap(args.settle_cap);
     if matches!(mode, SettleMode::Auto(_)) {
         config.check_periodic("simulate --settle auto (settling to a periodic motion)")?;
     }

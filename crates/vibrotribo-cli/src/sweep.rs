@@ -12,7 +12,10 @@ use serde_json::json;
 use vibrotribo::ChainState;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
-use vibrotribo::sweep::{Continuation, PointRunner, error_text, grid, run_continued};
+use vibrotribo::sweep::{
+    Cell, Continuation, IMPACT_COLUMNS, PointColumns, PointRunner, SweepError, grid, impact_rows,
+    orbit_columns, orbit_rows, run_continued,
+};
 
 use crate::config::ConfigArgs;
 use crate::job::{
@@ -21,7 +24,6 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{Kind, SettleRecord, ShardRecord, SweepManifest, base_motion_of, to_value};
-use crate::output::{PointColumns, numbered};
 use crate::progress::{Interrupted, Progress, interrupted};
 
 /// Options of `vibrotribo sweep`.
@@ -31,7 +33,8 @@ pub struct SweepArgs {
     pub input: ConfigArgs,
     /// The swept parameter: a configuration key (`excitation.omega_ratio`,
     /// `oscillator.gaps[1]`, `harvester.load_resistance`, …) or a derived one (`mass_ratio`,
-    /// `gap_ratio`, `gap`, `omega_ratio`, `restitution`, …).
+    /// `gap_ratio`, `gap`, `omega_ratio`, `restitution`, …); an integer key
+    /// (`excitation.seed`) takes whole values.
     #[arg(long)]
     pub param: String,
     /// First value.
@@ -73,26 +76,25 @@ pub struct SweepArgs {
 /// Files of a sweep directory: `orbit.csv`, `impacts.csv`, `summary.csv` (the index file,
 /// one row per value; its columns are [`PointColumns`]) and the manifest `sweep.json`.
 fn sweep_layout(masses: usize, columns: PointColumns) -> Layout {
-    let mut orbit_cols = vec!["param".to_string(), "period".to_string()];
-    orbit_cols.extend(numbered("x", masses, "_m"));
-    let mut summary_cols = vec!["param".to_string()];
-    summary_cols.extend(columns.names());
+    let keyed = |rest: Vec<String>| {
+        let mut cols = vec!["param".to_string()];
+        cols.extend(rest);
+        cols
+    };
     Layout {
         manifest: "sweep.json",
         files: vec![
             CsvSpec {
                 name: "orbit.csv",
-                columns: orbit_cols,
+                columns: keyed(orbit_columns(masses)),
             },
             CsvSpec {
                 name: "impacts.csv",
-                columns: ["param", "time_s", "contact", "rel_velocity_m_s"]
-                    .map(String::from)
-                    .to_vec(),
+                columns: keyed(IMPACT_COLUMNS.map(String::from).to_vec()),
             },
             CsvSpec {
                 name: "summary.csv",
-                columns: summary_cols,
+                columns: keyed(columns.names()),
             },
         ],
         index_file: 2,
@@ -100,37 +102,26 @@ fn sweep_layout(masses: usize, columns: PointColumns) -> Layout {
     }
 }
 
-/// Writes one value's rows: orbit, impacts, then its summary row (last, see [`crate::job`]).
+/// Writes one value's rows (the library's [`orbit_rows`], [`impact_rows`] and
+/// [`PointColumns::cells`]): orbit, impacts, then its summary row (last, see [`crate::job`]).
 fn write_value(
     out: &mut GridOutput,
-    value: f64,
-    result: &Result<PointResult, String>,
+    (value, masses): (f64, usize),
+    result: &Result<PointResult, SweepError>,
     columns: PointColumns,
 ) -> Result<()> {
-    let p = value.to_string();
+    let text = |row: Vec<Cell>| row.iter().map(ToString::to_string).collect::<Vec<_>>();
     if let Ok(r) = result {
-        // Masses per stroboscopic sample.
-        let n = r.strobe.len() / r.strobe_periods.len().max(1);
-        for (j, &period) in r.strobe_periods.iter().enumerate() {
-            let mut row = vec![p.clone(), period.to_string()];
-            row.extend(r.strobe[j * n..(j + 1) * n].iter().map(f64::to_string));
-            out.row(0, row)?;
+        for row in orbit_rows(&[value], masses, r) {
+            out.row(0, text(row))?;
         }
-        for i in &r.impacts {
-            out.row(
-                1,
-                vec![
-                    p.clone(),
-                    i.time.to_string(),
-                    (i.contact + 1).to_string(),
-                    i.closing_speed.to_string(),
-                ],
-            )?;
+        for row in impact_rows(&[value], r) {
+            out.row(1, text(row))?;
         }
     }
-    let mut row = vec![p];
+    let mut row = vec![Cell::Float(value)];
     row.extend(columns.cells(result));
-    out.row(2, row)
+    out.row(2, text(row))
 }
 
 /// The manifest `sweep.json` of a sweep (everything that determines its output).
@@ -282,7 +273,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             |point| match (point, out.as_mut()) {
                 (Some((&j, r)), o) => {
                     failed += usize::from(r.is_err());
-                    o.map_or(Ok(()), |o| write_value(o, values[j], r, columns))
+                    o.map_or(Ok(()), |o| write_value(o, (values[j], masses), r, columns))
                 }
                 (None, Some(o)) => o.commit(),
                 (None, None) => Ok(()),
@@ -294,11 +285,10 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             let mut written = 0usize;
             let mut failure = None;
             let (done, _) = run_continued(&runner, key, &values, todo, state, |j, r, state| {
-                let r = r.map_err(|e| error_text(&e));
                 failed += usize::from(r.is_err());
                 written += 1;
                 if let Some(o) = out.as_mut() {
-                    let w = write_value(o, values[j], &r, columns)
+                    let w = write_value(o, (values[j], masses), &r, columns)
                         .and_then(|()| o.checkpoint(skip + written, json!(state)));
                     if let Err(e) = w {
                         failure = Some(e);

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use vibrotribo::config::Config;
-use vibrotribo::study::{AutoSettle, PointOptions, SettleMode};
-use vibrotribo::sweep::PointRunner;
+use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, SettleMode};
+use vibrotribo::sweep::{PointRequest, PointRunner};
 
 /// `I/N`: the I-th (0-based) of N interleaved slices of the grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,52 +41,6 @@ impl std::str::FromStr for Shard {
     }
 }
 
-/// `--settle`: how long each point runs before its recorded window.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Settle {
-    /// Until the motion repeats, finishing a geometric approach by Newton shooting, at most
-    /// `--settle-cap` periods ([`SettleMode::Auto`]).
-    #[default]
-    Auto,
-    /// The fixed `--transient` ([`SettleMode::Fixed`]).
-    Fixed,
-}
-
-impl std::str::FromStr for Settle {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(Settle::Auto),
-            "fixed" => Ok(Settle::Fixed),
-            other => Err(format!("unknown --settle {other:?}: expected auto or fixed")),
-        }
-    }
-}
-
-impl Settle {
-    /// `auto` or `fixed`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Settle::Auto => "auto",
-            Settle::Fixed => "fixed",
-        }
-    }
-
-    /// The library's settle mode, with at most `cap` periods for `auto`.
-    pub fn mode(self, cap: u64) -> SettleMode {
-        match self {
-            Settle::Auto => SettleMode::Auto(AutoSettle {
-                cap_periods: cap,
-                ..AutoSettle::default()
-            }),
-            Settle::Fixed => SettleMode::Fixed,
-        }
-    }
-}
-
-/// The default of `--settle-cap`, periods.
-pub const SETTLE_CAP: u64 = 2000;
-
 /// Settings shared by sweeps and maps.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
@@ -100,7 +54,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub mechanics_only: bool,
     /// Relative tolerance of the period detection.
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = DEFAULT_PERIOD_TOLERANCE)]
     pub period_tolerance: f64,
     /// Also find the periodic orbit of each point's detected period by shooting and write
     /// its largest Floquet multiplier modulus (column `max_abs_multiplier`; < 1: stable).
@@ -111,10 +65,10 @@ pub struct RunArgs {
     /// periodic orbit is finished by Newton shooting; a motion whose returns do not shrink
     /// stops after --transient periods), at most --settle-cap periods; `fixed` exactly
     /// --transient periods (the results of earlier versions).
-    #[arg(long, default_value = "auto", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
-    pub settle: Settle,
+    #[arg(long, default_value = "auto", value_name = "auto|fixed")]
+    pub settle: SettleMode,
     /// Most periods `--settle auto` runs before the recorded window.
-    #[arg(long, default_value_t = SETTLE_CAP, value_name = "PERIODS")]
+    #[arg(long, default_value_t = DEFAULT_SETTLE_CAP, value_name = "PERIODS")]
     pub settle_cap: u64,
     /// Worker threads (default: all cores).
     #[arg(long)]
@@ -137,41 +91,16 @@ impl RunArgs {
     }
 
     /// The point runner of these settings on `base`, with `(transient, recorded)` periods
-    /// where the options do not give them.
-    pub fn runner_or(&self, base: Config, (transient, recorded): (u64, u64)) -> Result<PointRunner> {
-        let transient = self.transient.unwrap_or(transient);
-        let recorded = self.recorded.unwrap_or(recorded);
-        if recorded == 0 {
-            bail!("--recorded must be at least 1");
-        }
-        if !(self.period_tolerance > 0.0 && self.period_tolerance < 1.0) {
-            bail!(
-                "--period-tolerance must lie in (0, 1), got {}",
-                self.period_tolerance
-            );
-        }
-        if self.settle_cap == 0 {
-            bail!("--settle-cap must be at least 1");
-        }
-        if self.floquet {
-            base.check_periodic("--floquet (Floquet multipliers)")?;
-        }
-        // Under a base motion that is not periodic there is no periodic motion to settle to
-        // or classify: each point runs exactly `transient + recorded` periods.
-        let periodic = base.is_periodic();
-        let options = PointOptions {
-            transient_periods: transient,
-            recorded_periods: recorded,
+    /// where the options do not give them (checked by the library's [`PointRequest`]).
+    pub fn runner_or(&self, base: Config, defaults: (u64, u64)) -> Result<PointRunner> {
+        let request = PointRequest {
+            transient: self.transient,
+            recorded: self.recorded,
             period_tolerance: self.period_tolerance,
             floquet: self.floquet,
-            settle: if periodic {
-                self.settle.mode(self.settle_cap)
-            } else {
-                vibrotribo::study::SettleMode::Fixed
-            },
-            classify: periodic,
-            ..PointOptions::default()
+            settle: self.settle.with_cap(self.settle_cap),
         };
+        let options = request.options(&base, defaults)?;
         Ok(PointRunner::new(base, options, self.mechanics_only))
     }
 }

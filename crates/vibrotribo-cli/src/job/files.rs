@@ -4,7 +4,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use crate::output::PointColumns;
+use vibrotribo::sweep::PointColumns;
 
 /// The point columns of a chain with `contacts` contacts
 /// ([`ChainParams::contact_count`](vibrotribo::ChainParams::contact_count)).

@@ -7,7 +7,7 @@ mod files;
 mod grid;
 mod run;
 
-pub use args::{MergeArgs, RunArgs, SETTLE_CAP, Settle, Shard};
+pub use args::{MergeArgs, RunArgs, Shard};
 pub use files::{header_len, point_columns};
 pub use grid::{CHECKPOINT, CsvSpec, GridOutput, Layout, merge, read_checkpoint};
 pub use run::{

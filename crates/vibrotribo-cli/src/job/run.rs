@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 
 use anyhow::{Context, Result, anyhow, bail};
 use vibrotribo::study::{PointResult, SettleMode};
-use vibrotribo::sweep::{Delivery, PointRunner, error_text, run_chunks};
+use vibrotribo::sweep::{Delivery, PointRunner, SweepError, run_chunks};
 
 use crate::limits;
 use crate::progress::{Progress, interrupted};
@@ -43,11 +43,11 @@ pub fn run_points<'k, P, W>(
 ) -> Result<usize>
 where
     P: Sync,
-    W: FnMut(Option<(&P, &Result<PointResult, String>)>) -> Result<()>,
+    W: FnMut(Option<(&P, &Result<PointResult, SweepError>)>) -> Result<()>,
 {
     run_chunked(
         points,
-        |p| runner.run(&keys(p), None).map_err(|e| error_text(&e)),
+        |p| runner.run(&keys(p), None),
         progress,
         quiet,
         |d| match d {

@@ -103,12 +103,12 @@ impl Ctx {
             transient: Some(self.budget.transient),
             recorded: Some(self.budget.recorded),
             mechanics_only,
-            period_tolerance: 1e-4,
+            period_tolerance: vibrotribo::study::DEFAULT_PERIOD_TOLERANCE,
             floquet: false,
             // Settled before recording, so that "not periodic" is a finding, not a short
             // transient; the motions are classified.
-            settle: crate::job::Settle::Auto,
-            settle_cap: crate::job::SETTLE_CAP,
+            settle: vibrotribo::study::SettleMode::Auto(vibrotribo::study::AutoSettle::default()),
+            settle_cap: vibrotribo::study::DEFAULT_SETTLE_CAP,
             threads: None,
             quiet: true,
             allow_large: false,

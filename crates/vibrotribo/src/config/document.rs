@@ -8,6 +8,7 @@ use toml::{Table, Value};
 
 use super::error::ConfigError;
 use super::keys::{self, PerMass};
+use super::param::Param;
 use crate::electrical::{ChargeOptions, HarvesterParams, TransducerMode};
 use crate::excitation::{BaseMotion, ExcitationKind, ExcitationSpec, Harmonic, Quantity, Sweep};
 use crate::model::{ChainParams, ChainState, Excitation, Frequency, SimOptions, Stops};
@@ -147,6 +148,8 @@ pub(super) struct Document {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
     table: Table,
+    /// The tree read into the document's types (what a [`Param`](super::Param) sets).
+    doc: Document,
     chain: ChainParams,
     run: RunSettings,
     initial: ChainState,
@@ -210,6 +213,13 @@ impl Config {
         if let Some(dir) = base_dir.as_deref() {
             resolve_record_path(&mut table, dir);
         }
+        Self::read_table(table, None)
+    }
+
+    /// The tree `table` read into the document's types and resolved; what `previous` (a
+    /// configuration this one is derived from) already read or built is reused where its
+    /// inputs are the same (a record's samples, a base motion's spline).
+    fn read_table(table: Table, previous: Option<&Config>) -> Result<Self, ConfigError> {
         let doc: Document = serde_path_to_error::deserialize(Value::Table(table.clone())).map_err(|e| {
             // A key the schema lacks is named as one (the deserialiser calls it a field).
             if let Some(key) = keys::unknown_key_in(&table) {
@@ -225,6 +235,17 @@ impl Config {
                 message: e.into_inner().message().trim().to_string(),
             }
         })?;
+        Self::resolve(table, doc, previous)
+    }
+
+    /// The configuration of the document `doc` read from `table`: the chain, the initial
+    /// state and the base motion derived, everything validated (see
+    /// [`read_table`](Self::read_table) for `previous`).
+    pub(super) fn resolve(
+        table: Table,
+        doc: Document,
+        previous: Option<&Config>,
+    ) -> Result<Self, ConfigError> {
         let chain = chain_of(&doc).map_err(|e| e.renamed(keys::chain_key))?;
         let mut harvester = doc.harvester.clone().unwrap_or_default();
         let mode_given = table.get("harvester").and_then(|h| h.get("mode")).is_some();
@@ -245,10 +266,13 @@ impl Config {
                 .map_err(|e| e.within("harvester"))?;
         }
         doc.electrical.validate().map_err(|e| e.within("electrical"))?;
-        let excitation = super::excitation::excitation_of(&doc, &chain)?;
-        let base = match excitation.kind() {
-            ExcitationKind::Harmonic => None,
-            kind => Some(Arc::new(
+        // The same record file: its samples as read before.
+        let same_record = previous.filter(|p| p.doc.excitation.file == doc.excitation.file);
+        let excitation = super::excitation::excitation_of(&doc, &chain, same_record.map(|p| &p.excitation))?;
+        let base = match (excitation.kind(), previous) {
+            (ExcitationKind::Harmonic, _) => None,
+            (_, Some(p)) if p.excitation == excitation && p.base.is_some() => p.base.clone(),
+            (kind, _) => Some(Arc::new(
                 excitation
                     .build(chain_harmonic(&chain))
                     .map_err(|e| super::excitation::named(kind, e))?,
@@ -278,13 +302,14 @@ impl Config {
         Ok(Config {
             table,
             chain,
-            run: doc.run,
+            run: doc.run.clone(),
             initial,
-            options: doc.options,
+            options: doc.options.clone(),
             harvester,
-            electrical: doc.electrical,
+            electrical: doc.electrical.clone(),
             excitation,
             base,
+            doc,
         })
     }
 
@@ -319,8 +344,56 @@ impl Config {
             keys::set_key(&mut table, key, value).map_err(|e| tell(&[(shown.clone(), key)], e))?;
             set.push((shown, key));
         }
-        *self = Self::from_table(table).map_err(|e| tell(&set, e))?;
+        *self = Self::read_table(table, Some(self)).map_err(|e| tell(&set, e))?;
         Ok(())
+    }
+
+    /// A copy with each parameter of `values` set to its value, in order, validated once
+    /// they are all set (see [`set_all`](Self::set_all)): a sweep's or a map's point. The
+    /// parameters of the document's types are set there directly, without writing and
+    /// reading TOML again; a record file is not read again.
+    pub fn with_values(&self, values: &[(&Param, f64)]) -> Result<Self, ConfigError> {
+        if values.iter().any(|(p, _)| !p.is_typed()) {
+            return self.with_values_in_tree(values);
+        }
+        let (mut doc, mut table) = (self.doc.clone(), self.table.clone());
+        let mut set = Vec::new();
+        for &(param, value) in values {
+            let shown = format!("{} = {}", param.key(), Value::Float(value));
+            param
+                .set(&mut doc, &mut table, value)
+                .map_err(|e| tell(&[(shown.clone(), param.key())], e))?;
+            set.push((shown, param.key()));
+        }
+        Self::resolve(table, doc, Some(self)).map_err(|e| tell(&set, e))
+    }
+
+    /// [`with_values`](Self::with_values) through the TOML tree ([`set_all`](Self::set_all)):
+    /// each value as a float, or, if that is refused, a whole value as an integer (for the
+    /// integer keys, such as `excitation.seed`).
+    fn with_values_in_tree(&self, values: &[(&Param, f64)]) -> Result<Self, ConfigError> {
+        let mut config = self.clone();
+        let floats = values.iter().map(|&(p, v)| (p.key(), Value::Float(v)));
+        let Err(error) = config.set_all(floats) else {
+            return Ok(config);
+        };
+        let whole = |v: f64| v.is_finite() && v.fract() == 0.0 && v.abs() <= 2f64.powi(53);
+        if !values.iter().any(|&(_, v)| whole(v)) {
+            return Err(error);
+        }
+        let mixed = values.iter().map(|&(p, v)| {
+            let value = if whole(v) && !p.is_typed() {
+                Value::Integer(v as i64)
+            } else {
+                Value::Float(v)
+            };
+            (p.key(), value)
+        });
+        let mut config = self.clone();
+        match config.set_all(mixed) {
+            Ok(()) => Ok(config),
+            Err(_) => Err(error),
+        }
     }
 
     /// The TOML tree: the file with the overrides applied (what a run records as its

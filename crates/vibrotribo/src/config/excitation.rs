@@ -100,8 +100,14 @@ pub(super) fn named(kind: ExcitationKind, e: SignalError) -> ConfigError {
     conflict(key, format!("kind = \"{}\": {e}", kind.as_str()))
 }
 
-/// The `[excitation]` of `doc` (chain already read and valid) as an [`ExcitationSpec`].
-pub(super) fn excitation_of(doc: &Document, chain: &ChainParams) -> Result<ExcitationSpec, ConfigError> {
+/// The `[excitation]` of `doc` (chain already read and valid) as an [`ExcitationSpec`];
+/// `same_file` is one read before from the same `excitation.file`, whose record samples are
+/// used instead of reading the file again.
+pub(super) fn excitation_of(
+    doc: &Document,
+    chain: &ChainParams,
+    same_file: Option<&ExcitationSpec>,
+) -> Result<ExcitationSpec, ConfigError> {
     let t = &doc.excitation;
     let kind = t.kind.unwrap_or_default();
     for (key, kinds) in given_keys(t) {
@@ -285,7 +291,14 @@ pub(super) fn excitation_of(doc: &Document, chain: &ChainParams) -> Result<Excit
             // Relative to the working directory; a file's own relative paths were resolved
             // against its directory when it was read (`Config::from_table_in`).
             let path = PathBuf::from(file);
-            let samples = read_record(&path).map_err(|e| conflict("file", e.to_string()))?;
+            let before = match same_file {
+                Some(ExcitationSpec::Record(r)) => Some(r),
+                _ => None,
+            };
+            let samples = match before {
+                Some(r) => Arc::clone(&r.samples),
+                None => Arc::new(read_record(&path).map_err(|e| conflict("file", e.to_string()))?),
+            };
             if samples.duration() < run_length {
                 return Err(conflict(
                     "file",
@@ -296,10 +309,14 @@ pub(super) fn excitation_of(doc: &Document, chain: &ChainParams) -> Result<Excit
                     ),
                 ));
             }
-            // Build once to report a record that cannot be scaled or integrated now.
-            record_displacement(&samples, quantity, scaling).map_err(|e| conflict("file", e.to_string()))?;
+            // Build once to report a record that cannot be scaled or integrated now (done
+            // already if the record was read before with the same quantity and scaling).
+            if !before.is_some_and(|r| r.quantity == quantity && r.scaling == scaling) {
+                record_displacement(&samples, quantity, scaling)
+                    .map_err(|e| conflict("file", e.to_string()))?;
+            }
             ExcitationSpec::Record(RecordSpec {
-                samples: Arc::new(samples),
+                samples,
                 quantity,
                 scaling,
             })

@@ -271,6 +271,11 @@ pub(super) fn set_key(table: &mut Table, key: &str, value: Value) -> Result<(), 
         "mass_ratio" => {
             let r = number(&value, key)?;
             let mut m = chain()?.masses;
+            if m.len() < 2 {
+                return Err(ConfigError::Malformed(
+                    "mass_ratio needs at least 2 masses".into(),
+                ));
+            }
             m[1] = r * m[0];
             set_array(table, "oscillator", "masses", m)
         }

@@ -10,14 +10,18 @@
 //! those types is a key, and unknown keys are refused. [`Config`] reads a file, applies
 //! overrides ([`Config::set`], [`apply_overrides`]) including the derived keys of
 //! [`DERIVED_KEYS`], validates everything, and names the key at fault in every error
-//! (the library's field names mapped to keys, `masses[1]` → `oscillator.masses[1]`).
+//! (the library's field names mapped to keys, `masses[1]` → `oscillator.masses[1]`). A
+//! [`Param`] is a key resolved once, which the points of a sweep set directly
+//! ([`Config::with_values`]).
 
 mod document;
 mod error;
 mod excitation;
 mod keys;
+mod param;
 
 pub use document::Config;
 pub use error::ConfigError;
 pub use excitation::{DEFAULT_SPLINE_TOLERANCE, MAX_HARMONICS};
 pub use keys::{DERIVED_KEYS, apply_overrides, known_keys, parse_override, parse_value};
+pub use param::Param;

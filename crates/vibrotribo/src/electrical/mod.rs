@@ -61,7 +61,7 @@ pub use solver::{
     ChargeCheckpoint, ChargeMoments, ChargeOptions, ChargeSolver, ElectricalSamples, PeriodStats,
     PowerSummary, SolverStats, power_curve, summarize,
 };
-pub use sweep::{LoadPoint, LoadSweep, load_sweep, log_spaced};
+pub use sweep::{LoadPoint, LoadSweep, best_load, check_resistances, load_sweep, log_spaced};
 pub use table::HarvesterTable;
 pub use transducer::{ContactSeparation, Freestanding, Transducer, TransducerState};
 pub use waveform::{GapWaveform, PwlGaps, PwlPiece};

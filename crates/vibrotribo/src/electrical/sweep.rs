@@ -60,24 +60,7 @@ pub fn load_sweep(
     transient: usize,
     options: &ChargeOptions,
 ) -> Result<LoadSweep, ElectricalError> {
-    if resistances.is_empty() {
-        return Err(ParamError::Length {
-            name: "sweep.resistances".into(),
-            expected: 1,
-            got: 0,
-        }
-        .into());
-    }
-    for (i, &r) in resistances.iter().enumerate() {
-        if !(r.is_finite() && r > 0.0) {
-            return Err(ParamError::Invalid {
-                name: format!("sweep.resistances[{i}]"),
-                value: r,
-                reason: "must be a positive resistance",
-            }
-            .into());
-        }
-    }
+    check_resistances(resistances)?;
     if trajectory.segments().is_empty() {
         return Err(ElectricalError::EmptyTrajectory);
     }
@@ -98,15 +81,55 @@ pub fn load_sweep(
             energy_per_period_j: s.energy_per_period_j,
         })
     };
+    best_load(resistances, evaluate)
+}
+
+/// Checks the resistances of a load sweep: at least one, each finite and positive (Ω).
+pub fn check_resistances(resistances: &[f64]) -> Result<(), ParamError> {
+    if resistances.is_empty() {
+        return Err(ParamError::Length {
+            name: "sweep.resistances".into(),
+            expected: 1,
+            got: 0,
+        });
+    }
+    for (i, &r) in resistances.iter().enumerate() {
+        if !(r.is_finite() && r > 0.0) {
+            return Err(ParamError::Invalid {
+                name: format!("sweep.resistances[{i}]"),
+                value: r,
+                reason: "must be a positive resistance",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The power at each of `resistances` (Ω, checked by [`check_resistances`]) as `evaluate`
+/// gives it, and the optimum: the best grid point refined by golden-section search in log R
+/// between its neighbours (relative precision 1e-3 in R). [`load_sweep`] evaluates a load by
+/// the charge along one recorded trajectory; a two-way coupled study by a whole coupled run.
+pub fn best_load<E: From<ParamError>>(
+    resistances: &[f64],
+    mut evaluate: impl FnMut(f64) -> Result<LoadPoint, E>,
+) -> Result<LoadSweep, E> {
+    check_resistances(resistances)?;
     let points = resistances
         .iter()
         .map(|&r| evaluate(r))
         .collect::<Result<Vec<_>, _>>()?;
     let mut sorted = points.clone();
     sorted.sort_by(|a, b| a.resistance_ohm.total_cmp(&b.resistance_ohm));
-    let best = (0..sorted.len())
-        .max_by(|&a, &b| sorted[a].average_power_w.total_cmp(&sorted[b].average_power_w))
-        .expect("non-empty");
+    let Some(best) =
+        (0..sorted.len()).max_by(|&a, &b| sorted[a].average_power_w.total_cmp(&sorted[b].average_power_w))
+    else {
+        return Err(ParamError::Length {
+            name: "sweep.resistances".into(),
+            expected: 1,
+            got: 0,
+        }
+        .into());
+    };
     if best == 0 || best + 1 == sorted.len() {
         return Ok(LoadSweep {
             points,

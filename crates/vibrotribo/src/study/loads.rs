@@ -1,13 +1,17 @@
-//! [`load_study`]: average power against the load resistance on one mechanical run (the
-//! coupling is one-way, so the mechanics is simulated once and replayed for every load), the
-//! optimal load, the power at the configured load, and V–Q cycles over the last period.
+//! [`load_study`]: average power against the load resistance, the optimal load, the power at
+//! the configured load, and V–Q cycles over the last period. Under one-way coupling the
+//! mechanics is simulated once and the charge replayed along it for every load; under
+//! two-way coupling (the charge acts on the masses) every load is a whole coupled run.
 
-use super::observer::RunObserver;
+use super::observer::{RunObserver, Sample};
 use super::replay::{ReplayOptions, record_trajectory, replay};
-use super::settings::{Harvester, RunSpec};
-use super::simulate::{Ending, StudyError};
+use super::settings::{Harvester, RunSpec, Sampling};
+use super::simulate::{Ending, StudyError, simulate};
+use crate::coupling::Coupling;
 use crate::electrical::breakdown::BreakdownMargin;
-use crate::electrical::{ElectricalSamples, HarvesterParams, Load, LoadSweep, load_sweep};
+use crate::electrical::{
+    ElectricalSamples, HarvesterParams, Load, LoadPoint, LoadSweep, best_load, load_sweep,
+};
 use crate::error::ParamError;
 use crate::{ChainParams, Trajectory};
 
@@ -72,6 +76,9 @@ pub fn load_study<O: RunObserver + ?Sized>(
         },
         ..Harvester::new(configured.params.clone(), configured.options.clone())
     };
+    if configured.params.coupling == Coupling::TwoWay {
+        return coupled_load_study(spec, options, observer, (configured_load_ohm, &resistor));
+    }
     let (trajectory, ending) = record_trajectory(spec, 0, observer)?;
     if ending != Ending::Completed {
         return Ok(None);
@@ -113,6 +120,131 @@ pub fn load_study<O: RunObserver + ?Sized>(
         configured_average_power_w,
         vq_cycles,
     }))
+}
+
+/// A coupled run of `spec` stopped by its observer (not a failure).
+enum Coupled {
+    Stopped,
+    Failed(StudyError),
+}
+
+impl From<ParamError> for Coupled {
+    fn from(e: ParamError) -> Self {
+        Coupled::Failed(e.into())
+    }
+}
+
+impl From<StudyError> for Coupled {
+    fn from(e: StudyError) -> Self {
+        Coupled::Failed(e)
+    }
+}
+
+/// [`load_study`] under two-way coupling: the charge acts on the masses, so every load is a
+/// whole coupled run of `spec` with that resistor (`resistor` gives the harvester), its power
+/// averaged after `spec.transient_periods` exactly as [`simulate`] reports it; the V–Q
+/// cycles are sampled from the coupled runs at the configured and the optimal load.
+fn coupled_load_study<O: RunObserver + ?Sized>(
+    spec: &RunSpec,
+    options: &LoadStudyOptions,
+    observer: &mut O,
+    (configured_load_ohm, resistor): (f64, &dyn Fn(f64) -> Harvester),
+) -> Result<Option<LoadStudy>, StudyError> {
+    let mut run = |r: f64| -> Result<LoadPoint, Coupled> {
+        let at = RunSpec {
+            harvester: Some(resistor(r)),
+            ..spec.clone()
+        };
+        let outcome = simulate(&at, &mut *observer)?;
+        match outcome.ending {
+            Ending::Completed => {}
+            Ending::Stopped => return Err(Coupled::Stopped),
+            Ending::Failed(e) => return Err(Coupled::Failed(e)),
+        }
+        let power = outcome.electrical.and_then(|e| e.power);
+        Ok(LoadPoint {
+            resistance_ohm: r,
+            average_power_w: power.as_ref().map_or(f64::NAN, |p| p.average_power_w),
+            energy_per_period_j: power.map_or(f64::NAN, |p| p.energy_per_period_j),
+        })
+    };
+    let outcome = best_load(&options.resistances, &mut run)
+        .and_then(|sweep| Ok((run(configured_load_ohm)?.average_power_w, sweep)));
+    let (configured_average_power_w, sweep) = match outcome {
+        Ok(found) => found,
+        Err(Coupled::Stopped) => return Ok(None),
+        Err(Coupled::Failed(e)) => return Err(e),
+    };
+    let mut vq_cycles = Vec::new();
+    if let Some(points) = options.vq_points {
+        for r in [configured_load_ohm, sweep.optimum.resistance_ohm] {
+            vq_cycles.push(coupled_vq_cycle(spec, &resistor(r), points)?);
+        }
+    }
+    Ok(Some(LoadStudy {
+        sweep,
+        configured_load_ohm,
+        configured_average_power_w,
+        vq_cycles,
+    }))
+}
+
+/// The V–Q cycle over the last period of a coupled run of `spec` with `harvester`, at
+/// `points + 1` times, and the air-breakdown check over that period.
+fn coupled_vq_cycle(spec: &RunSpec, harvester: &Harvester, points: usize) -> Result<VqCycle, StudyError> {
+    let period = spec.chain.period();
+    let last = spec.periods - 1;
+    let at = RunSpec {
+        harvester: Some(harvester.clone()),
+        transient_periods: last,
+        breakdown_check: true,
+        sampling: Some(Sampling::Uniform {
+            start: last as f64 * period,
+            step: period / points.max(1) as f64,
+        }),
+        ..spec.clone()
+    };
+    let mut cycle = VqSamples {
+        points: points as u64,
+        samples: ElectricalSamples::default(),
+    };
+    let outcome = simulate(&at, &mut cycle)?;
+    if let Ending::Failed(e) = outcome.ending {
+        return Err(e);
+    }
+    Ok(VqCycle {
+        load_resistance_ohm: harvester.params.load.resistance().unwrap_or(f64::NAN),
+        samples: cycle.samples,
+        breakdown: outcome.electrical.and_then(|e| e.breakdown).unwrap_or_default(),
+    })
+}
+
+/// Collects the electrical samples of the first `points + 1` grid times.
+struct VqSamples {
+    points: u64,
+    samples: ElectricalSamples,
+}
+
+impl RunObserver for VqSamples {
+    fn wants_samples(&self) -> bool {
+        true
+    }
+
+    fn sample(&mut self, sample: &Sample<'_>) {
+        let (Some(e), true) = (sample.electrical, sample.index <= self.points) else {
+            return;
+        };
+        let s = &mut self.samples;
+        s.times.push(sample.time);
+        s.charge_c.push(e.charge_c);
+        s.current_a.push(e.current_a);
+        s.voltage_v.push(e.voltage_v);
+        s.capacitance_f.push(e.capacitance_f);
+        s.voc_v.push(e.voc_v);
+        if let Some(v) = e.storage_voltage_v {
+            s.storage_voltage_v.push(v);
+        }
+    }
 }
 
 /// The V–Q cycle of period `index` at `points + 1` times of `harvester` along `trajectory`
@@ -183,5 +315,46 @@ mod tests {
         assert_eq!(study.configured_load_ohm, 1e5);
         assert_eq!(study.vq_cycles.len(), 2);
         assert_eq!(study.vq_cycles[0].samples.times.len(), 51);
+    }
+
+    /// Under two-way coupling each load is a whole coupled run: the load study's power at a
+    /// load is what a two-way simulation with that load reports, and not the one-way power
+    /// of the same load (the charge's force changes the motion); the V–Q cycle has its
+    /// points.
+    #[test]
+    fn two_way_loads_are_coupled_runs() {
+        let load = 1e10;
+        let harvester = |coupling| HarvesterParams {
+            load: Load::Resistor { resistance: load },
+            coupling,
+            voc_model: crate::electrical::VocModel::Exact,
+            ..HarvesterParams::default()
+        };
+        let spec = |coupling| RunSpec {
+            transient_periods: 10,
+            harvester: Some(Harvester::new(harvester(coupling), ChargeOptions::default())),
+            ..RunSpec::new(ChainParams::default(), 20)
+        };
+        let options = LoadStudyOptions {
+            resistances: vec![load],
+            vq_points: Some(20),
+        };
+        let two_way = spec(Coupling::TwoWay);
+        let study = load_study(&two_way, &options, &mut ()).unwrap().unwrap();
+        let direct = crate::study::simulate(&two_way, &mut ()).unwrap();
+        let want = direct.electrical.unwrap().power.unwrap().average_power_w;
+        let got = study.sweep.points[0].average_power_w;
+        assert_eq!(got, want, "load study {got} W vs two-way simulation {want} W");
+        assert_eq!(study.configured_average_power_w, want);
+        let one_way = load_study(&spec(Coupling::OneWay), &options, &mut ())
+            .unwrap()
+            .unwrap();
+        let p1 = one_way.sweep.points[0].average_power_w;
+        assert!(
+            (p1 - want).abs() > 1e-3 * want,
+            "two-way {want} W should differ from one-way {p1} W at {load} Ω"
+        );
+        assert_eq!(study.vq_cycles.len(), 2);
+        assert_eq!(study.vq_cycles[0].samples.times.len(), 21);
     }
 }

@@ -20,12 +20,15 @@ use super::settle::{AutoSettle, SettleEnding, SettleMode, settle};
 use super::simulate::{Ending, StudyError, simulate};
 use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, StroboscopicSection, detect_period};
 use crate::dynamics::{Event, EventKind, Observer, StateView};
-use crate::electrical::{ChargeOptions, HarvesterParams};
+use crate::electrical::{ChargeOptions, ElectricalError, HarvesterParams};
 use crate::error::SimError;
 use crate::excitation::BaseMotion;
 use crate::lyapunov::{LyapunovError, LyapunovObserver, LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
-use crate::orbits::{ShootingOptions, find_periodic_orbit};
+use crate::orbits::{OrbitError, ShootingOptions, find_periodic_orbit};
+
+/// The default of [`PointOptions::period_tolerance`], 1e-4 (relative).
+pub const DEFAULT_PERIOD_TOLERANCE: f64 = 1e-4;
 
 /// Settings of [`run_point`].
 #[derive(Debug, Clone, PartialEq)]
@@ -65,7 +68,7 @@ impl Default for PointOptions {
         PointOptions {
             transient_periods: 300,
             recorded_periods: 100,
-            period_tolerance: 1e-4,
+            period_tolerance: DEFAULT_PERIOD_TOLERANCE,
             grazing_ratio: 1e-3,
             electrical_warmup_periods: 20,
             floquet: false,
@@ -140,13 +143,13 @@ pub struct PointResult {
     /// charge solver succeeded.
     pub average_power_w: Option<f64>,
     /// Why the charge solver failed, if it did (the mechanics is still reported).
-    pub electrical_error: Option<String>,
+    pub electrical_error: Option<ElectricalError>,
     /// State at the end of the run (t = (transient + recorded)·T).
     pub final_state: ChainState,
     /// With [`PointOptions::floquet`] and a detected period: the largest modulus of the
     /// Floquet multipliers of the periodic orbit of that period found by shooting from the
     /// final state (`Err` with the reason where shooting failed, e.g. at a grazing point).
-    pub max_abs_multiplier: Option<Result<f64, String>>,
+    pub max_abs_multiplier: Option<Result<f64, OrbitError>>,
     /// The Lyapunov spectrum over the recorded periods, if [`PointOptions::lyapunov`] asked
     /// for it.
     pub lyapunov: Option<Result<LyapunovSpectrum, LyapunovError>>,
@@ -190,6 +193,10 @@ pub enum PointError {
     /// The run could not be set up (or failed otherwise).
     #[error(transparent)]
     Study(#[from] StudyError),
+    /// The stroboscopic section could not be set up (a chain without masses, a period that
+    /// is not positive and finite).
+    #[error(transparent)]
+    Analysis(#[from] crate::analysis::AnalysisError),
 }
 
 /// Records impacts after the transient and flags grazing.
@@ -429,8 +436,7 @@ fn record(
             phase_time: 0.0,
             transient_periods: transient + 1,
         },
-    )
-    .expect("valid stroboscopic options");
+    )?;
     let lyapunov = match lyapunov {
         Some(o) => Some(LyapunovObserver::new(params, transient, o).map_err(StudyError::from)?),
         None => None,
@@ -462,7 +468,7 @@ fn record(
     let (average_power_w, electrical_error) = match &outcome.electrical {
         Some(e) => match &e.power {
             Some(p) if e.solver_error.is_none() => (Some(p.average_power_w), None),
-            _ => (None, e.solver_error.as_ref().map(ToString::to_string)),
+            _ => (None, e.solver_error.clone()),
         },
         None => (None, None),
     };
@@ -486,7 +492,6 @@ fn record(
             },
         )
         .map(|o| o.spectral_radius())
-        .map_err(|e| e.to_string())
     });
     let grazing = impacts.grazing;
     let mut impacts = impacts.records;

@@ -43,7 +43,43 @@ impl SettleMode {
             SettleMode::Auto(_) => "auto",
         }
     }
+
+    /// This mode with at most `cap` periods before the recorded window if it is
+    /// [`SettleMode::Auto`].
+    pub fn with_cap(self, cap: u64) -> Self {
+        match self {
+            SettleMode::Auto(a) => SettleMode::Auto(AutoSettle {
+                cap_periods: cap,
+                ..a
+            }),
+            SettleMode::Fixed => SettleMode::Fixed,
+        }
+    }
 }
+
+impl std::str::FromStr for SettleMode {
+    type Err = UnknownSettleMode;
+
+    /// `auto` ([`SettleMode::Auto`] with the default [`AutoSettle`]) or `fixed`.
+    fn from_str(s: &str) -> Result<Self, UnknownSettleMode> {
+        match s {
+            "auto" => Ok(SettleMode::Auto(AutoSettle::default())),
+            "fixed" => Ok(SettleMode::Fixed),
+            other => Err(UnknownSettleMode(other.to_string())),
+        }
+    }
+}
+
+/// A settle mode's name is neither `auto` nor `fixed`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown settle mode {0:?}: expected auto or fixed")]
+pub struct UnknownSettleMode(
+    /// The name given.
+    pub String,
+);
+
+/// The default of [`AutoSettle::cap_periods`]: the most periods a point settles, 2000.
+pub const DEFAULT_SETTLE_CAP: u64 = 2000;
 
 /// Settings of [`SettleMode::Auto`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,7 +96,7 @@ pub struct AutoSettle {
 impl Default for AutoSettle {
     fn default() -> Self {
         AutoSettle {
-            cap_periods: 2000,
+            cap_periods: DEFAULT_SETTLE_CAP,
             block: 50,
             shoot: true,
         }
@@ -179,8 +215,7 @@ pub fn settle(
                 phase_time: 0.0,
                 transient_periods: 1,
             },
-        )
-        .expect("valid stroboscopic options");
+        )?;
         let mut watch = Mechanics::new(strobe);
         let outcome = simulate(&spec, &mut watch)?;
         match outcome.ending {

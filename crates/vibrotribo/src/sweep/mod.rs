@@ -5,10 +5,15 @@
 //! ([`SweepColumns`]). The command line and the Python package both run their sweeps and
 //! maps through here.
 
+mod request;
 mod runner;
 mod table;
 
+pub use request::{PointRequest, PointRequestError};
 pub use runner::{
     Continuation, Delivery, PointRunner, SweepError, grid, run_chunks, run_continued, run_grid, run_grid_on,
 };
-pub use table::{Column, MOTION_COLUMNS, MotionCells, SweepColumns, Table, error_text, point_columns};
+pub use table::{
+    Cell, Column, IMPACT_COLUMNS, Kind, LYAPUNOV_COLUMNS, MOTION_COLUMNS, PointColumns, SweepColumns, Table,
+    error_text, impact_rows, orbit_columns, orbit_rows, point_columns,
+};

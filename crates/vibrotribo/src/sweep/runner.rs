@@ -4,7 +4,7 @@ use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
-use crate::config::{Config, ConfigError};
+use crate::config::{Config, ConfigError, Param};
 use crate::model::ChainState;
 use crate::study::{PointError, PointOptions, PointResult, run_point_driven};
 
@@ -122,17 +122,34 @@ impl PointRunner {
         self.base.chain().contact_count()
     }
 
+    /// The parameter `key` of the base configuration ([`Param::new`]).
+    pub fn param(&self, key: &str) -> Result<Param, ConfigError> {
+        Param::new(&self.base, key)
+    }
+
     /// The base configuration with each `(key, value)` of `keys` set (validated).
     pub fn configure(&self, keys: &[(&str, f64)]) -> Result<Config, ConfigError> {
-        let mut config = self.base.clone();
-        config.set_all(keys.iter().map(|&(k, v)| (k, toml::Value::Float(v))))?;
-        Ok(config)
+        let params = keys
+            .iter()
+            .map(|&(k, v)| Ok((self.param(k)?, v)))
+            .collect::<Result<Vec<_>, ConfigError>>()?;
+        let values: Vec<(&Param, f64)> = params.iter().map(|(p, v)| (p, *v)).collect();
+        self.base.with_values(&values)
     }
 
     /// Runs the configuration with `keys` set, from `initial` (if it fits the chain) or the
     /// configured initial state.
     pub fn run(&self, keys: &[(&str, f64)], initial: Option<&ChainState>) -> Result<PointResult, SweepError> {
         self.run_config(&self.configure(keys)?, initial)
+    }
+
+    /// Runs the configuration with the parameters of `values` set (see [`run`](Self::run)).
+    pub fn run_values(
+        &self,
+        values: &[(&Param, f64)],
+        initial: Option<&ChainState>,
+    ) -> Result<PointResult, SweepError> {
+        self.run_config(&self.base.with_values(values)?, initial)
     }
 
     /// Runs `config` (one of [`configure`](Self::configure)'s) with this runner's point
@@ -264,9 +281,10 @@ where
         Option<&ChainState>,
     ) -> Result<ControlFlow<()>, SweepError>,
 {
+    let param = runner.param(key)?;
     let mut done = 0;
     for &j in order {
-        let r = runner.run(&[(key, values[j])], state.as_ref());
+        let r = runner.run_values(&[(&param, values[j])], state.as_ref());
         if let Ok(p) = &r {
             state = Some(p.final_state.clone());
         }
