@@ -30,7 +30,7 @@ MOTIONS = {
     ),
     "record": (
         f'kind = "record"\nfile = "{RECORD}"\nquantity = "acceleration"\npeak_acceleration = 9.8\n',
-        "start_relative_to_base = true\n",
+        "",
     ),
 }
 MODELS = {

@@ -35,7 +35,7 @@ fn motions(record: &Path) -> Vec<(&'static str, String, &'static str)> {
                 "kind = \"record\"\nfile = \"{}\"\nquantity = \"acceleration\"\npeak_acceleration = 9.8\n",
                 record.display()
             ),
-            "start_relative_to_base = true\n",
+            "",
         ),
     ]
 }
