@@ -192,6 +192,10 @@ pub enum SimError {
     /// An observer failed the run (see [`Observer::proceed`](crate::Observer::proceed)).
     #[error("{0}")]
     Observer(String),
+    /// The base motion cannot drive this chain or this run (the combination and the reason
+    /// named).
+    #[error("base motion: {0}")]
+    BaseMotion(crate::excitation::BaseMotionError),
     /// A requested time lies before the current simulation time.
     #[error("cannot run backwards: requested t = {requested} s, current t = {current} s")]
     Backwards {
@@ -200,4 +204,12 @@ pub enum SimError {
         /// Current time, s.
         current: f64,
     },
+}
+
+// Not `#[from]`: that would also make the inner error the `source()`, which the message
+// already shows.
+impl From<crate::excitation::BaseMotionError> for SimError {
+    fn from(e: crate::excitation::BaseMotionError) -> Self {
+        SimError::BaseMotion(e)
+    }
 }

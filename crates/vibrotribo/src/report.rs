@@ -151,13 +151,14 @@ pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String
     let on_pieces = "exact per-interval forces k_i y + c_i y' of degree-7 Chebyshev interpolants of the \
                      harmonics' displacement and velocity (a closed-form multisine in the engine is a later step)";
     let run_as = match &**b {
-        BaseMotion::Harmonics(h) if crate::study::as_chain_harmonic(h, &spec.chain).is_some() => {
+        BaseMotion::Harmonics(h) if crate::dynamics::as_chain_harmonic(h, &spec.chain).is_some() => {
             "the harmonic excitation A sin ωt (closed form)".to_string()
         }
         BaseMotion::Harmonics(h) => {
-            // The pieces of a multisine are built for the run's length (BaseDrive).
+            // The pieces of a multisine are built for the run's length (as the engine does).
             let end = (spec.periods as f64 * spec.chain.period()).max(spec.chain.period());
-            if let Ok(a) = crate::excitation::piece_accuracy(h, end, crate::study::multisine_tolerance(h)) {
+            if let Ok(a) = crate::excitation::piece_accuracy(h, end, crate::dynamics::multisine_tolerance(h))
+            {
                 out.extend(crate::excitation::pieces_summary(&a));
             }
             on_pieces.to_string()

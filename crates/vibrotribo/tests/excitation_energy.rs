@@ -67,13 +67,15 @@
 use std::f64::consts::TAU;
 
 use vibrotribo::config::Config;
+use vibrotribo::dynamics::driven_chain;
 use vibrotribo::excitation::{HarmonicPieces, PiecewiseCubic};
-use vibrotribo::study::{BaseDrive, RunObserver, RunSpec, driven_chain, simulate};
+use vibrotribo::study::{RunObserver, RunSpec, simulate};
 use vibrotribo::{
     ChainParams, Event, EventKind, Flow, ForcePolynomial, Observer, RunEnd, Simulator, StateView,
 };
 
 mod common;
+use common::base_motion::Base;
 use common::quadrature::{Sum, gauss_legendre};
 
 /// Relative tolerance of the balance (of Σ|terms|), as the issue states it.
@@ -81,74 +83,6 @@ const TOLERANCE: f64 = 1e-8;
 
 /// Gauss–Legendre nodes per quadrature interval.
 const NODES: usize = 12;
-
-/// The base displacement as this test evaluates it.
-enum Base<'a> {
-    /// y = A sin ωt (the chain's own harmonic).
-    Sine { amplitude: f64, omega: f64 },
-    /// The spline the engine is driven by.
-    Spline(&'a PiecewiseCubic),
-    /// The piecewise polynomials the engine is driven by (a random signal's harmonics).
-    Pieces(&'a HarmonicPieces),
-}
-
-impl Base<'_> {
-    /// y (m) and y' (m/s) at `t` on the spline's interval `piece` (ignored for a sine).
-    fn at(&self, t: f64, piece: usize) -> (f64, f64) {
-        match self {
-            Base::Sine { amplitude, omega } => {
-                let (s, c) = (omega * t).sin_cos();
-                (amplitude * s, amplitude * omega * c)
-            }
-            Base::Spline(s) => {
-                let (t0, [c0, c1, c2, c3]) = s.piece(piece);
-                let x = t - t0;
-                (
-                    c0 + x * (c1 + x * (c2 + x * c3)),
-                    c1 + x * (2.0 * c2 + 3.0 * x * c3),
-                )
-            }
-            Base::Pieces(p) => {
-                let (mid, y, v) = p.piece(piece);
-                let x = t - mid;
-                let horner = |c: &[f64]| c.iter().rev().fold(0.0, |acc, &k| acc * x + k);
-                (horner(y), horner(v))
-            }
-        }
-    }
-
-    /// y and y' at `t` (continuous across knots).
-    fn value(&self, t: f64) -> (f64, f64) {
-        match self {
-            Base::Sine { .. } => self.at(t, 0),
-            Base::Spline(s) => self.at(t, s.interval(t)),
-            Base::Pieces(p) => self.at(t, p.interval(t)),
-        }
-    }
-
-    /// `[a, b]` split at the knots strictly inside it, each part with its spline interval.
-    fn parts(&self, a: f64, b: f64) -> Vec<(f64, f64, usize)> {
-        match self {
-            Base::Sine { .. } => vec![(a, b, 0)],
-            Base::Spline(_) | Base::Pieces(_) => {
-                let (knots, mut i) = match self {
-                    Base::Spline(s) => (s.knots(), s.interval(a)),
-                    Base::Pieces(p) => (p.knots(), p.interval(a)),
-                    Base::Sine { .. } => unreachable!(),
-                };
-                let mut out = Vec::new();
-                let mut from = a;
-                while i + 1 < knots.len() - 1 && knots[i + 1] < b {
-                    out.push((from, knots[i + 1], i));
-                    from = knots[i + 1];
-                    i += 1;
-                }
-                out.push((from, b, i));
-                out
-            }
-        }
-    }
-}
 
 /// A state of the chain at one time.
 #[derive(Debug, Clone)]
@@ -514,9 +448,17 @@ fn random_case(name: &str, text: &str, f_high_hz: f64) -> Report {
     // interval interpolates on its own), so the spring energy ½k(x − y)² jumps there by up
     // to k|x − y|·2e_y without work: with e_y ~ 1e-11 m that adds ~1e-12 of the terms,
     // still far inside the tolerance.
-    let (_, drive) = BaseDrive::new(&spec).unwrap();
-    let pieces = drive
-        .spline()
+    let end = spec.periods as f64 * spec.chain.period();
+    let sim = Simulator::driven(
+        &spec.chain,
+        &spec.initial,
+        spec.options.clone(),
+        spec.base_motion.as_ref(),
+        end,
+    )
+    .unwrap();
+    let pieces = sim
+        .base_displacement()
         .and_then(|b| b.pieces())
         .expect("a random signal runs on piecewise polynomials");
     let intervals = pieces.knots().len() - 1;
@@ -603,7 +545,7 @@ fn energy_balance_harmonic_controls() {
 /// How the drive of [`own_drive`] departs from the exact interval forces.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Tamper {
-    /// None: the forces k_i y + c_i y' of every interval (what `study::BaseDrive` does).
+    /// None: the forces k_i y + c_i y' of every interval (what `Simulator::driven` does).
     Faithful,
     /// Interval j gets no base force at all.
     Dropped(usize),
@@ -615,7 +557,7 @@ enum Tamper {
 /// Drives a [`Simulator`] on the chain of `spec` (harmonic amplitude 0) with the forces
 /// k_i y + c_i y' of each interval of `spline`, set at its knots, tampered as `tamper` says.
 fn own_drive(spec: &RunSpec, spline: &PiecewiseCubic, tamper: Tamper, obs: &mut Balance<'_>) {
-    let chain = driven_chain(spec).into_owned();
+    let chain = driven_chain(&spec.chain, spec.base_motion.as_deref()).into_owned();
     assert_eq!(chain.excitation.amplitude, 0.0);
     let mut sim = Simulator::new(&chain, &spec.initial, spec.options.clone()).unwrap();
     let t_end = spec.periods as f64 * chain.period();

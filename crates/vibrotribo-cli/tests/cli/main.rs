@@ -3,6 +3,7 @@
 
 mod basins;
 mod chirp;
+mod composition;
 mod excitation;
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_motion_classified;

@@ -451,7 +451,9 @@ impl Config {
     pub fn is_periodic(&self) -> bool {
         match (self.excitation.kind(), self.base.as_deref()) {
             (ExcitationKind::Harmonic, _) => true,
-            (_, Some(BaseMotion::Harmonics(h))) => crate::study::as_chain_harmonic(h, &self.chain).is_some(),
+            (_, Some(BaseMotion::Harmonics(h))) => {
+                crate::dynamics::as_chain_harmonic(h, &self.chain).is_some()
+            }
             _ => false,
         }
     }
@@ -478,7 +480,7 @@ impl Config {
             return Ok(());
         };
         let kind = self.excitation.kind().as_str();
-        crate::study::check_base_motion(&self.chain, base)
+        crate::dynamics::check_base_motion(&self.chain, base)
             .map_err(|m| ConfigError::Unsupported(format!("excitation kind {kind}: {m}")))?;
         if let Some(end) = base.end() {
             let run_end = self.run.periods as f64 * self.chain.period();

@@ -1,6 +1,8 @@
 //! The external forces on the masses as the simulator applies them: the constant forces of
-//! [`ChainParams::forces`] and the time polynomials of
-//! [`Simulator::set_external_forces`](super::Simulator::set_external_forces).
+//! [`ChainParams::forces`], the time polynomials of
+//! [`Simulator::set_external_forces`](super::Simulator::set_external_forces), and those of a
+//! base motion other than the chain's harmonic ([`super::base`]); the two kinds of
+//! polynomials add.
 //!
 //! In the closed form of a cluster (`M s'' + C s' + K s = F₀ + C y' + K y + f(t)`, see
 //! [`super::oscillator`]) the constant forces join F₀ (so the static offset F₀/K takes them),
@@ -17,8 +19,14 @@ use crate::model::{ChainParams, ForcePolynomial};
 pub(crate) struct ExternalForces {
     /// Constant force on each mass, N; empty for none.
     constant: Vec<f64>,
-    /// Polynomial force on each mass, N, all about one reference time; empty for none.
+    /// Polynomial force on each mass, N, all about one reference time; empty for none: the
+    /// sum of `user` and `base`.
     poly: Vec<Poly>,
+    /// The polynomials set by the caller ([`set_polynomials`](Self::set_polynomials)); empty
+    /// for none.
+    user: Vec<Poly>,
+    /// The polynomials of the base motion ([`set_base`](Self::set_base)); empty for none.
+    base: Vec<Poly>,
 }
 
 impl ExternalForces {
@@ -27,6 +35,8 @@ impl ExternalForces {
         ExternalForces {
             constant: params.forces.clone(),
             poly: Vec::new(),
+            user: Vec::new(),
+            base: Vec::new(),
         }
     }
 
@@ -41,6 +51,8 @@ impl ExternalForces {
     pub fn assign_from(&mut self, other: &ExternalForces) {
         self.constant.clone_from(&other.constant);
         self.poly.clone_from(&other.poly);
+        self.user.clone_from(&other.user);
+        self.base.clone_from(&other.base);
     }
 
     /// Whether time polynomials are set.
@@ -49,14 +61,30 @@ impl ExternalForces {
         !self.poly.is_empty()
     }
 
-    /// Replaces the polynomial forces by `forces` (one per mass of `n`, or none), each taken
-    /// about the common reference time `t_ref`, s. On an error nothing changes.
+    /// Replaces the caller's polynomial forces by `forces` (one per mass of `n`, or none),
+    /// each taken about the time `t_ref`, s, where they are summed with the base motion's.
+    /// On an error nothing changes.
     pub fn set_polynomials(
         &mut self,
         forces: &[ForcePolynomial],
         n: usize,
         t_ref: f64,
     ) -> Result<(), SimError> {
+        Self::load(&mut self.user, forces, n, t_ref)?;
+        self.combine(t_ref);
+        Ok(())
+    }
+
+    /// Replaces the base motion's polynomial forces by `forces` (one per mass of `n`, or
+    /// none), as [`set_polynomials`](Self::set_polynomials).
+    pub fn set_base(&mut self, forces: &[ForcePolynomial], n: usize, t_ref: f64) -> Result<(), SimError> {
+        Self::load(&mut self.base, forces, n, t_ref)?;
+        self.combine(t_ref);
+        Ok(())
+    }
+
+    /// Validates `forces` and stores them in `layer` about `t_ref` (cleared if all are zero).
+    fn load(layer: &mut Vec<Poly>, forces: &[ForcePolynomial], n: usize, t_ref: f64) -> Result<(), SimError> {
         if !forces.is_empty() && forces.len() != n {
             return Err(ParamError::Length {
                 name: "forces".into(),
@@ -70,16 +98,33 @@ impl ExternalForces {
                 f.validate(&format!("forces[{i}]"))?;
             }
         }
-        self.poly.clear();
-        self.poly.extend(
+        layer.clear();
+        layer.extend(
             forces
                 .iter()
                 .map(|f| Poly::new(f.t_ref, &f.coefficients).shifted(t_ref)),
         );
-        if self.poly.iter().all(Poly::is_zero) {
-            self.poly.clear();
+        if layer.iter().all(Poly::is_zero) {
+            layer.clear();
         }
         Ok(())
+    }
+
+    /// The applied polynomials: one layer as it is, or both summed about `t`, s.
+    fn combine(&mut self, t: f64) {
+        self.poly.clear();
+        match (self.user.is_empty(), self.base.is_empty()) {
+            (true, true) => {}
+            (false, true) => self.poly.extend_from_slice(&self.user),
+            (true, false) => self.poly.extend_from_slice(&self.base),
+            (false, false) => {
+                for (u, b) in self.user.iter().zip(&self.base) {
+                    let mut p = u.shifted(t);
+                    p.add_scaled(&b.shifted(t), 1.0);
+                    self.poly.push(p);
+                }
+            }
+        }
     }
 
     /// Σ of the constant forces on masses `first..=last`, N.

@@ -4,6 +4,7 @@
 //! Entry point: [`Simulator`]. Output goes to an [`Observer`]; ready-made observers are
 //! [`EventLog`], [`Trajectory`] (dense output at any time) and [`UniformSampler`].
 
+mod base;
 mod contact;
 mod forces;
 mod observer;
@@ -17,6 +18,10 @@ mod signal;
 mod simulator;
 mod taylor;
 
+pub use base::{
+    BaseDisplacement, MULTISINE_RELATIVE_TOLERANCE, as_chain_harmonic, check_base_motion, driven_chain,
+    is_chain_harmonic, multisine_tolerance,
+};
 pub use observer::{
     ClusterFlow, Event, EventKind, EventLog, Flow, LoggedEvent, Observer, ObserverError, Segment, StateView,
     Trajectory, UniformSampler, Verdict,

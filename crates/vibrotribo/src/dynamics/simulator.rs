@@ -13,11 +13,15 @@
 
 use std::ops::ControlFlow;
 
+use std::sync::Arc;
+
+use super::base::{BaseDisplacement, BaseDrive, driven_chain};
 use super::contact::Closure;
 use super::forces::ExternalForces;
 use super::observer::{ClusterFlow, Event, EventKind, Flow, Observer, StateView};
 use super::oscillator::{Forcing, OscConstants, Oscillator, Phase};
 use crate::error::{ParamError, SimError};
+use crate::excitation::BaseMotion;
 use crate::model::{ChainParams, ChainState, ForcePolynomial, SimOptions};
 
 /// How [`Simulator::run_until`] ended.
@@ -132,6 +136,9 @@ pub struct Simulator {
     /// default). A caller that installs new forces before every run (which rebuilds anyway)
     /// turns it off: the flows stay valid past a stop, anchored where they started.
     rebuild_at_stops: bool,
+    /// The interval forces of a base motion other than the chain's harmonic (`None`: the
+    /// chain's harmonic drives the base).
+    drive: Option<BaseDrive>,
 }
 
 /// A touch found at the start of a search that changes nothing moves that contact's next
@@ -203,6 +210,7 @@ impl Simulator {
             search_from: vec![f64::NEG_INFINITY; nc],
             scratch_racers: Vec::with_capacity(nc),
             rebuild_at_stops: true,
+            drive: None,
         };
         sim.refresh_tolerances();
         // Start with closed contacts where the masses touch with equal velocity and press.
@@ -210,6 +218,56 @@ impl Simulator {
         sim.scratch_events.clear();
         sim.rebuild()?;
         Ok(sim)
+    }
+
+    /// A simulator at time 0 in `initial` state with its base moving as `base` (`None`: the
+    /// chain's own harmonic `A sin ωt`) over `[0, end]`, s: the chain's harmonic amplitude
+    /// is that of a one-harmonic multisine that is exactly the chain's harmonic, and 0 under
+    /// any other motion, which drives the masses as the forces `k_i y + c_i y'` of each of
+    /// its intervals. Forces set with
+    /// [`set_external_forces`](Self::set_external_forces) add to these.
+    ///
+    /// Errors ([`SimError::BaseMotion`]) if `base` cannot drive `params` (rigid stops moving
+    /// with the base under another motion) or ends before `end`; otherwise as
+    /// [`new`](Self::new).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use vibrotribo::excitation::{BaseMotion, Harmonic};
+    /// use vibrotribo::{ChainParams, ChainState, EventLog, SimOptions, Simulator};
+    ///
+    /// let params = ChainParams::default();
+    /// let w = params.omega();
+    /// // Two harmonics: the chain's own and a third of it at 1.5 ω.
+    /// let base = Arc::new(BaseMotion::Harmonics(vec![
+    ///     Harmonic { amplitude: params.excitation.amplitude, omega: w, phase: 0.0 },
+    ///     Harmonic { amplitude: params.excitation.amplitude / 3.0, omega: 1.5 * w, phase: 0.3 },
+    /// ]));
+    /// let end = 5.0 * params.period();
+    /// let mut sim = Simulator::driven(&params, &ChainState::at_rest(3), SimOptions::default(), Some(&base), end)?;
+    /// sim.run_until(end, &mut EventLog::default())?;
+    /// # Ok::<(), vibrotribo::SimError>(())
+    /// ```
+    pub fn driven(
+        params: &ChainParams,
+        initial: &ChainState,
+        options: SimOptions,
+        base: Option<&Arc<BaseMotion>>,
+        end: f64,
+    ) -> Result<Self, SimError> {
+        let Some(base) = base else {
+            return Self::new(params, initial, options);
+        };
+        let drive = BaseDrive::new(params, base, end)?;
+        let mut sim = Self::new(&driven_chain(params, Some(base)), initial, options)?;
+        sim.drive = drive;
+        Ok(sim)
+    }
+
+    /// The base displacement the engine runs on as interval forces (`None`: the chain's
+    /// harmonic drives the base).
+    pub fn base_displacement(&self) -> Option<&BaseDisplacement> {
+        self.drive.as_ref().map(BaseDrive::displacement)
     }
 
     /// Current time, s.
@@ -258,6 +316,7 @@ impl Simulator {
             // Scratch of the event search, empty between searches: nothing to copy.
             scratch_racers: _,
             rebuild_at_stops,
+            drive,
         } = other;
         self.params = params.clone();
         self.options = options.clone();
@@ -288,6 +347,10 @@ impl Simulator {
         self.scratch_resting.clone_from(scratch_resting);
         self.search_from.clone_from(search_from);
         self.rebuild_at_stops = *rebuild_at_stops;
+        match (&mut self.drive, drive) {
+            (Some(mine), Some(theirs)) => mine.assign_from(theirs),
+            (mine, theirs) => mine.clone_from(theirs),
+        }
     }
 
     /// Whether [`run_until`](Self::run_until) re-anchors the flows where it stops without an
@@ -319,7 +382,8 @@ impl Simulator {
 
     /// Sets time-polynomial external forces on the masses from the current time on, until the
     /// next call: mass i feels `forces[i]` (N, positive along x, docs/MODEL.md) on top of its
-    /// constant force [`ChainParams::forces`]. One polynomial per mass, of degree at most
+    /// constant force [`ChainParams::forces`] and of the forces of a base motion
+    /// ([`driven`](Self::driven)). One polynomial per mass, of degree at most
     /// [`MAX_FORCE_DEGREE`](crate::model::MAX_FORCE_DEGREE), or none (an empty slice) to
     /// return to the constant forces only. The polynomials are meant to be evaluated from
     /// [`time`](Self::time) on; a later [`run_until`](Self::run_until) follows them exactly.
@@ -393,12 +457,43 @@ impl Simulator {
     }
 
     /// Runs to time `t_end`, s, reporting flow and events to `observer`, which may stop the run
-    /// early or fail it ([`Observer::proceed`]).
+    /// early or fail it ([`Observer::proceed`]). Under a base motion other than the chain's
+    /// harmonic the run stops at every interval end of the motion and sets the next
+    /// interval's forces there (no event, no observer call).
     pub fn run_until<O: Observer + ?Sized>(
         &mut self,
         t_end: f64,
         observer: &mut O,
     ) -> Result<RunEnd, SimError> {
+        if self.drive.is_none() {
+            return self.run_span(t_end, observer);
+        }
+        let n = self.x.len();
+        loop {
+            let t = self.t;
+            let Some(drive) = self.drive.as_mut() else {
+                return self.run_span(t_end, observer);
+            };
+            let (forces, stop) = drive.at(t, t_end);
+            let changed = match forces {
+                Some(f) => {
+                    self.forces.set_base(f, n, t)?;
+                    true
+                }
+                None => false,
+            };
+            if changed {
+                self.rebuild()?;
+            }
+            match self.run_span(stop, observer)? {
+                RunEnd::Reached if stop < t_end => {}
+                end => return Ok(end),
+            }
+        }
+    }
+
+    /// [`run_until`](Self::run_until) on one stretch of the base forces.
+    fn run_span<O: Observer + ?Sized>(&mut self, t_end: f64, observer: &mut O) -> Result<RunEnd, SimError> {
         if t_end.is_nan() || t_end < self.t {
             return Err(SimError::Backwards {
                 requested: t_end,

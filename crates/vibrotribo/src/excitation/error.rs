@@ -40,3 +40,41 @@ pub enum SignalError {
     #[error("{0}")]
     TooLarge(String),
 }
+
+/// Why a base motion cannot drive a run: the combination named and the reason.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum BaseMotionError {
+    /// Rigid stops with `frame = "base"` move as the chain's harmonic `A sin ωt`; they
+    /// cannot follow another base motion.
+    #[error(
+        "rigid stops with frame = \"base\" move as the harmonic A sin ωt: they cannot \
+         follow a non-harmonic base motion (use frame = \"fixed\", or kind = \"harmonic\")"
+    )]
+    MovingStops {
+        /// The kind of base motion (`"multisine"`, `"chirp"`, `"random"`, `"record"`).
+        kind: &'static str,
+    },
+    /// The base motion is defined on `[0, end]` and the run goes beyond it.
+    #[error("the base motion ends at t = {end} s, before the run's end at {run_end} s")]
+    EndsEarly {
+        /// The kind of base motion.
+        kind: &'static str,
+        /// Where the motion ends, s.
+        end: f64,
+        /// Where the run ends, s.
+        run_end: f64,
+    },
+    /// The multisine could not be turned into the piecewise polynomials the engine runs on.
+    #[error("multisine: {0}")]
+    Multisine(SignalError),
+    /// A study that needs a periodic base motion (Floquet multipliers, periodic orbits) was
+    /// asked of one that is not periodic with the reference period T.
+    #[error("{what} need a base motion periodic with the reference period T; this one ({kind}) is not")]
+    NotPeriodic {
+        /// What was asked.
+        what: &'static str,
+        /// The kind of base motion.
+        kind: &'static str,
+    },
+}

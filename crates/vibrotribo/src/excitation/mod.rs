@@ -1,5 +1,5 @@
-//! Base motion beyond one sine (issue 14): the signal side. The engine side, which runs
-//! these motions exactly, is [`BaseDrive`](crate::study::BaseDrive).
+//! Base motion beyond one sine: the signal side. The engine runs these motions exactly
+//! ([`Simulator::driven`](crate::Simulator::driven)).
 //!
 //! The chain's base moves as y(t) (m); mass i feels it through its spring and damper, the
 //! force k_i y + c_i y'. Today's engine drives it with `y = A sin ωt`
@@ -34,7 +34,7 @@ mod spline;
 use std::sync::Arc;
 
 pub use chirp::{Chirp, Sweep};
-pub use error::SignalError;
+pub use error::{BaseMotionError, SignalError};
 pub use harmonics::{
     Harmonic, MAX_KNOTS, SplineAccuracy, evaluate_sum, fourth_derivative_bound, harmonics_to_spline,
 };
@@ -226,6 +226,18 @@ pub enum BaseMotion {
 }
 
 impl BaseMotion {
+    /// The kind of motion as a configuration names it: `multisine` for a sum of harmonics
+    /// (the harmonic kind when it is the chain's own sine), `chirp` or `record` for a spline
+    /// (a record carries its report), `random` for pieces.
+    pub fn kind(&self) -> ExcitationKind {
+        match self {
+            BaseMotion::Harmonics(_) => ExcitationKind::Multisine,
+            BaseMotion::Spline(s) if s.record.is_some() => ExcitationKind::Record,
+            BaseMotion::Spline(_) => ExcitationKind::Chirp,
+            BaseMotion::Pieces(_) => ExcitationKind::Random,
+        }
+    }
+
     /// Displacement (m), velocity (m/s) and acceleration (m/s²) of the base at `t` (s).
     pub fn evaluate(&self, t: f64) -> [f64; 3] {
         match self {

@@ -4,7 +4,7 @@
 //! the interpolation remainder as a stated bound.
 //!
 //! The engine takes the base motion as the forces `k_i y + c_i y'` on the masses, one
-//! polynomial per interval ([`BaseDrive`](crate::study::BaseDrive)); every interval end
+//! polynomial per interval ([`Simulator::driven`](crate::Simulator::driven)); every interval end
 //! restarts the event search, so the fewer the intervals the faster the run. A cubic spline
 //! within 1e-10 of a sinusoid needs ~1500 knots per cycle; degree-7 interpolants need about
 //! 8, because the remainder of interpolation at the n + 1 = 8 Chebyshev points (roots of

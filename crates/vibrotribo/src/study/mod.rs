@@ -6,7 +6,6 @@
 //! the charge solver and the statistics together itself.
 
 mod chirp;
-mod drive;
 mod loads;
 mod lyapunov;
 mod motion;
@@ -23,10 +22,6 @@ mod simulate;
 pub use chirp::{
     ChirpError, ChirpOptions, ChirpRun, ChirpStudy, Cycle, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE,
     Direction, Jump, MIN_CYCLES, check_options, chirp_config, chirp_study, largest_jump, run_chirp,
-};
-pub use drive::{
-    BaseDisplacement, BaseDrive, MULTISINE_RELATIVE_TOLERANCE, as_chain_harmonic, check_base_motion,
-    driven_chain, multisine_tolerance,
 };
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};

@@ -22,7 +22,7 @@ use crate::analysis::{PeriodOptions, Periodicity, StroboscopicOptions, Strobosco
 use crate::dynamics::{Event, EventKind, Observer, StateView};
 use crate::electrical::{ChargeOptions, ElectricalError, HarvesterParams};
 use crate::error::SimError;
-use crate::excitation::BaseMotion;
+use crate::excitation::{BaseMotion, BaseMotionError};
 use crate::lyapunov::{LyapunovError, LyapunovObserver, LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::orbits::{OrbitError, ShootingOptions, find_periodic_orbit};
@@ -365,16 +365,19 @@ pub fn run_point_driven(
         return run_point(params, initial, sim_options, harvester, options);
     };
     if let BaseMotion::Harmonics(h) = &**base
-        && let Some(a) = super::drive::as_chain_harmonic(h, params)
+        && let Some(a) = crate::dynamics::as_chain_harmonic(h, params)
     {
         let mut chain = params.clone();
         chain.excitation.amplitude = a;
         return run_point(&chain, initial, sim_options, harvester, options);
     }
-    let refuse = |what: &str| {
-        Err(PointError::Study(StudyError::BaseMotion(format!(
-            "{what} need a base motion periodic with the reference period T; this one is not"
-        ))))
+    let refuse = |what: &'static str| {
+        Err(PointError::Study(StudyError::BaseMotion(
+            BaseMotionError::NotPeriodic {
+                what,
+                kind: base.kind().as_str(),
+            },
+        )))
     };
     if options.floquet {
         return refuse("Floquet multipliers");

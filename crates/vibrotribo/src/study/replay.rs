@@ -25,7 +25,13 @@ pub fn record_trajectory<O: RunObserver + ?Sized>(
     };
     let from = from_period as f64 * spec.chain.period();
     let mut rec = (
-        Mechanics::starting_at(Trajectory::for_chain(&super::drive::driven_chain(spec)), from),
+        Mechanics::starting_at(
+            Trajectory::for_chain(&crate::dynamics::driven_chain(
+                &spec.chain,
+                spec.base_motion.as_deref(),
+            )),
+            from,
+        ),
         observer,
     );
     let outcome = simulate(&mechanics, &mut rec)?;

@@ -155,7 +155,7 @@ pub struct RunSpec {
     /// Check the air gaps for breakdown from the end of the transient on (needs a harvester).
     pub breakdown_check: bool,
     /// The base motion when it is not the chain's own `A sin ωt` (`None`: the chain's
-    /// harmonic), run by [`BaseDrive`](super::BaseDrive).
+    /// harmonic), run by the engine ([`Simulator::driven`](crate::Simulator::driven)).
     pub base_motion: Option<std::sync::Arc<crate::excitation::BaseMotion>>,
 }
 

@@ -10,12 +10,14 @@ use super::observer::{ElectricalSample, RunObserver, Sample};
 use super::settings::{ElectricalFailure, RunSpec, Sampling};
 use crate::analysis::RunStats;
 use crate::coupling::{ChargeHost, CoupledChain, Coupling, CouplingError, CouplingOptions, CouplingStats};
+use crate::dynamics::{BaseDisplacement, driven_chain};
 use crate::dynamics::{Event, Flow, Observer, RunEnd, Simulator, StateView, Verdict};
 use crate::electrical::breakdown::BreakdownMargin;
 use crate::electrical::{
     ChargeSolver, ElectricalError, ElectricalSamples, PeriodStats, PowerSummary, SolverStats, power_curve,
 };
 use crate::error::{ParamError, SimError};
+use crate::excitation::BaseMotionError;
 use crate::model::ChainState;
 
 /// A run could not be carried out, or failed on the way.
@@ -31,9 +33,10 @@ pub enum StudyError {
     /// The charge solver stopped.
     #[error("charge solver: {0}")]
     Electrical(ElectricalError),
-    /// The base motion cannot drive this run (the reason named).
+    /// The base motion cannot drive this run, or not this study (the combination and the
+    /// reason named).
     #[error("base motion: {0}")]
-    BaseMotion(String),
+    BaseMotion(BaseMotionError),
 }
 
 /// How a run ended.
@@ -150,10 +153,19 @@ impl RunOutcome {
 /// # Ok::<(), vibrotribo::study::StudyError>(())
 /// ```
 pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Result<RunOutcome, StudyError> {
-    let (chain, mut drive) = super::drive::BaseDrive::new(spec)?;
+    let end = spec.periods as f64 * spec.chain.period();
+    let sim = Simulator::driven(
+        &spec.chain,
+        &spec.initial,
+        spec.options.clone(),
+        spec.base_motion.as_ref(),
+        end,
+    )
+    .map_err(StudyError::from_sim)?;
+    let base = sim.base_displacement().cloned();
+    let chain = driven_chain(&spec.chain, spec.base_motion.as_deref());
     let chain = &*chain;
     let period = chain.period();
-    let sim = Simulator::new(chain, &spec.initial, spec.options.clone())?;
     let transient_time = spec.transient_periods as f64 * period;
     let solver = match &spec.harvester {
         Some(h) => {
@@ -174,7 +186,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
     };
     let samples = match spec.sampling {
         Some(grid) if observer.wants_samples() => Some(SampleGrid {
-            base: drive.spline().cloned(),
+            base,
             ..SampleGrid::new(grid, period, chain)
         }),
         _ => None,
@@ -201,15 +213,6 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
         .harvester
         .as_ref()
         .filter(|h| h.params.coupling == Coupling::TwoWay);
-    if two_way.is_some() && drive.spline().is_some() {
-        // Both would set the engine's external forces; combining them is not built yet.
-        return Err(StudyError::Param(ParamError::Conflict {
-            name: "harvester.coupling".into(),
-            message: "two-way coupling runs with harmonic base motion only for now \
-                      (excitation.kind = \"harmonic\", or a one-harmonic multisine)"
-                .into(),
-        }));
-    }
     let mut mechanics = Mechanics::Plain(Box::new(sim));
     for p in 1..=spec.periods {
         if let (Some(h), Mechanics::Plain(plain)) = (two_way, &mechanics)
@@ -227,7 +230,7 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
             mechanics = Mechanics::Coupled(Box::new(coupled));
             rec.solver_driven = true;
         }
-        match mechanics.run_until(&mut drive, p as f64 * period, &mut rec) {
+        match mechanics.run_until(p as f64 * period, &mut rec) {
             Ok(RunEnd::Reached) => {}
             Ok(RunEnd::Stopped { .. }) => {
                 ending = Ending::Stopped;
@@ -297,7 +300,7 @@ struct SampleGrid {
     d: Vec<f64>,
     gaps: Vec<f64>,
     /// The base displacement when it is not the chain's harmonic.
-    base: Option<super::drive::BaseDisplacement>,
+    base: Option<BaseDisplacement>,
 }
 
 impl SampleGrid {
@@ -457,12 +460,11 @@ enum Mechanics {
 impl Mechanics {
     fn run_until<O: RunObserver + ?Sized>(
         &mut self,
-        drive: &mut super::drive::BaseDrive,
         t: f64,
         rec: &mut Recorder<'_, O>,
     ) -> Result<RunEnd, StudyError> {
         match self {
-            Mechanics::Plain(sim) => Ok(drive.run_until(sim, t, rec)?),
+            Mechanics::Plain(sim) => Ok(sim.run_until(t, rec)?),
             Mechanics::Coupled(c) => c.run_until(t, rec).map_err(coupling_error),
         }
     }
@@ -494,8 +496,24 @@ fn coupling_error(e: CouplingError) -> StudyError {
     }
 }
 
+impl StudyError {
+    /// The engine's error as a run's: a base motion that cannot drive the run is told as such.
+    pub fn from_sim(e: SimError) -> Self {
+        match e {
+            SimError::BaseMotion(b) => StudyError::BaseMotion(b),
+            other => StudyError::Sim(other),
+        }
+    }
+}
+
 // Not `#[from]`: that would also make the inner error the `source()`, which the message
 // already shows (a failure's chain printed it twice).
+impl From<BaseMotionError> for StudyError {
+    fn from(e: BaseMotionError) -> Self {
+        StudyError::BaseMotion(e)
+    }
+}
+
 impl From<ElectricalError> for StudyError {
     fn from(e: ElectricalError) -> Self {
         StudyError::Electrical(e)
