@@ -222,7 +222,7 @@ pub fn si(value: f64, unit: &str) -> String {
 /// `impacts_per_period_1..contacts`, `error`, with `floquet` `max_abs_multiplier`, with
 /// `lyapunov` `lyapunov_max_1_s,lyapunov_spread_1_s`, and last the motion columns
 /// ([`MOTION_COLUMNS`]: `motion`, `average_power_se_w`, `settle_periods`, `settle_rate`,
-/// `residual`, `settle_periods_needed`).
+/// `residual`, `settle_periods_needed`, `label_source`, `coexisting_period`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointColumns {
     /// Contacts of the chain (N − 1, or N + 1 with stops).

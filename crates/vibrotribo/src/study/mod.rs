@@ -30,7 +30,7 @@ pub use drive::{
 };
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
-pub use motion::{Motion, MotionReport, Window, classify, exponent_sign};
+pub use motion::{LabelSource, Motion, MotionReport, Window, classify, exponent_sign};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{ImpactRecord, PointError, PointOptions, PointResult, run_point, run_point_driven};
@@ -38,5 +38,5 @@ pub use record::{EventColumns, Recording, SampleColumns};
 pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use run_motion::RunMotion;
 pub use settings::{ElectricalFailure, Harvester, RunSettings, RunSpec, Sampling};
-pub use settle::{AutoSettle, SettleEnding, SettleMode, Settled, settle};
+pub use settle::{AutoSettle, SettleEnding, SettleMode, Settled, ShotOrbit, settle};
 pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};

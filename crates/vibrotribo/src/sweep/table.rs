@@ -30,14 +30,19 @@ pub fn point_columns(contacts: usize) -> Vec<String> {
 /// `settle_periods` (periods run before the recorded window), `settle_rate` (decay factor
 /// of the return distances per period, where converging), `residual` (the period test's
 /// relative mismatch at the detected or closest period), `settle_periods_needed` (for a
-/// settling motion, periods still needed). See [`MotionReport`](crate::study::MotionReport).
-pub const MOTION_COLUMNS: [&str; 6] = [
+/// settling motion, periods still needed), `label_source` (for a periodic motion, `reached`
+/// where the run repeats, `shot` where Newton shooting finished an approach the run was seen
+/// making), `coexisting_period` (the minimal period of a stable orbit found near the run that
+/// the run does not approach). See [`MotionReport`](crate::study::MotionReport).
+pub const MOTION_COLUMNS: [&str; 8] = [
     "motion",
     "average_power_se_w",
     "settle_periods",
     "settle_rate",
     "residual",
     "settle_periods_needed",
+    "label_source",
+    "coexisting_period",
 ];
 
 /// A point's values of [`MOTION_COLUMNS`] (NaN, −1 or empty text where missing).
@@ -55,6 +60,10 @@ pub struct MotionCells {
     pub residual: f64,
     /// `settle_periods_needed`.
     pub needed: f64,
+    /// `label_source`.
+    pub label_source: String,
+    /// `coexisting_period` (−1 where none).
+    pub coexisting: i64,
 }
 
 impl MotionCells {
@@ -68,6 +77,10 @@ impl MotionCells {
             rate: m.and_then(|m| m.rate).unwrap_or(f64::NAN),
             residual: m.map_or(f64::NAN, |m| m.residual),
             needed: m.and_then(|m| m.periods_needed).unwrap_or(f64::NAN),
+            label_source: m
+                .and_then(|m| m.label_source)
+                .map_or(String::new(), |s| s.as_str().to_string()),
+            coexisting: m.and_then(|m| m.coexisting).map_or(-1, |c| i64::from(c.0)),
         }
     }
 
@@ -80,6 +93,8 @@ impl MotionCells {
             rate: f64::NAN,
             residual: f64::NAN,
             needed: f64::NAN,
+            label_source: String::new(),
+            coexisting: -1,
         }
     }
 
@@ -97,6 +112,12 @@ impl MotionCells {
             num(self.rate),
             num(self.residual),
             num(self.needed),
+            self.label_source.clone(),
+            if self.coexisting < 0 {
+                String::new()
+            } else {
+                self.coexisting.to_string()
+            },
         ]
     }
 }
@@ -328,6 +349,8 @@ impl SweepColumns {
             float(|c| c.rate),
             float(|c| c.residual),
             float(|c| c.needed),
+            Column::Text(m.iter().map(|c| c.label_source.clone()).collect()),
+            Column::Int(m.iter().map(|c| c.coexisting).collect()),
         ];
         for (name, c) in MOTION_COLUMNS.iter().zip(motion) {
             columns.push((name.to_string(), c));
@@ -386,8 +409,8 @@ mod tests {
         }
         let s = t.summary();
         assert_eq!(s.names()[..3], ["param", "average_power_w", "impacts_per_period"]);
-        assert_eq!(s.names()[s.names().len() - 7], "error");
-        assert_eq!(s.names()[s.names().len() - 6..], MOTION_COLUMNS);
+        assert_eq!(s.names()[s.names().len() - 9], "error");
+        assert_eq!(s.names()[s.names().len() - 8..], MOTION_COLUMNS);
         assert_eq!(s.rows(), 3);
         let Some(Column::Float(p)) = s.get("average_power_w") else {
             panic!()
