@@ -280,7 +280,10 @@ fn print_motion(m: &MotionReport) {
             Some((l, s)) => format!("λ1 = {l:.4} ± {s:.4} 1/s"),
             None => "no Lyapunov exponent".into(),
         },
-        Motion::Undetermined => "too short a window to tell".into(),
+        Motion::Undetermined => {
+            "the window cannot tell: too short, or a two-way coupled run neither periodic nor converging"
+                .into()
+        }
     };
     let detail = match m.coexisting {
         Some((p, r)) => {

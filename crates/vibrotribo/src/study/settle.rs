@@ -342,7 +342,7 @@ impl Shot<'_> {
         let q = fit.rate().powi(p as i32);
         let near = self.distance(state, &orbit.state) <= 4.0 * fit.distance / (1.0 - q);
         let rho = orbit.spectral_radius();
-        if !orbit.stable || !near || !(rho > 0.0) {
+        if !orbit.stable || !near || rho.is_nan() || rho <= 0.0 {
             return Ok(Verdict::Unknown);
         }
         // Orbit periods over which the multipliers predict a fourfold shrink.
