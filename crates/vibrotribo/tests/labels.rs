@@ -181,7 +181,7 @@ impl Lcg {
 }
 
 /// The impact oscillator at Ω = 3.05: a period-2 orbit and an irregular attractor share the
-/// starts of the box ±A, ±A·ω. From each of 12 starts the label is the attractor the long
+/// starts of the box [−A, 0] × ±A·ω (the stop is at the static position). From each of 12 starts the label is the attractor the long
 /// run from that start is on.
 #[test]
 fn impact_oscillator_with_an_orbit_beside_an_irregular_attractor() {
@@ -196,7 +196,8 @@ fn impact_oscillator_with_an_orbit_beside_an_irregular_attractor() {
     let mut kinds = Vec::new();
     for k in 0..12 {
         let start = ChainState {
-            positions: vec![a * (2.0 * rng.next() - 1.0)],
+            // At or below the stop, which sits at the static position.
+            positions: vec![-a * rng.next()],
             velocities: vec![v * (2.0 * rng.next() - 1.0)],
         };
         let (auto, long) = judged(params, &start, c.sim_options());
