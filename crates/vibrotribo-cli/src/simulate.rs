@@ -264,7 +264,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
 
 fn print_motion(m: &MotionReport) {
     let detail = match m.motion {
-        Motion::Periodic => format!("period {}, residual {:.1e}", m.residual_period, m.residual),
+        Motion::Periodic => format!(
+            "period {}, residual {:.1e}, {}",
+            m.residual_period,
+            m.residual,
+            m.label_source.map_or("reached", |s| s.as_str())
+        ),
         Motion::Settling => format!(
             "rate {} per period, about {} more periods needed",
             m.rate.map_or("?".into(), |r| format!("{r:.5}")),
@@ -274,6 +279,16 @@ fn print_motion(m: &MotionReport) {
             Some((l, s)) => format!("λ1 = {l:.4} ± {s:.4} 1/s"),
             None => "no Lyapunov exponent".into(),
         },
+        Motion::Undetermined => {
+            "the window cannot tell: too short, or a two-way coupled run neither periodic nor converging"
+                .into()
+        }
+    };
+    let detail = match m.coexisting {
+        Some((p, r)) => {
+            format!("{detail}; a stable period-{p} orbit (|μ| = {r:.4}) coexists, not approached")
+        }
+        None => detail,
     };
     println!(
         "  motion after {} settling periods ({}): {} ({detail})",

@@ -182,7 +182,9 @@ pub fn base_motion_json(config: &Config, spec: &RunSpec) -> Option<serde_json::V
 /// summary.json's `motion` object (null for a run that did not complete): `motion`,
 /// `period` (0 unless periodic), `residual`, `residual_period`, `settle_periods`,
 /// `settle_ending`, `settle_rate`, `settle_periods_needed`, `newton` (period and residual
-/// of a shot orbit), `lyapunov_max_1_s`, `lyapunov_spread_1_s`, `section_curve_ratio`.
+/// of a shot orbit), `lyapunov_max_1_s`, `lyapunov_spread_1_s`, `section_curve_ratio`,
+/// `label_source` (`reached` or `shot` for a periodic motion), `coexisting` (period and
+/// largest multiplier modulus of a stable orbit near the run that the run does not approach).
 pub fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
     let Some(m) = m else {
         return serde_json::Value::Null;
@@ -201,6 +203,8 @@ pub fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
         "lyapunov_max_1_s": m.lyapunov.map(|l| l.0).and_then(finite),
         "lyapunov_spread_1_s": m.lyapunov.map(|l| l.1).and_then(finite),
         "section_curve_ratio": m.curve_ratio,
+        "label_source": m.label_source.map(|s| s.as_str()),
+        "coexisting": m.coexisting.map(|(p, r)| json!({"period": p, "max_abs_multiplier": r})),
     })
 }
 

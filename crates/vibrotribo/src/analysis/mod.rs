@@ -30,8 +30,8 @@ pub use fit::{QuadraticFit, fit_quadratic};
 pub use period::{PeriodOptions, Periodicity, detect_period};
 pub use poincare::{ImpactPoint, ImpactSection, StroboscopicOptions, StroboscopicSection};
 pub use settle::{
-    CLOSED_CURVE_RATIO, Convergence, amplitude, batch_means_se, closed_curve_ratio, converging_lag,
-    fit_convergence, return_distances,
+    CLOSED_CURVE_RATIO, Convergence, amplitude, batch_means_se, closed_curve_ratio, contracting_divisor,
+    converging_lag, fit_convergence, return_distances,
 };
 pub use spectrum::{Detrend, Psd, WelchOptions, Window, welch_psd};
 pub use stats::RunStats;

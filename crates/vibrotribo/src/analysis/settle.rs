@@ -80,8 +80,14 @@ impl Convergence {
     /// the points within 0.25 (in ln d, root mean square) of the line, a slow but clean
     /// geometric decay.
     pub fn converging(&self) -> bool {
-        let halved = self.slope * (self.samples.saturating_sub(1)) as f64 <= -std::f64::consts::LN_2;
-        self.slope < 0.0 && self.slope + 5.0 * self.slope_se < 0.0 && (halved || self.rms <= 0.25)
+        self.slope < 0.0 && self.slope + 5.0 * self.slope_se < 0.0 && (self.halved() || self.rms <= 0.25)
+    }
+
+    /// Whether the fitted distance at least halved over the samples fitted (a decline that
+    /// the residual of a motion already within the period tolerance of its orbit cannot
+    /// produce at a lag that is not the orbit's period).
+    pub fn halved(&self) -> bool {
+        self.slope * (self.samples.saturating_sub(1)) as f64 <= -std::f64::consts::LN_2
     }
 
     /// Samples still needed, at the fitted rate, for the distance to fall to `tolerance`
@@ -147,6 +153,28 @@ pub fn converging_lag(
     (1..=max_period)
         .find_map(|p| fit(p).filter(Convergence::converging).map(|f| (p, Some(f))))
         .unwrap_or_else(|| (fallback, fit(fallback)))
+}
+
+/// The smallest proper divisor d of `p` at which the return distances of `samples` (see
+/// [`return_distances`]) shrink geometrically ([`Convergence::converging`]) and at least
+/// halved over the series ([`Convergence::halved`]), with its fit; `None` if there is none.
+///
+/// A series that repeats at lag p within a tolerance yet has such a divisor is not on an
+/// orbit of period p: it is converging onto an orbit of period d along a slow spiral whose
+/// rotation nearly closes after p/d turns (a multiplier near a root of unity), and the
+/// period-p match is an artefact of the window. On an orbit of period p the distances at a
+/// lag d that is not a period stay at the distance between the orbit's points.
+pub fn contracting_divisor(
+    samples: &[f64],
+    dim: usize,
+    p: usize,
+    scale: f64,
+) -> Option<(usize, Convergence)> {
+    (1..p).filter(|d| p.is_multiple_of(*d)).find_map(|d| {
+        fit_convergence(&return_distances(samples, dim, d, scale))
+            .filter(|c| c.converging() && c.halved())
+            .map(|c| (d, c))
+    })
 }
 
 /// How far a set of section points is from lying on one closed curve: the points, in a
@@ -323,6 +351,33 @@ mod tests {
         assert!(c100 > CLOSED_CURVE_RATIO, "{c100}");
         // The ratio of a cloud grows with its number of points (about as √n).
         assert!(c400 > 1.5 * c100, "{c100} {c400}");
+    }
+
+    /// A slow spiral onto a fixed point, turning by nearly π per step (multiplier
+    /// 0.99·e^{i(π − 0.01)}): its lag-2 returns nearly vanish, its lag-1 returns shrink
+    /// geometrically at 0.99, so 1 is a contracting divisor of 2; an exact period-2 series
+    /// (with a decaying perturbation far below its lag-1 distance) has none.
+    #[test]
+    fn a_spiral_is_not_a_period_two_orbit() {
+        let (r, a) = (0.99f64, std::f64::consts::PI - 0.01);
+        let spiral: Vec<f64> = (0..300)
+            .flat_map(|j| {
+                let (m, t) = (r.powi(j), a * j as f64);
+                [1.0 + m * t.cos(), m * t.sin()]
+            })
+            .collect();
+        let lag2 = return_distances(&spiral, 2, 2, 1.0);
+        assert!(lag2[lag2.len() - 1] < 1e-3, "{}", lag2[lag2.len() - 1]);
+        let (d, fit) = contracting_divisor(&spiral, 2, 2, 1.0).unwrap();
+        assert_eq!(d, 1);
+        assert!((fit.rate() - r).abs() < 1e-3, "{fit:?}");
+        let orbit: Vec<f64> = (0..300)
+            .flat_map(|j| {
+                let e = 1e-6 * 0.9f64.powi(j);
+                [[0.2, 0.7][j as usize % 2] + e, 0.1 - e]
+            })
+            .collect();
+        assert_eq!(contracting_divisor(&orbit, 2, 2, 1.0), None);
     }
 
     /// Batch means of independent values: the error of the mean is σ/√n for uncorrelated

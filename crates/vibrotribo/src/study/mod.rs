@@ -25,7 +25,7 @@ pub use chirp::{
 };
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
-pub use motion::{Motion, MotionReport, Window, classify, exponent_sign};
+pub use motion::{LabelSource, Motion, MotionReport, Window, classify, exponent_sign};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{
@@ -37,6 +37,6 @@ pub use replay::{ReplayOptions, Replayed, record_trajectory, replay};
 pub use run_motion::RunMotion;
 pub use settings::{ElectricalFailure, Harvester, RunSettings, RunSpec, Sampling};
 pub use settle::{
-    AutoSettle, DEFAULT_SETTLE_CAP, SettleEnding, SettleMode, Settled, UnknownSettleMode, settle,
+    AutoSettle, DEFAULT_SETTLE_CAP, SettleEnding, SettleMode, Settled, ShotOrbit, UnknownSettleMode, settle,
 };
 pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};

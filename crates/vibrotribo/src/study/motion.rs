@@ -4,10 +4,14 @@
 //! [`classify`] reads the recorded window of a sweep point:
 //!
 //! - **periodic**: the stroboscopic positions repeat with a period p ≤ the largest tested
-//!   ([`PointOptions::period_options`]), within the period tolerance; the residual is the
-//!   test's relative mismatch.
-//! - **settling**: not periodic, but the return distances at some lag p ≤ the largest
-//!   tested period shrink geometrically beyond doubt ([`converging_lag`],
+//!   ([`PointOptions::period_options`]), within the period tolerance, and the return
+//!   distances at no proper divisor of p are still shrinking ([`contracting_divisor`]); the
+//!   residual is the test's relative mismatch. [`MotionReport::label_source`] says whether
+//!   the run reached the orbit (`reached`) or Newton shooting finished the approach after
+//!   the run was seen going there (`shot`).
+//! - **settling**: not periodic, or periodic at p while the returns at a divisor d of p
+//!   still shrink (a slow spiral onto an orbit of period d), or the return distances at some
+//!   lag p ≤ the largest tested period shrink geometrically beyond doubt ([`converging_lag`],
 //!   [`Convergence::converging`](crate::analysis::Convergence::converging)): the motion is still
 //!   approaching an orbit; the rate per period and the periods still needed to reach the
 //!   tolerance are reported. A motion whose largest Lyapunov exponent is negative beyond its
@@ -21,6 +25,15 @@
 //!   a closed curve, the section of a two-torus; above it the window is a cloud (a torus of
 //!   higher dimension, or chaos too weak to show in the window).
 //!
+//! - **undetermined**: too short a window to tell (no period test, no converging fit, and
+//!   no Lyapunov exponent with an error bar), or a run whose masses feel the harvester
+//!   (two-way coupling) that is neither periodic nor converging: the exponent of the
+//!   mechanics alone does not describe it.
+//!
+//! A stable orbit that Newton shooting found during the settling but the run did not
+//! approach, and that the recorded window is not on, is reported as
+//! [`MotionReport::coexisting`].
+//!
 //! The Lyapunov exponent is computed only for a point that is neither periodic nor settling
 //! (over the recorded window when the settling already found the motion irregular, else by
 //! a run of the same length from the final state), so periodic points cost nothing extra.
@@ -30,8 +43,8 @@ use std::cmp::Ordering;
 use super::lyapunov::lyapunov_spectrum;
 use super::point::{PointOptions, PointResult};
 use super::settings::RunSpec;
-use super::settle::{SettleEnding, Settled, section_states};
-use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, converging_lag};
+use super::settle::{SettleEnding, Settled, ShotOrbit, section_states};
+use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, contracting_divisor, converging_lag};
 use crate::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::sensitivity::length_scale;
@@ -47,16 +60,39 @@ pub enum Motion {
     Quasiperiodic,
     /// Largest Lyapunov exponent positive beyond its error bar.
     Chaotic,
+    /// Too short a window to tell.
+    Undetermined,
 }
 
 impl Motion {
-    /// `periodic`, `settling`, `quasiperiodic` or `chaotic`.
+    /// `periodic`, `settling`, `quasiperiodic`, `chaotic` or `undetermined`.
     pub fn as_str(self) -> &'static str {
         match self {
             Motion::Periodic => "periodic",
             Motion::Settling => "settling",
             Motion::Quasiperiodic => "quasiperiodic",
             Motion::Chaotic => "chaotic",
+            Motion::Undetermined => "undetermined",
+        }
+    }
+}
+
+/// How a periodic label was reached.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LabelSource {
+    /// The run itself repeats within the period tolerance.
+    Reached,
+    /// Newton shooting finished the run's approach, after the run was seen approaching the
+    /// orbit at the rate of its multipliers.
+    Shot,
+}
+
+impl LabelSource {
+    /// `reached` or `shot`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LabelSource::Reached => "reached",
+            LabelSource::Shot => "shot",
         }
     }
 }
@@ -97,6 +133,12 @@ pub struct MotionReport {
     /// The recorded section's [`closed_curve_ratio`] (scaled positions and velocities), for
     /// a quasi-periodic or chaotic motion.
     pub curve_ratio: Option<f64>,
+    /// For a periodic motion: whether the run reached the orbit or shooting finished it.
+    pub label_source: Option<LabelSource>,
+    /// A stable orbit found near the run during the settling that the run did not approach
+    /// and the recorded window is not on: its minimal period and largest multiplier modulus
+    /// (over that period).
+    pub coexisting: Option<(u32, f64)>,
 }
 
 /// Error bars a Lyapunov exponent must clear to count as nonzero.
@@ -114,6 +156,9 @@ pub struct Window<'a> {
     pub periodicity: Option<Periodicity>,
     /// State at the window's end (where a Lyapunov run starts).
     pub final_state: &'a ChainState,
+    /// Whether the harvester's forces act on the masses (two-way coupling): the exponent of
+    /// the mechanics alone does not describe such a run, and none is computed for it.
+    pub coupled: bool,
 }
 
 impl<'a> Window<'a> {
@@ -124,6 +169,7 @@ impl<'a> Window<'a> {
             velocities: &result.strobe_velocities,
             periodicity: result.periodicity,
             final_state: &result.final_state,
+            coupled: false,
         }
     }
 }
@@ -157,12 +203,33 @@ pub fn classify(
         shot: settled.and_then(|s| s.shot),
         lyapunov: None,
         curve_ratio: None,
+        label_source: None,
+        coexisting: None,
     };
+    let scale = amplitude(window.positions);
+    report.coexisting = settled
+        .and_then(|s| s.rejected.as_ref())
+        .filter(|o| !window_on(window.positions, n, o, scale))
+        .map(|o| (o.period, o.spectral_radius));
+    let tolerance = options.period_tolerance;
+    let states: Vec<f64> = section_states(window.positions, window.velocities, params).collect();
     let (closest, mismatch) = match window.periodicity {
         Some(Periodicity::Periodic { period, mismatch }) => {
+            if let Some((d, fit)) = contracting_divisor(&states, 2 * n, period, scale) {
+                // A slow spiral onto an orbit of period d, nearly closing after period/d turns.
+                report.residual = lag_mismatch(window.positions, n, d, scale);
+                report.residual_period = d;
+                report.rate = Some(fit.rate());
+                report.periods_needed = fit.samples_needed(tolerance).map(|p| p + test_window);
+                return report;
+            }
             report.motion = Motion::Periodic;
             report.residual = mismatch;
             report.residual_period = period;
+            report.label_source = Some(match report.settle_ending {
+                SettleEnding::Shot => LabelSource::Shot,
+                _ => LabelSource::Reached,
+            });
             return report;
         }
         Some(Periodicity::NonPeriodic {
@@ -173,9 +240,6 @@ pub fn classify(
     };
     report.residual = mismatch;
     report.residual_period = closest;
-    let scale = amplitude(window.positions);
-    let tolerance = options.period_tolerance;
-    let states: Vec<f64> = section_states(window.positions, window.velocities, params).collect();
     let max_lag = options
         .period_options()
         .max_period
@@ -186,6 +250,11 @@ pub fn classify(
     {
         report.rate = Some(fit.rate());
         report.periods_needed = fit.samples_needed(tolerance).map(|p| p + test_window);
+        return report;
+    }
+    if window.coupled && spectrum.is_none() {
+        // Not periodic, not converging, and no exponent of the coupled run to go by.
+        report.motion = Motion::Undetermined;
         return report;
     }
     let spectrum = match spectrum {
@@ -212,6 +281,11 @@ pub fn classify(
     };
     let (largest, se) = (s.largest(), s.largest_spread());
     report.lyapunov = Some((largest, se));
+    if window.periodicity.is_none() && !se.is_finite() {
+        // Neither a period test nor an error bar: the window is too short to tell.
+        report.motion = Motion::Undetermined;
+        return report;
+    }
     report.motion = match exponent_sign(largest, se) {
         Ordering::Greater => Motion::Chaotic,
         Ordering::Less => {
@@ -239,6 +313,33 @@ pub fn exponent_sign(largest: f64, se: f64) -> Ordering {
     } else {
         Ordering::Equal
     }
+}
+
+/// How close (relative to the amplitude, in the largest coordinate) a recorded sample must
+/// come to an orbit's section state for the window to count as on that orbit.
+const ON_ORBIT: f64 = 1e-2;
+
+/// Whether the stroboscopic `positions` (`n` per sample) come within [`ON_ORBIT`] (relative
+/// to `scale`) of the orbit's section state: a window on the orbit passes through it once
+/// every orbit period.
+fn window_on(positions: &[f64], n: usize, orbit: &ShotOrbit, scale: f64) -> bool {
+    positions.chunks_exact(n).any(|x| {
+        x.iter()
+            .zip(&orbit.state.positions)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+            <= ON_ORBIT * scale
+    })
+}
+
+/// The period test's relative mismatch at lag `p` over the whole window: the largest
+/// coordinate difference of samples `p` apart over `scale`.
+fn lag_mismatch(positions: &[f64], n: usize, p: usize, scale: f64) -> f64 {
+    let rows: Vec<&[f64]> = positions.chunks_exact(n).collect();
+    let worst = (p..rows.len())
+        .flat_map(|j| rows[j].iter().zip(rows[j - p]).map(|(a, b)| (a - b).abs()))
+        .fold(f64::NAN, f64::max);
+    worst / scale
 }
 
 /// Periods the tangent vectors of a classifying Lyapunov run align over before averaging.

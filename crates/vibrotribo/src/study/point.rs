@@ -274,10 +274,14 @@ pub fn run_point(
                     params,
                     sim_options,
                     options,
-                    Window::of(&r),
+                    Window {
+                        coupled: two_way(harvester),
+                        ..Window::of(&r)
+                    },
                     None,
                     spectrum,
                 ));
+                no_period_while_settling(&mut r);
             }
             return Ok(r);
         }
@@ -324,10 +328,14 @@ pub fn run_point(
                 params,
                 sim_options,
                 options,
-                Window::of(&r),
+                Window {
+                    coupled: two_way(harvester),
+                    ..Window::of(&r)
+                },
                 Some(&settled),
                 spectrum,
             ));
+            no_period_while_settling(&mut r);
         }
         if options.lyapunov.is_none() {
             r.lyapunov = None;
@@ -345,6 +353,25 @@ pub fn run_point(
         round += 1;
         before = end;
         start = r.final_state;
+    }
+}
+
+/// Whether `harvester`'s forces act on the masses (two-way coupling).
+fn two_way(harvester: Option<(&HarvesterParams, &ChargeOptions)>) -> bool {
+    harvester.is_some_and(|(h, _)| h.coupling == crate::coupling::Coupling::TwoWay)
+}
+
+/// A window the period test passed at p but whose returns at a divisor of p still shrink
+/// (a slow spiral, classified settling) has no period: the match at p is the window's
+/// artefact, not the orbit's period.
+fn no_period_while_settling(r: &mut PointResult) {
+    if let (Some(m), Some(Periodicity::Periodic { .. })) = (&r.motion, r.periodicity)
+        && m.motion == Motion::Settling
+    {
+        r.periodicity = Some(Periodicity::NonPeriodic {
+            closest_period: m.residual_period,
+            mismatch: m.residual,
+        });
     }
 }
 

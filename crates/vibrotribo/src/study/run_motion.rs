@@ -79,6 +79,10 @@ impl RunMotion {
                 velocities: &strobe.velocities,
                 periodicity,
                 final_state,
+                coupled: spec
+                    .harvester
+                    .as_ref()
+                    .is_some_and(|h| h.params.coupling == crate::coupling::Coupling::TwoWay),
             },
             settled,
             None,

@@ -7,22 +7,35 @@
 //! return distances at the closest candidate period p are fitted by a geometric decay
 //! ([`fit_convergence`]); where they shrink beyond doubt and would need more than another
 //! block to reach the tolerance, the periodic orbit of period p is sought by Newton shooting
-//! from the current state ([`find_periodic_orbit`]) and accepted only if it is stable and the
+//! from the current state ([`find_periodic_orbit`]) and accepted only if it is stable, the
 //! current state is within the distance the geometric tail still has to travel (four times
-//! `d/(1 − r^p)`): the run is then continued from the orbit. Distances that do not shrink
-//! end the settling once the fixed transient (`transient_periods`) has passed, so an
-//! irregular motion costs no more than before; the cap ends it otherwise.
+//! `d/(1 − r^p)`), and the run is going there: the run's own state, simulated on for K·p
+//! periods, with K the smallest count of orbit periods over which the orbit's largest
+//! multiplier modulus ρ predicts a fourfold shrink (ρ^K ≤ 1/4), must end within 2·ρ^K of
+//! its starting distance from the orbit (in the section states the fit reads). The recorded
+//! window then starts on the orbit, at the period the settling reached; its period is the
+//! orbit's minimal one (the smallest divisor d of p with `φ_d(z) = z` within the period
+//! tolerance). A stable orbit the run does not approach is kept as a coexisting orbit and
+//! the settling goes on from the run's state. A confirmation that would overrun the cap is
+//! not tried.
+//!
+//! A window that repeats at lag p is taken as settled only if no proper divisor d of p has
+//! return distances that are still shrinking geometrically ([`contracting_divisor`]): a slow
+//! spiral onto an orbit of period d that nearly closes after p/d turns is still settling.
+//! Distances that do not shrink end the settling once the fixed transient
+//! (`transient_periods`) has passed, so an irregular motion costs no more than before; the
+//! cap ends it otherwise.
 
 use super::observer::Mechanics;
 use super::point::{PointError, PointOptions};
 use super::settings::RunSpec;
 use super::simulate::{Ending, StudyError, simulate};
 use crate::analysis::{
-    Convergence, Periodicity, StroboscopicOptions, StroboscopicSection, amplitude, converging_lag,
-    detect_period,
+    Convergence, Periodicity, StroboscopicOptions, StroboscopicSection, amplitude, contracting_divisor,
+    converging_lag, detect_period,
 };
 use crate::model::{ChainParams, ChainState, SimOptions};
-use crate::orbits::{ShootingOptions, find_periodic_orbit};
+use crate::orbits::{PeriodicOrbit, ShootingOptions, find_periodic_orbit};
 
 /// How long a sweep point runs before its recorded window.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -110,7 +123,8 @@ pub enum SettleEnding {
     Fixed,
     /// The returns repeated within the period tolerance.
     Repeated,
-    /// Newton shooting finished a geometric approach to a stable periodic orbit.
+    /// Newton shooting finished a geometric approach to a stable periodic orbit, and the
+    /// run's own state was seen approaching it at the rate its multipliers predict.
     Shot,
     /// The returns did not shrink (once the fixed transient had passed).
     Irregular,
@@ -145,8 +159,22 @@ pub struct Settled {
     pub convergence: Option<Convergence>,
     /// The candidate period the fit was made at.
     pub fit_period: usize,
-    /// After [`SettleEnding::Shot`]: the orbit's period and Newton residual.
+    /// After [`SettleEnding::Shot`]: the orbit's minimal period and Newton residual.
     pub shot: Option<(u32, f64)>,
+    /// The last stable orbit Newton shooting found near the run that the run, simulated
+    /// on, did not approach (a coexisting attractor).
+    pub rejected: Option<ShotOrbit>,
+}
+
+/// A stable periodic orbit found by Newton shooting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShotOrbit {
+    /// Minimal period, in excitation periods.
+    pub period: u32,
+    /// Largest Floquet multiplier modulus of the orbit taken over `period` excitation periods.
+    pub spectral_radius: f64,
+    /// The orbit's state at the section t ≡ 0 (mod T).
+    pub state: ChainState,
 }
 
 /// The section states `[x_1 … x_N, v_1/ω_1 … v_N/ω_N]`, m, of stroboscopic samples
@@ -169,6 +197,35 @@ pub(super) fn section_states<'a>(
                     .map(move |(i, v)| v / (params.stiffness[i] / params.masses[i]).sqrt()),
             )
         })
+}
+
+/// Runs the mechanics of `params` from `state` for `periods` excitation periods: the
+/// stroboscopic samples at t = T, 2T, … (from the start) and the final state.
+fn strobe_run(
+    params: &ChainParams,
+    sim_options: &SimOptions,
+    state: &ChainState,
+    periods: u64,
+) -> Result<(StroboscopicSection, ChainState), PointError> {
+    let mut spec = RunSpec::new(params.clone(), periods);
+    spec.initial = state.clone();
+    spec.options = sim_options.clone();
+    spec.transient_periods = 0;
+    let strobe = StroboscopicSection::new(
+        params.len(),
+        params.period(),
+        StroboscopicOptions {
+            phase_time: 0.0,
+            transient_periods: 1,
+        },
+    )?;
+    let mut watch = Mechanics::new(strobe);
+    let outcome = simulate(&spec, &mut watch)?;
+    match outcome.ending {
+        Ending::Failed(StudyError::Sim(e)) => Err(e.into()),
+        Ending::Failed(e) => Err(PointError::Study(e)),
+        Ending::Completed | Ending::Stopped => Ok((watch.inner, outcome.final_state)),
+    }
 }
 
 /// At most this many Newton attempts per point.
@@ -196,6 +253,7 @@ pub fn settle(
     let mut shots = 0;
     let mut last_fit = None;
     let mut fit_period = 1;
+    let mut rejected = None;
     loop {
         let len = if done == 0 {
             block.max(needed as u64)
@@ -204,110 +262,196 @@ pub fn settle(
         }
         .min(auto.cap_periods.saturating_sub(done))
         .max(1);
-        let mut spec = RunSpec::new(params.clone(), len);
-        spec.initial = state.clone();
-        spec.options = sim_options.clone();
-        spec.transient_periods = 0;
-        let strobe = StroboscopicSection::new(
-            n,
-            params.period(),
-            StroboscopicOptions {
-                phase_time: 0.0,
-                transient_periods: 1,
-            },
-        )?;
-        let mut watch = Mechanics::new(strobe);
-        let outcome = simulate(&spec, &mut watch)?;
-        match outcome.ending {
-            Ending::Failed(StudyError::Sim(e)) => return Err(e.into()),
-            Ending::Failed(e) => return Err(PointError::Study(e)),
-            Ending::Completed | Ending::Stopped => {}
-        }
+        let (strobe, last) = strobe_run(params, sim_options, &state, len)?;
         done += len;
-        state = outcome.final_state;
-        history.extend_from_slice(&watch.inner.positions);
-        states.extend(section_states(
-            &watch.inner.positions,
-            &watch.inner.velocities,
-            params,
-        ));
+        state = last;
+        history.extend_from_slice(&strobe.positions);
+        states.extend(section_states(&strobe.positions, &strobe.velocities, params));
         let keep = needed.max(block as usize) + popts.max_period;
         if history.len() > keep * n {
             history.drain(..history.len() - keep * n);
             states.drain(..states.len() - keep * 2 * n);
         }
         let samples = history.len() / n;
-        let end = |ending, fit, fit_period| Settled {
+        let end = |ending, fit, fit_period, rejected: &Option<ShotOrbit>| Settled {
             periods: done,
             state: state.clone(),
             ending,
             convergence: fit,
             fit_period,
             shot: None,
+            rejected: rejected.clone(),
         };
         if samples >= needed {
             let tail = &history[(samples - needed) * n..];
+            let scale = amplitude(tail);
             match detect_period(tail, n, &popts) {
-                Ok(Periodicity::Periodic { .. }) => {
-                    return Ok(end(SettleEnding::Repeated, last_fit, fit_period));
+                Ok(Periodicity::Periodic { period, .. }) => {
+                    match contracting_divisor(&states, 2 * n, period, scale) {
+                        // A slow spiral onto an orbit of period d: still settling.
+                        Some((d, _)) => fit_period = d,
+                        None => return Ok(end(SettleEnding::Repeated, last_fit, fit_period, &rejected)),
+                    }
                 }
                 Ok(Periodicity::NonPeriodic { closest_period, .. }) => fit_period = closest_period,
                 Err(_) => {}
             }
             // The fit reads every sample kept (the test's window or a block, and p more).
-            let scale = amplitude(tail);
             let max_lag = popts.max_period.min(samples / 3).max(1);
             (fit_period, last_fit) = converging_lag(&states, 2 * n, max_lag, scale, fit_period);
             if let Some(fit) = last_fit.filter(Convergence::converging) {
                 let more = fit.samples_needed(options.period_tolerance).unwrap_or(0.0);
                 if auto.shoot && shots < MAX_SHOTS && more > block as f64 {
                     shots += 1;
-                    if let Some(s) = shoot(params, &state, sim_options, fit_period, &fit, scale) {
-                        return Ok(Settled {
-                            state: s.0,
-                            shot: Some((fit_period as u32, s.1)),
-                            ..end(SettleEnding::Shot, last_fit, fit_period)
-                        });
+                    let shot = Shot {
+                        params,
+                        sim_options,
+                        scale,
+                        tolerance: options.period_tolerance,
+                    };
+                    let budget = auto.cap_periods.saturating_sub(done);
+                    match shot.try_orbit(&state, fit_period, &fit, budget)? {
+                        Verdict::Confirmed(orbit, residual) => {
+                            return Ok(Settled {
+                                shot: Some((orbit.period, residual)),
+                                state: orbit.state,
+                                ..end(SettleEnding::Shot, last_fit, fit_period, &rejected)
+                            });
+                        }
+                        Verdict::Elsewhere(orbit) => rejected = Some(orbit),
+                        Verdict::Unknown => {}
                     }
                 }
             } else if done >= options.transient_periods {
-                return Ok(end(SettleEnding::Irregular, last_fit, fit_period));
+                return Ok(end(SettleEnding::Irregular, last_fit, fit_period, &rejected));
             }
         }
         if done >= auto.cap_periods {
-            return Ok(end(SettleEnding::Cap, last_fit, fit_period));
+            return Ok(end(SettleEnding::Cap, last_fit, fit_period, &rejected));
         }
     }
 }
 
-/// The stable periodic orbit of period `p` near `state`, if Newton shooting finds one and
-/// `state` lies within the geometric tail of `fit` from it (positions relative to `scale`):
-/// its state and Newton residual.
-fn shoot(
-    params: &ChainParams,
-    state: &ChainState,
-    sim_options: &SimOptions,
-    p: usize,
-    fit: &Convergence,
+/// What Newton shooting and the run's own continuation say about an orbit.
+enum Verdict {
+    /// A stable orbit the run approaches at the predicted rate, with its minimal period and
+    /// its Newton residual.
+    Confirmed(ShotOrbit, f64),
+    /// A stable orbit the run, simulated on, does not approach.
+    Elsewhere(ShotOrbit),
+    /// No stable orbit near the run, or none that could be checked within the cap.
+    Unknown,
+}
+
+/// The settings a shot needs: the chain, the simulator's options, the amplitude the
+/// distances are measured against, and the period tolerance.
+struct Shot<'a> {
+    params: &'a ChainParams,
+    sim_options: &'a SimOptions,
     scale: f64,
-) -> Option<(ChainState, f64)> {
-    let orbit = find_periodic_orbit(
-        params,
-        state,
-        p as u32,
-        &ShootingOptions {
-            sim: sim_options.clone(),
-            ..ShootingOptions::default()
-        },
-    )
-    .ok()?;
-    let q = fit.rate().powi(p as i32);
-    let distance = state
-        .positions
-        .iter()
-        .zip(&orbit.state.positions)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max)
-        / scale;
-    (orbit.stable && distance <= 4.0 * fit.distance / (1.0 - q)).then_some((orbit.state, orbit.residual))
+    tolerance: f64,
+}
+
+impl Shot<'_> {
+    /// Seeks the stable periodic orbit of period `p` near `state` within the geometric tail
+    /// of `fit` (see the module docs), then checks that `state`, simulated on for at most
+    /// `budget` periods, approaches it at the rate of its multipliers.
+    fn try_orbit(
+        &self,
+        state: &ChainState,
+        p: usize,
+        fit: &Convergence,
+        budget: u64,
+    ) -> Result<Verdict, PointError> {
+        let Ok(orbit) = find_periodic_orbit(
+            self.params,
+            state,
+            p as u32,
+            &ShootingOptions {
+                sim: self.sim_options.clone(),
+                ..ShootingOptions::default()
+            },
+        ) else {
+            return Ok(Verdict::Unknown);
+        };
+        let q = fit.rate().powi(p as i32);
+        let near = self.distance(state, &orbit.state) <= 4.0 * fit.distance / (1.0 - q);
+        let rho = orbit.spectral_radius();
+        if !orbit.stable || !near || rho.is_nan() || rho <= 0.0 {
+            return Ok(Verdict::Unknown);
+        }
+        // Orbit periods over which the multipliers predict a fourfold shrink.
+        let k = ((0.25f64).ln() / rho.ln()).ceil().max(1.0);
+        let periods = k * f64::from(orbit.period);
+        if periods > budget as f64 {
+            return Ok(Verdict::Unknown);
+        }
+        let ends = self.run_states(state, periods as u64)?;
+        let Some(last) = ends.last() else {
+            return Ok(Verdict::Unknown);
+        };
+        let (start, end) = (
+            self.distance(state, &orbit.state),
+            self.distance(last, &orbit.state),
+        );
+        let found = self.minimal(&orbit)?;
+        if end <= (2.0 * rho.powf(k) * start).max(0.01 * self.tolerance) {
+            Ok(Verdict::Confirmed(found, orbit.residual))
+        } else {
+            Ok(Verdict::Elsewhere(found))
+        }
+    }
+
+    /// The orbit at its minimal period: the smallest divisor d of its period whose d-period
+    /// return `φ_d(z)` is within the period tolerance of z (relative to the amplitude), its
+    /// multiplier modulus taken over d periods.
+    fn minimal(&self, orbit: &PeriodicOrbit) -> Result<ShotOrbit, PointError> {
+        let p = orbit.period;
+        let returns = self.run_states(&orbit.state, u64::from(p))?;
+        let d = (1..p)
+            .filter(|d| p.is_multiple_of(*d))
+            .find(|&d| {
+                let r = &returns[d as usize - 1];
+                let worst = r
+                    .positions
+                    .iter()
+                    .zip(&orbit.state.positions)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                worst / self.scale <= self.tolerance
+            })
+            .unwrap_or(p);
+        Ok(ShotOrbit {
+            period: d,
+            spectral_radius: orbit.spectral_radius().powf(f64::from(d) / f64::from(p)),
+            state: orbit.state.clone(),
+        })
+    }
+
+    /// The states of a run from `state` at the ends of its first `periods` excitation periods.
+    fn run_states(&self, state: &ChainState, periods: u64) -> Result<Vec<ChainState>, PointError> {
+        let n = self.params.len();
+        let (s, _) = strobe_run(self.params, self.sim_options, state, periods)?;
+        Ok(s.positions
+            .chunks_exact(n)
+            .zip(s.velocities.chunks_exact(n))
+            .map(|(x, v)| ChainState {
+                positions: x.to_vec(),
+                velocities: v.to_vec(),
+            })
+            .collect())
+    }
+
+    /// Distance between two states in the section states the fit reads (positions and
+    /// velocities over each mass's natural frequency), relative to the amplitude.
+    fn distance(&self, a: &ChainState, b: &ChainState) -> f64 {
+        let sa: Vec<f64> = section_states(&a.positions, &a.velocities, self.params).collect();
+        let sb: Vec<f64> = section_states(&b.positions, &b.velocities, self.params).collect();
+        sa.iter()
+            .zip(&sb)
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / self.scale
+    }
 }

@@ -34,14 +34,19 @@ pub fn point_columns(contacts: usize) -> Vec<String> {
 /// `settle_periods` (periods run before the recorded window), `settle_rate` (decay factor
 /// of the return distances per period, where converging), `residual` (the period test's
 /// relative mismatch at the detected or closest period), `settle_periods_needed` (for a
-/// settling motion, periods still needed). See [`MotionReport`](crate::study::MotionReport).
-pub const MOTION_COLUMNS: [&str; 6] = [
+/// settling motion, periods still needed), `label_source` (for a periodic motion, `reached`
+/// where the run repeats, `shot` where Newton shooting finished an approach the run was seen
+/// making), `coexisting_period` (the minimal period of a stable orbit found near the run that
+/// the run does not approach). See [`MotionReport`](crate::study::MotionReport).
+pub const MOTION_COLUMNS: [&str; 8] = [
     "motion",
     "average_power_se_w",
     "settle_periods",
     "settle_rate",
     "residual",
     "settle_periods_needed",
+    "label_source",
+    "coexisting_period",
 ];
 
 /// The columns `lyapunov` adds before the motion columns: the largest Lyapunov exponent over
@@ -165,7 +170,7 @@ impl PointColumns {
         if self.lyapunov {
             kinds.extend([Float, Float]);
         }
-        kinds.extend([Text, Float, Int, Float, Float, Float]);
+        kinds.extend([Text, Float, Int, Float, Float, Float, Text, Int]);
         kinds
     }
 
@@ -218,7 +223,7 @@ impl PointColumns {
 
 /// The cells of [`MOTION_COLUMNS`] for a point (all missing for a failed one; NaN is
 /// missing).
-fn motion_cells(point: Option<&PointResult>) -> [Cell; 6] {
+fn motion_cells(point: Option<&PointResult>) -> [Cell; 8] {
     let Some(p) = point else {
         return std::array::from_fn(|_| Cell::Missing);
     };
@@ -230,6 +235,12 @@ fn motion_cells(point: Option<&PointResult>) -> [Cell; 6] {
         Cell::number(m.and_then(|m| m.rate)),
         Cell::number(m.map(|m| m.residual)),
         Cell::number(m.and_then(|m| m.periods_needed)),
+        Cell::Text(
+            m.and_then(|m| m.label_source)
+                .map_or(String::new(), |s| s.as_str().to_string()),
+        ),
+        m.and_then(|m| m.coexisting)
+            .map_or(Cell::Missing, |c| Cell::Int(i64::from(c.0))),
     ]
 }
 
@@ -509,8 +520,8 @@ mod tests {
         }
         let s = t.summary();
         assert_eq!(s.names()[..3], ["param", "average_power_w", "impacts_per_period"]);
-        assert_eq!(s.names()[s.names().len() - 7], "error");
-        assert_eq!(s.names()[s.names().len() - 6..], MOTION_COLUMNS);
+        assert_eq!(s.names()[s.names().len() - 9], "error");
+        assert_eq!(s.names()[s.names().len() - 8..], MOTION_COLUMNS);
         assert_eq!(s.rows(), 3);
         let Some(Column::Float(p)) = s.get("average_power_w") else {
             panic!()
