@@ -68,7 +68,7 @@ use std::f64::consts::TAU;
 
 use vibrotribo::config::Config;
 use vibrotribo::dynamics::driven_chain;
-use vibrotribo::excitation::{HarmonicPieces, PiecewiseCubic};
+use vibrotribo::excitation::PiecewiseCubic;
 use vibrotribo::study::{RunObserver, RunSpec, simulate};
 use vibrotribo::{
     ChainParams, Event, EventKind, Flow, ForcePolynomial, Observer, RunEnd, Simulator, StateView,
