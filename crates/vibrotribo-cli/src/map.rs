@@ -106,9 +106,6 @@ pub fn run(args: &MapArgs) -> Result<()> {
     check_axis("x", args.x_from, args.x_to, args.x_steps)?;
     check_axis("y", args.y_from, args.y_to, args.y_steps)?;
     limits::check_grid("--x-steps × --y-steps", args.x_steps as f64 * args.y_steps as f64)?;
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     if args.resume && args.out.is_none() {
         bail!("--resume needs --out DIR (the directory of the job to continue)");
     }
@@ -371,9 +368,6 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     }
     if args.run.mechanics_only {
         bail!("the optimal mass ratio maximises power: --mechanics-only does not apply");
-    }
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;

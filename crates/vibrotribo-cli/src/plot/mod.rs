@@ -19,6 +19,7 @@
 //! name the font family `sans-serif` and leave the glyphs to the viewer.
 
 mod category;
+pub mod drawn;
 mod figure;
 mod heat;
 #[cfg(test)]

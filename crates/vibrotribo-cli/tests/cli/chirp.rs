@@ -425,10 +425,6 @@ fn bad_chirp_input_is_named() {
             ],
             "linear or logarithmic",
         ),
-        (
-            &["--from", "0.8", "--to", "1.6", "--duration", "60", "--plot"],
-            "--plot needs --out",
-        ),
     ];
     for (extra, expected) in cases {
         let mut args = base.to_vec();
