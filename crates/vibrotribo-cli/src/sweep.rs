@@ -121,7 +121,7 @@ pub struct RunArgs {
     /// within the period tolerance (checked every 50 periods; a geometric approach to a
     /// periodic orbit is finished by Newton shooting; a motion whose returns do not shrink
     /// stops after --transient periods), at most --settle-cap periods; `fixed` exactly
-    /// --transient periods (the results of earlier versions).
+    /// --transient periods.
     #[arg(long, default_value = "auto", value_name = "auto|fixed", value_parser = clap::value_parser!(Settle))]
     pub settle: Settle,
     /// Most periods `--settle auto` runs before the recorded window.

@@ -1,4 +1,4 @@
-//! Base motion beyond one sine (issue 14): the signal side. The engine side, which runs
+//! Base motion beyond one sine: the signal side. The engine side, which runs
 //! these motions exactly, is [`BaseDrive`](crate::study::BaseDrive).
 //!
 //! The chain's base moves as y(t) (m); mass i feels it through its spring and damper, the

@@ -1,5 +1,5 @@
 //! [`BaseDrive`]: drives the exact mechanics with a base motion other than the chain's own
-//! `y = A sin ωt` (issue 14).
+//! `y = A sin ωt`.
 //!
 //! Every spring and damper of mass i is attached to the base (docs/MODEL.md), so a base
 //! displacement y(t) acts on mass i as the force `k_i y(t) + c_i y'(t)`. On each interval
@@ -17,8 +17,8 @@
 //! every interval end restarts the event search. A multisine's displacement error is at most
 //! [`multisine_tolerance`]; a random signal's is `spline_tolerance` times its RMS displacement, built
 //! once with the configuration ([`BaseMotion::Pieces`]); a multisine's are built per run.
-// TODO(issue 14): a closed-form multisine in the engine (one particular solution per
-// harmonic, no intervals at all) would remove the remaining interpolation error.
+// A closed-form multisine in the engine (one particular solution per harmonic, no intervals
+// at all) would remove the remaining interpolation error; it is not implemented.
 
 use std::borrow::Cow;
 use std::sync::Arc;
