@@ -98,7 +98,10 @@ fn default_out(command: &mut Command) {
     };
     if plot && out.is_none() {
         let dir = std::path::Path::new(DEFAULT_OUT).join(name);
-        println!("vibrotribo {name}: no --out given, writing into {}", dir.display());
+        println!(
+            "vibrotribo {name}: no --out given, writing into {}",
+            dir.display()
+        );
         *out = Some(dir);
     }
 }

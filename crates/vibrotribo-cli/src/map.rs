@@ -212,6 +212,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
+    if let Some(dir) = &args.out {
+        println!("  wrote {0}/map.csv, {0}/map.json", dir.display());
+    }
     if !complete {
         return Err(Interrupted {
             what: format!(
@@ -520,6 +523,10 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                 plot_optimal_mass_ratio(path, &ws, &rs, fit.as_ref(), (args.omega_from, args.omega_to))
             })?;
         }
+        println!(
+            "  wrote {0}/power_grid.csv, {0}/optimum.csv, {0}/fit.json",
+            dir.display()
+        );
     }
     Ok(())
 }

@@ -17,7 +17,10 @@ pub(super) fn record(path: &Path) {
 
 /// Takes the list of the files drawn so far (the list is empty afterwards).
 pub fn take() -> Vec<PathBuf> {
-    DRAWN.lock().map(|mut d| std::mem::take(&mut *d)).unwrap_or_default()
+    DRAWN
+        .lock()
+        .map(|mut d| std::mem::take(&mut *d))
+        .unwrap_or_default()
 }
 
 /// The lines that tell what was drawn: per directory, the pictures' names without their
@@ -28,8 +31,14 @@ pub fn summary(files: &[PathBuf]) -> Vec<String> {
     for f in files {
         let dir = f.parent().map(Path::to_path_buf).unwrap_or_default();
         let (stems, exts) = by_dir.entry(dir).or_default();
-        let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let ext = f.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+        let stem = f
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let ext = f
+            .extension()
+            .map(|e| format!(".{}", e.to_string_lossy()))
+            .unwrap_or_default();
         if !stems.contains(&stem) {
             stems.push(stem);
         }
@@ -69,10 +78,16 @@ mod tests {
 
     #[test]
     fn summary_groups_by_directory_and_extension() {
-        let files: Vec<PathBuf> = ["out/a.png", "out/a.svg", "out/b.png", "out/b.svg", "out/sub/c.png"]
-            .iter()
-            .map(PathBuf::from)
-            .collect();
+        let files: Vec<PathBuf> = [
+            "out/a.png",
+            "out/a.svg",
+            "out/b.png",
+            "out/b.svg",
+            "out/sub/c.png",
+        ]
+        .iter()
+        .map(PathBuf::from)
+        .collect();
         assert_eq!(
             summary(&files),
             vec![

@@ -87,6 +87,7 @@ use Allowed::{Between, IntegerAtLeast, NonNegative, OneOf, Positive, Text};
 const KINDS: &[&str] = &["harmonic", "multisine", "chirp", "random", "record"];
 
 /// Meaning, unit and allowed values of every key, in the schema's order.
+#[rustfmt::skip]
 pub const KEY_DOCS: &[KeyDoc] = &[
     // [oscillator]
     doc("oscillator.masses", "kg", Positive, "", "Masses m₁ … m_N, top to bottom; their number is the chain's length N (N ≥ 2, or N ≥ 1 with a stop)."),
@@ -146,13 +147,13 @@ pub const KEY_DOCS: &[KeyDoc] = &[
     doc("harvester.storage_capacitance", "F", Positive, "", "Rectifier: storage capacitance."),
     doc("harvester.storage_load_resistance", "Ω", Positive, "none", "Rectifier: resistor across the storage capacitor."),
     doc("harvester.storage_initial_voltage", "V", Text("finite"), "", "Rectifier: storage voltage at t = 0."),
-    doc("harvester.target_voltage", "V", Positive, "none", "Rectifier: storage voltage whose first crossing is reported (`time_to_target_s`)."),
+    doc("harvester.target_voltage", "V", Text("finite"), "none", "Rectifier: storage voltage whose first crossing is reported (`time_to_target_s`)."),
     doc("harvester.initial_charge", "C", Text("finite"), "electrostatic equilibrium Q(0) = C(0)·V_oc(0)", "Charge transferred between the electrodes at t = 0."),
     doc("harvester.coupling", "—", OneOf(&["one_way", "two_way"]), "", "Whether the electrostatic force of the charges acts back on the masses (`two_way` needs `voc_model = \"exact\"` in freestanding mode)."),
     doc("harvester.coupling_tolerance", "m", Positive, "", "Two-way coupling: the displacement error one window's charge representation may cause."),
     doc("harvester.diode_saturation_current", "A", Positive, "", "Rectifier diodes: saturation current I_s."),
     doc("harvester.diode_ideality", "—", Positive, "", "Rectifier diodes: ideality factor n."),
-    doc("harvester.diode_series_resistance", "Ω", NonNegative, "", "Rectifier diodes: series resistance."),
+    doc("harvester.diode_series_resistance", "Ω", Positive, "", "Rectifier diodes: series resistance."),
     doc("harvester.diode_thermal_voltage", "V", Positive, "", "Rectifier diodes: thermal voltage V_T."),
     doc("harvester.diode_parallel_conductance", "S", NonNegative, "", "Rectifier diodes: leakage conductance."),
     // [electrical]
@@ -301,8 +302,16 @@ mod tests {
 
     #[test]
     fn every_key_is_documented_and_every_entry_is_a_key() {
-        assert!(undocumented_keys().is_empty(), "keys without an entry in KEY_DOCS: {:?}", undocumented_keys());
-        assert!(stale_entries().is_empty(), "KEY_DOCS entries that are no key: {:?}", stale_entries());
+        assert!(
+            undocumented_keys().is_empty(),
+            "keys without an entry in KEY_DOCS: {:?}",
+            undocumented_keys()
+        );
+        assert!(
+            stale_entries().is_empty(),
+            "KEY_DOCS entries that are no key: {:?}",
+            stale_entries()
+        );
     }
 
     /// The defaults the reference shows are the values the default configuration reads.
@@ -311,16 +320,37 @@ mod tests {
         let config = Config::default();
         let defaults = serde_json::to_value(default_document()).unwrap();
         let chain = config.chain();
-        assert_eq!(default_of(&defaults, "oscillator.masses"), Some(toml::Value::try_from(&chain.masses).unwrap().to_string()));
-        assert_eq!(default_of(&defaults, "oscillator.gaps"), Some(toml::Value::try_from(&chain.gaps).unwrap().to_string()));
-        assert_eq!(default_of(&defaults, "excitation.amplitude"), Some(chain.excitation.amplitude.to_string()));
-        assert_eq!(default_of(&defaults, "excitation.omega_ratio"), Some(chain.omega_ratio().to_string()));
+        assert_eq!(
+            default_of(&defaults, "oscillator.masses"),
+            Some(toml::Value::try_from(&chain.masses).unwrap().to_string())
+        );
+        assert_eq!(
+            default_of(&defaults, "oscillator.gaps"),
+            Some(toml::Value::try_from(&chain.gaps).unwrap().to_string())
+        );
+        assert_eq!(
+            default_of(&defaults, "excitation.amplitude"),
+            Some(chain.excitation.amplitude.to_string())
+        );
+        assert_eq!(
+            default_of(&defaults, "excitation.omega_ratio").map(|v| v.parse::<f64>().unwrap()),
+            Some(chain.omega_ratio()).map(|w| (w * 1e12).round() / 1e12)
+        );
         assert_eq!(default_of(&defaults, "run.periods"), Some("100".into()));
-        assert_eq!(default_of(&defaults, "harvester.load_resistance"), Some("100000.0".into()));
+        assert_eq!(
+            default_of(&defaults, "harvester.load_resistance"),
+            Some("100000.0".into())
+        );
         assert_eq!(default_of(&defaults, "run.transient_periods"), None);
         // A configuration written from the shown defaults reads as the default one.
         let mut text = String::new();
-        for key in ["oscillator.masses", "oscillator.stiffness", "oscillator.damping", "oscillator.gaps", "oscillator.restitution"] {
+        for key in [
+            "oscillator.masses",
+            "oscillator.stiffness",
+            "oscillator.damping",
+            "oscillator.gaps",
+            "oscillator.restitution",
+        ] {
             let (_, name) = key.split_once('.').unwrap();
             if text.is_empty() {
                 text.push_str("[oscillator]\n");
