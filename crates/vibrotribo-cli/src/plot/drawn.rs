@@ -46,7 +46,7 @@ pub fn summary(files: &[PathBuf]) -> Vec<String> {
             exts.push(ext);
         }
     }
-    const SHOWN: usize = 12;
+    const SHOWN: usize = 24;
     by_dir
         .into_iter()
         .map(|(dir, (stems, exts))| {
@@ -95,9 +95,9 @@ mod tests {
                 "  drew 1 picture in out/sub: c (.png)".to_string(),
             ]
         );
-        let many: Vec<PathBuf> = (0..20).map(|i| PathBuf::from(format!("d/p{i:02}.png"))).collect();
+        let many: Vec<PathBuf> = (0..30).map(|i| PathBuf::from(format!("d/p{i:02}.png"))).collect();
         let line = &summary(&many)[0];
-        assert!(line.starts_with("  drew 20 pictures in d: p00, p01"), "{line}");
-        assert!(line.contains("… (8 more)"), "{line}");
+        assert!(line.starts_with("  drew 30 pictures in d: p00, p01"), "{line}");
+        assert!(line.contains("p23, … (6 more)"), "{line}");
     }
 }
