@@ -23,7 +23,7 @@ PARTS = [
      [r"roots::first_root$", r"roots::Search::advance$"]),
     ("    events: impacts, sticking, chatter (Simulator::handle)", 0, [r"Simulator::handle$"]),
     ("  charge solver (ChargeSolver::advance_flow)", 0, [r"ChargeSolver>::advance_flow$"]),
-    # Undercounted where the build inlines Oscillator::taylor into it (as from stop 23 on):
+    # Undercounted where the build inlines Oscillator::taylor into it (current builds do):
     # inlined callees have no inclusive entry of their own.
     ("    Taylor expansion of the gaps (GapPolynomial::build; see the note)", 0,
      [r"GapPolynomial::build$", r"Oscillator::taylor$"]),

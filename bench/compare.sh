@@ -2,7 +2,7 @@
 # Side-by-side speed comparison, one run: vibrotribo's engine (criterion, median) against the
 # scipy solve_ivp baseline (median of 3 separate processes), both on the paper's default case
 # and its chatter case. Prints periods/s for each, the ratio per simulated period, and the
-# engine's events/s per core (issue 12's target: 1 000 000 in the default case).
+# engine's events/s per core (the target: 1 000 000 in the default case).
 #
 # Usage: bench/compare.sh [scipy periods, default 100]
 # Needs python3 with numpy and scipy (pip install numpy scipy).
@@ -40,7 +40,7 @@ for case in ("default", "chatter"):
     periods = float(est.split("periods (")[1].split(")")[0])
     median_ns = json.load(open(est))["median"]["point_estimate"]
     vt_rate = periods / (median_ns * 1e-9)
-    # Events per period of the benchmark's own run, from its events benchmark's name (issue 12's
+    # Events per period of the benchmark's own run, from its events benchmark's name (the
     # events/s target is per core: the engine benchmark is single-threaded).
     names = glob.glob(os.path.join(crit, case + "_case", "events (* in * periods)"))
     ev = ""

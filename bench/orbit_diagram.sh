@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 12's second target, side by side in one run: the chatter case's orbit diagram over
+# The 2000× target for orbit diagrams, side by side in one run: the chatter case's orbit diagram over
 # Ω ∈ [0.3, 1.0], 200 values, each 300 transient + 100 recorded periods from rest (400 periods),
 # by `vibrotribo sweep` with the 100 kΩ harvester's power on 2 threads, against the scipy
 # baseline (mechanics only, one process) run on every STRIDE-th value of the same grid for

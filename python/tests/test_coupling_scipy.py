@@ -1,4 +1,4 @@
-"""Two-way electromechanical coupling (issue 11) against an independent general-purpose
+"""Two-way electromechanical coupling against an independent general-purpose
 stiff integrator: scipy's Radau (rtol 1e-10) with event functions on the same coupled
 equations, restarted after every impact, compared with ``vibrotribo.simulate`` on impact
 times, impact speeds and the load's energy.

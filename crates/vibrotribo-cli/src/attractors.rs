@@ -95,9 +95,6 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
         bail!("--from and --to must be finite numbers");
     }
     crate::limits::check_grid("--steps × --samples", args.steps as f64 * args.samples as f64)?;
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
     base.check_uncoupled("attractors")?;

@@ -218,9 +218,6 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     }
     let (nx, ny) = (args.grid.nx, args.grid.ny);
     limits::check_grid("--grid", nx as f64 * ny as f64)?;
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     if args.resume && args.out.is_none() {
         bail!("--resume needs --out DIR (the directory of the job to continue)");
     }

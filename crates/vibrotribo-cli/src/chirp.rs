@@ -82,7 +82,7 @@ pub struct ChirpArgs {
     /// Write response.csv and chirp.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Also draw the response curves, up and down together (needs --out).
+    /// Also draw the response curves, up and down together (without --out: into vibrotribo-out/chirp).
     #[arg(long)]
     pub plot: bool,
     /// No progress bar.
@@ -102,9 +102,6 @@ fn option_error(e: ChirpError) -> anyhow::Error {
 
 /// Runs `vibrotribo chirp`.
 pub fn run(args: &ChirpArgs) -> Result<()> {
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     let config = args.input.load()?;
     let options = ChirpOptions {
         from: args.from,

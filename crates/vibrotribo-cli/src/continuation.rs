@@ -54,7 +54,7 @@ pub struct ContinueArgs {
     /// Write branch.csv, bifurcations.csv and continue.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Also draw the branches over a brute-force orbit diagram (needs --out).
+    /// Also draw the branches over a brute-force orbit diagram (without --out: into vibrotribo-out/continue).
     #[arg(long)]
     pub plot: bool,
     /// Values of the brute-force orbit diagram drawn under the branches with --plot.
@@ -71,9 +71,6 @@ const POWER_PERIODS: u32 = 2;
 
 /// Runs `vibrotribo continue`.
 pub fn run(args: &ContinueArgs) -> Result<()> {
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     if args.period == Some(0) {
         bail!("--period must be at least 1");
     }

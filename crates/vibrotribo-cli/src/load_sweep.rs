@@ -33,7 +33,7 @@ pub struct LoadSweepArgs {
     /// Write load_sweep.csv, vq_cycle.csv and load_sweep.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Also draw load_sweep.png/.svg and vq_cycle.png/.svg (needs --out).
+    /// Also draw load_sweep.png/.svg and vq_cycle.png/.svg (without --out: into vibrotribo-out/load-sweep).
     #[arg(long)]
     pub plot: bool,
     /// No progress bar.
@@ -52,9 +52,6 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
     }
     if args.steps == 0 {
         bail!("--steps must be at least 1");
-    }
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
     }
     let config = args.input.load()?;
     let spec = config.run_spec(false);

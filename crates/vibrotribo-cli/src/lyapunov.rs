@@ -56,9 +56,6 @@ pub fn run(args: &LyapunovArgs) -> Result<()> {
     if args.periods == 0 {
         bail!("--periods must be at least 1");
     }
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     let config = args.input.load()?;
     config.check_uncoupled("lyapunov")?;
     config.check_periodic("Lyapunov exponents (`lyapunov`)")?;

@@ -72,6 +72,40 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
     Plot(PlotArgs),
+    /// Write the configuration reference (every key, its unit, default and allowed values) as
+    /// Markdown: the guide's `reference/configuration.md`.
+    #[command(hide = true)]
+    ConfigReference,
+}
+
+/// Where a command writes when `--plot` is given without `--out`: `vibrotribo-out/COMMAND`
+/// in the working directory.
+pub const DEFAULT_OUT: &str = "vibrotribo-out";
+
+/// Gives a command run with `--plot` and no `--out` the default folder, and says so.
+fn default_out(command: &mut Command) {
+    let (name, out, plot) = match command {
+        Command::Simulate(a) => ("simulate", &mut a.out, a.plot),
+        Command::LoadSweep(a) => ("load-sweep", &mut a.out, a.plot),
+        Command::Periodic(a) => ("periodic", &mut a.out, a.plot),
+        Command::Continue(a) => ("continue", &mut a.out, a.plot),
+        Command::Sweep(a) => ("sweep", &mut a.out, a.plot),
+        Command::Chirp(a) => ("chirp", &mut a.out, a.plot),
+        Command::Map(a) => ("map", &mut a.out, a.plot),
+        Command::OptimizeMassRatio(a) => ("optimize-mass-ratio", &mut a.out, a.plot),
+        Command::Lyapunov(a) => ("lyapunov", &mut a.out, a.plot),
+        Command::Basins(a) => ("basins", &mut a.out, a.plot),
+        Command::Attractors(a) => ("attractors", &mut a.out, a.plot),
+        _ => return,
+    };
+    if plot && out.is_none() {
+        let dir = std::path::Path::new(DEFAULT_OUT).join(name);
+        println!(
+            "vibrotribo {name}: no --out given, writing into {}",
+            dir.display()
+        );
+        *out = Some(dir);
+    }
 }
 
 /// Options of `vibrotribo plot`.
@@ -86,7 +120,8 @@ struct PlotArgs {
 }
 
 fn run() -> anyhow::Result<()> {
-    let cli = Cli::parse();
+    let mut cli = Cli::parse();
+    default_out(&mut cli.command);
     progress::install_interrupt_handler()
         .map_err(|e| anyhow::anyhow!("cannot install the signal handlers: {e}"))?;
     match cli.command {
@@ -105,11 +140,18 @@ fn run() -> anyhow::Result<()> {
         Command::Attractors(args) => attractors::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
+        Command::ConfigReference => {
+            print!("{}", vibrotribo::config::reference_markdown());
+            Ok(())
+        }
     }
 }
 
 fn main() -> ExitCode {
-    match run() {
+    let result = run();
+    // The pictures drawn, also when the command stopped on the way.
+    plot::drawn::report();
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => match e.downcast_ref::<progress::Interrupted>() {
             Some(stop) => {

@@ -108,9 +108,6 @@ pub fn run(args: &MapArgs) -> Result<()> {
     check_axis("x", args.x_from, args.x_to, args.x_steps)?;
     check_axis("y", args.y_from, args.y_to, args.y_steps)?;
     limits::check_grid("--x-steps × --y-steps", args.x_steps as f64 * args.y_steps as f64)?;
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     if args.resume && args.out.is_none() {
         bail!("--resume needs --out DIR (the directory of the job to continue)");
     }
@@ -225,6 +222,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
+    if let Some(dir) = &args.out {
+        println!("  wrote {0}/map.csv, {0}/map.json", dir.display());
+    }
     if !complete {
         return Err(Interrupted {
             what: format!(
@@ -371,9 +371,6 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     }
     if args.run.mechanics_only {
         bail!("the optimal mass ratio maximises power: --mechanics-only does not apply");
-    }
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
@@ -526,6 +523,10 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
                 plot_optimal_mass_ratio(path, &ws, &rs, fit.as_ref(), (args.omega_from, args.omega_to))
             })?;
         }
+        println!(
+            "  wrote {0}/power_grid.csv, {0}/optimum.csv, {0}/fit.json",
+            dir.display()
+        );
     }
     Ok(())
 }

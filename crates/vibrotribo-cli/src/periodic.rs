@@ -36,7 +36,7 @@ pub struct PeriodicArgs {
     /// Write periodic.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Also draw the orbit's phase portraits and its multipliers (needs --out).
+    /// Also draw the orbit's phase portraits and its multipliers (without --out: into vibrotribo-out/periodic).
     #[arg(long)]
     pub plot: bool,
 }
@@ -47,9 +47,6 @@ const POWER_PERIODS: u32 = 4;
 
 /// Runs `vibrotribo periodic`.
 pub fn run(args: &PeriodicArgs) -> Result<()> {
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
-    }
     if args.period == Some(0) {
         bail!("--period must be at least 1");
     }

@@ -32,7 +32,7 @@ pub fn install_interrupt_handler() -> std::io::Result<()> {
         term: Arc::new(AtomicBool::new(false)),
     });
     for (signal, status) in [(SIGINT, EXIT_SIGINT), (SIGTERM, EXIT_SIGTERM)] {
-        // Registered first, so that it sees the flag as it was before this signal: a second
+        // Registered first, so that it sees the flag's value from before this signal: a second
         // signal of either kind exits at once.
         signal_hook::flag::register_conditional_shutdown(signal, i32::from(status), Arc::clone(&flags.any))?;
         signal_hook::flag::register(signal, Arc::clone(&flags.any))?;

@@ -31,7 +31,7 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub mechanics_only: bool,
     /// Also write the per-run analyses (Poincaré sections, PSDs) and draw the pictures
-    /// (needs --out).
+    /// (without --out: into vibrotribo-out/simulate).
     #[arg(long)]
     pub plot: bool,
     /// No progress bar.
@@ -167,9 +167,6 @@ impl RunObserver for Files {
 
 /// Runs `vibrotribo simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    if args.plot && args.out.is_none() {
-        anyhow::bail!("--plot needs --out DIR");
-    }
     let config = args.input.load()?;
     let mut spec = config.sampled_run_spec(args.mechanics_only);
     spec.breakdown_check = true;

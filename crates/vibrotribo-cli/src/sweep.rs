@@ -61,7 +61,8 @@ pub struct SweepArgs {
     /// result is what one uninterrupted run writes.
     #[arg(long)]
     pub resume: bool,
-    /// Also draw the diagrams (PNG and SVG) into the output directory.
+    /// Also draw the diagrams (PNG and SVG) into the output directory (without --out:
+    /// vibrotribo-out/sweep).
     #[arg(long)]
     pub plot: bool,
     /// Also compute the largest Lyapunov exponent over the recorded periods of every value
@@ -168,9 +169,6 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     limits::check_grid("--steps", args.steps as f64)?;
     if !args.from.is_finite() || !args.to.is_finite() {
         bail!("--from and --to must be finite numbers");
-    }
-    if args.plot && args.out.is_none() {
-        bail!("--plot needs --out DIR");
     }
     if args.resume && args.out.is_none() {
         bail!("--resume needs --out DIR (the directory of the job to continue)");

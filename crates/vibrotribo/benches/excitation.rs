@@ -1,5 +1,5 @@
-//! The cost of a base motion other than one sine (issue 14: "a recorded-input run costs at
-//! most 3× the harmonic run per simulated second"). Four runs of the paper's default case
+//! The cost of a base motion other than one sine, against the goal that a recorded-input run
+//! cost at most 3× the harmonic run per simulated second. Four runs of the paper's default case
 //! over 1000 excitation periods (179.5 s), mechanics only and with the 100 kΩ harvester:
 //!
 //! - `harmonic`: `y = A sin ωt`, the engine's own closed form;

@@ -1,4 +1,4 @@
-//! Two-way electromechanical coupling (issue 11): the coupled run against what is known
+//! Two-way electromechanical coupling: the coupled run against what is known
 //! without it.
 
 use vibrotribo::coupling::{CoupledChain, CouplingOptions, SolverOnly};

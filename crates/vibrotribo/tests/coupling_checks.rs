@@ -1,4 +1,4 @@
-//! Two-way electromechanical coupling (issue 11): the checks against truth from outside the
+//! Two-way electromechanical coupling: the checks against truth from outside the
 //! coupling code.
 //!
 //! **Static equilibrium.** With the base at rest the coupled chain settles where every spring
@@ -507,7 +507,7 @@ fn energy_balance_two_way_resistor() {
 
 /// Energy balance of the chatter case in its sticking regime (masses 0.05/0.15/0.05 kg, gaps
 /// 5 mm, Ω = 0.4, 100 kΩ, 5 periods from rest: impacts, chatter, sticks and releases), where
-/// two-way runs used to loop at a release (tests/issue_coupled_stick_release_loop.rs): the
+/// a two-way run can loop at a release (tests/issue_coupled_stick_release_loop.rs): the
 /// work of the base is ΔE + D + L + E_load + ΔU to 1e-8 of it and to 1e-5 of the electrical
 /// terms.
 #[test]
@@ -562,17 +562,14 @@ fn energy_balance_two_way_rectifier() {
 }
 
 /// The rectifier's balance residual against `coupling_tolerance` (the default case, 20
-/// periods), as [`energy_balance_against_the_coupling_tolerance`] for the resistor. Measured at
-/// stop 20: −1.85e-8, 9.8e-10, −1.23e-10, −7.5e-11 J at 1e-10, 1e-11, 1e-12, 1e-13 m (−6.3e-6,
-/// 3.4e-7, −4.2e-8, −2.6e-8 of the electrical terms, 2.9 mJ; the last step is near the charge
-/// solver's rtol of 1e-10), ~8 s; stop 22: +3.5e-9, −1.7e-9, −4.3e-10, −1.7e-10 J (1.2e-6,
-/// 5.8e-7, 1.5e-7, 5.8e-8 of the electrical terms), 1.3 s; stop 23, after a change of the event
-/// search that moves event times by rounding only: +4.1e-10, −1.4e-9, −4.8e-10, −1.7e-10 J.
-/// The residual at the loosest tolerance is erratic (−1.85e-8, +3.5e-9, +4.1e-10 J across those
-/// versions: the coupling error of 1e-10 m windows, whose edges follow the event times), so
-/// the residual is not monotone decade by decade here; what holds is the envelope: the
-/// tightest tolerance gives the smallest residual, and from 1e-11 m on it is within 1e-6 of
-/// the electrical terms.
+/// periods), as [`energy_balance_against_the_coupling_tolerance`] for the resistor. Measured:
+/// +4.1e-10, −1.4e-9, −4.8e-10, −1.7e-10 J at 1e-10, 1e-11, 1e-12, 1e-13 m (the electrical
+/// terms are 2.9 mJ; the last step is near the charge solver's rtol of 1e-10). The residual at
+/// the loosest tolerance is erratic (it moves between −1.85e-8 and +4.1e-10 J when event times
+/// change by rounding: the coupling error of 1e-10 m windows, whose edges follow the event
+/// times), so the residual is not monotone decade by decade here; what holds is the envelope:
+/// the tightest tolerance gives the smallest residual, and from 1e-11 m on it is within 1e-6
+/// of the electrical terms.
 #[test]
 fn energy_balance_rectifier_against_the_coupling_tolerance() {
     balance_against_the_coupling_tolerance("two-way rectifier", Shrinks::ToTheTightest, |tolerance| {
@@ -735,16 +732,10 @@ fn force_error_accounts_for_the_residual() {
 
 /// The residual of the full identity against `coupling_tolerance` (the default case, 100 kΩ,
 /// 20 periods): it shrinks with the tolerance, and from the default tolerance on it is within
-/// 1e-6 of the electrical terms. Measured: −9.2e-8, −7.5e-10, 8.7e-11, −1.4e-11 J at 1e-10,
-/// 1e-11, 1e-12, 1e-13 m (with the correction α + βτ, whose start value moved the force at
-/// each window's start: −5.5e-8, 8.6e-10, −1.6e-10, 2.9e-11 J; before the force moments were
-/// matched: 1.4e-6, 5.8e-7, 2.0e-7, −5.4e-7 J). 1e-13 m takes ~5 s of the ~8 s.
-///
-/// Failed at stop 21 for a while (windows sampled in one run, the charge at the inner nodes from
-/// the solver's dense output: +3.6e-8, +9.2e-10, −5.3e-10, −2.7e-12 J, the 1e-12 m row no
-/// smaller than the 1e-11 m one); passes again from stop 21's last commit (a438b38) on. Stop 22:
-/// +2.8e-9, +1.1e-9, +3.7e-11, −9.6e-12 J (at 1e-11 m 4.1e-7 of the electrical terms, 9.5e-12 of
-/// the work); the four runs take 0.2 s.
+/// 1e-6 of the electrical terms. Measured: +2.8e-9, +1.1e-9, +3.7e-11, −9.6e-12 J at 1e-10,
+/// 1e-11, 1e-12, 1e-13 m (at 1e-11 m 4.1e-7 of the electrical terms, 9.5e-12 of the work); the
+/// four runs take 0.2 s. Windows whose inner charge nodes are taken from the solver's dense
+/// output instead of solved do not pass (the 1e-12 m row no smaller than the 1e-11 m one).
 #[test]
 fn energy_balance_against_the_coupling_tolerance() {
     balance_against_the_coupling_tolerance("two-way", Shrinks::DecadeByDecade, |tolerance| {

@@ -1,4 +1,4 @@
-//! Two-way coupling and the events (issue 11): impacts, sticking, release and chatter under
+//! Two-way coupling and the events: impacts, sticking, release and chatter under
 //! the electrostatic force, with every load (resistor, rectifier, open, short), in the
 //! scenarios of the one-way event tests. The truth comes from outside the coupling code:
 //!
@@ -600,9 +600,9 @@ fn sticking_scenarios() -> Vec<(&'static str, ChainParams, f64)> {
 
 /// A start away from electrostatic equilibrium (−0.2 σS, C), so that the charge has a
 /// transient; the rectifier starts at equilibrium (V = 0): −0.2 σS would put kilovolts across
-/// its diodes at t = 0, a picosecond discharge through their series resistances (handled since
-/// stop 20, `electrical_analytic::rectifier_started_kilovolts_from_equilibrium_…`; it used to
-/// stop the charge solver) that these event tests are not about.
+/// its diodes at t = 0, a picosecond discharge through their series resistances (tested in
+/// `electrical_analytic::rectifier_started_kilovolts_from_equilibrium_…`) that these event
+/// tests are not about.
 fn start_charge(h: &HarvesterParams, chain: &ChainParams) -> f64 {
     match h.load {
         Load::Rectifier(_) => equilibrium_charge(h, &chain.gaps),
@@ -819,10 +819,9 @@ fn grazing_pair_in_open_circuit_against_the_closed_form() {
 
 /// The one-way accuracy of the stored flow in two-way runs: every gap of the stored flow ≥ −1e-12
 /// of its δ (tests/events_vs_bruteforce.rs's criterion; one-way runs of these chains reach
-/// −2.7e-13 δ at worst). Not met at stop 19–21 (notes/coupled-event-accuracy.md §2, down to
-/// about −2e-12 δ); met from stop 21's last commit (a438b38) on, the twelve runs at −1.5e-14 …
-/// −3.8e-13 δ. Also prints each run's latest release after the zero of its contact
-/// force (asserted in the main checks).
+/// −2.7e-13 δ at worst; notes/coupled-event-accuracy.md §2 explains what makes two-way runs
+/// reach it). Measured: the twelve runs at −1.5e-14 … −3.8e-13 δ. Also prints each run's latest
+/// release after the zero of its contact force (asserted in the main checks).
 #[test]
 fn coupled_stored_flow_gaps() {
     let mut failures = Vec::new();

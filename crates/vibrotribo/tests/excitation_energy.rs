@@ -1,4 +1,4 @@
-//! The engine under band-limited random base motion (issue 14) against an exact identity
+//! The engine under band-limited random base motion against an exact identity
 //! from outside the code: the mechanical energy balance
 //!
 //! ```text

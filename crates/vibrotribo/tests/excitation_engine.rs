@@ -1,4 +1,4 @@
-//! The engine under base motions other than one sine (issue 14), against truth from outside
+//! The engine under base motions other than one sine, against truth from outside
 //! the code: the harmonic run itself (a one-harmonic multisine must equal it bit for bit, a
 //! record of it sampled 200 times a period must reproduce it within the spline's error), an
 //! independent fixed-step RK4 integrator written here (two harmonics, impacts by bisection

@@ -1,4 +1,4 @@
-//! The signal side of non-harmonic base motion (issue 14), against truth from outside the
+//! The signal side of non-harmonic base motion, against truth from outside the
 //! code: splines of a sine against the sine and the Hall–Meyer bounds, exact integration of
 //! a piecewise-linear acceleration against the Fourier series of a triangle wave, chirps'
 //! instantaneous frequency from the zero crossings of the built signal, random signals'

@@ -20,6 +20,7 @@
 
 mod category;
 mod draw;
+pub mod drawn;
 mod figure;
 mod files;
 mod heat;

@@ -81,6 +81,7 @@ pub(super) fn write(path: &Path, size: (u32, u32), chart: &impl Render) -> Resul
             root.present().map_err(err).with_context(context)?;
         }
     }
+    super::drawn::record(path);
     Ok(())
 }
 

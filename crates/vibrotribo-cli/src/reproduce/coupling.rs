@@ -1,4 +1,4 @@
-//! Beyond the paper: two-way coupling (issue 11). The electrostatic force of the charges acts
+//! Beyond the paper: two-way coupling. The electrostatic force of the charges acts
 //! back on the masses (`harvester.coupling = "two_way"`): how much does it change the paper's
 //! default and chatter cases, the chatter case's response over Ω, and the optimal load?
 //! Every run uses the exact V_oc law in both modes, so that only the coupling differs.

@@ -1,4 +1,4 @@
-//! Beyond the paper: real vibration (issue 14). The paper's default and chatter devices
+//! Beyond the paper: real vibration. The paper's default and chatter devices
 //! driven by its sine, by a real recorded vibration (the BW.RJOB seismic record shipped in
 //! `configs/records/`) and by band-limited random noise of the same RMS acceleration: does
 //! chatter still pay off when the input is not one clean sine?

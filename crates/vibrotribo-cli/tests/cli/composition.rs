@@ -52,7 +52,7 @@ const MODELS: [(&str, &str, bool); 3] = [
     ),
 ];
 
-/// The stops: name and `[oscillator.stops.upper]` table (a stop 30 mm above the top mass).
+/// The stops: name and `[oscillator.stops.upper]` table (a stop placed 30 mm above the top mass).
 const STOPS: [(&str, &str); 3] = [
     ("none", ""),
     ("fixed", "gap = 0.03\nrestitution = 0.8\nframe = \"fixed\"\n"),

@@ -1,4 +1,4 @@
-//! Base motions other than one sine (issue 14) on the command line: the shipped record
+//! Base motions other than one sine on the command line: the shipped record
 //! configuration runs and states its base motion; sweeps and maps run under it; the
 //! stroboscopic tools refuse it, naming the reason.
 

@@ -1,4 +1,4 @@
-//! Issue 7: `merge` rejected complete, valid shards (grid values read back from sweep.json one
+//! `merge` rejected complete, valid shards (grid values read back from sweep.json one
 //! ulp off); a shard rerun killed by SIGTERM left the old `"complete": true` beside cut CSVs,
 //! and `merge` then produced an incomplete result with exit 0; SIGTERM was not handled,
 //! interrupted runs exited 0, and nothing could be resumed.

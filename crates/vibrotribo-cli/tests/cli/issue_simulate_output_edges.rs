@@ -1,4 +1,4 @@
-//! Issue 7: `trajectory.csv` sometimes lacked its last sample (j·T/spp rounded past the end);
+//! `trajectory.csv` sometimes lacked its last sample (j·T/spp rounded past the end);
 //! the air-breakdown ratio depended on `samples_per_period` and was missing without `--out`;
 //! sizes had no limits (`samples_per_period=1e11` filled memory, `--steps 1e11` aborted);
 //! negative option values needed `--from=-0.01`; `plot nothere` said the directory held no

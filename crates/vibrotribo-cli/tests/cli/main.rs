@@ -7,6 +7,7 @@ mod composition;
 mod excitation;
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_motion_classified;
+mod issue_plot_without_out;
 mod issue_simulate_output_edges;
 mod lyapunov;
 mod periodic_orbits;

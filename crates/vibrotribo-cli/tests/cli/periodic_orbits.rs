@@ -1,4 +1,4 @@
-//! `periodic`, `continue` and `sweep --floquet` (issue 9): the file contracts, and the
+//! `periodic`, `continue` and `sweep --floquet`: the file contracts, and the
 //! results checked against independent runs of the simulator.
 
 use super::util::*;

@@ -33,7 +33,7 @@ pub(super) struct OscillatorTable {
     pub stops: Stops,
 }
 
-/// The `[excitation]` table: the kind of base motion and its keys (issue 14). Every kind
+/// The `[excitation]` table: the kind of base motion and its keys. Every kind
 /// keeps `omega_ratio` or `frequency_hz`, the reference frequency whose period T is the
 /// unit in which `[run] periods`, `transient_periods` and `samples_per_period` count. A key
 /// of another kind than the one given is refused, naming the key. See

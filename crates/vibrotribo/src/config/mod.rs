@@ -12,16 +12,19 @@
 //! [`DERIVED_KEYS`], validates everything, and names the key at fault in every error
 //! (the library's field names mapped to keys, `masses[1]` → `oscillator.masses[1]`). A
 //! [`Param`] is a key resolved once, which the points of a sweep set directly
-//! ([`Config::with_values`]).
+//! ([`Config::with_values`]). [`reference_markdown`] writes every key with its unit, default
+//! and allowed values (the user guide's configuration reference).
 
 mod document;
 mod error;
 mod excitation;
 mod keys;
 mod param;
+mod reference;
 
 pub use document::Config;
 pub use error::ConfigError;
 pub use excitation::{DEFAULT_SPLINE_TOLERANCE, MAX_HARMONICS};
 pub use keys::{DERIVED_KEYS, apply_overrides, known_keys, parse_override, parse_value};
 pub use param::Param;
+pub use reference::{Allowed, KEY_DOCS, KeyDoc, reference_markdown, stale_entries, undocumented_keys};

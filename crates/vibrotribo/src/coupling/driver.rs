@@ -488,7 +488,7 @@ impl CoupledChain {
         // agree at the start but not in their derivatives, which decide a pair whose contact
         // force is zero there (a stick at a chatter point). Trials that keep those derivatives
         // could then undo each other's events at one instant (stick, release, stick, ...);
-        // such a window keeps the forces of a window that decides nothing, as before.
+        // such a window keeps the forces of a window that decides nothing.
         let settled = !(self.instant.0 == t0 && self.instant.1 >= 2);
         let mut precise = settled
             && self

@@ -37,9 +37,9 @@
 //! force polynomial's constant term is set to it; the correction vanishes at τ = 0). The
 //! engine decides the contacts at the window's start (stick, release, a touch) with that
 //! force, so every trial and every window from the same instant decides alike. A correction
-//! α + βτ, as before, moved the start force by up to the layer's size and made two-way runs of
-//! the chatter case loop at a release (release under one trial's force, stick under the
-//! next's, at one instant; `notes/coupled-stick-loop.md`).
+//! α + βτ that is not zero at τ = 0 would move the start force by up to the layer's size and
+//! can make two-way runs of the chatter case loop at a release (release under one trial's
+//! force, stick under the next's, at one instant; `notes/coupled-stick-loop.md`).
 //!
 //! The **charge tolerance** of a window of length h is the charge error whose force error,
 //! acting over the window, moves a mass by at most [`CouplingOptions::position_tolerance`]

@@ -24,7 +24,7 @@
 //! [`super::forces`]) adds its response from rest `r(t − t₀)` (see [`super::response`]: a
 //! power series on short flows, `p(t) + h_p(t − t₀)` with the polynomial particular solution
 //! `p` on long ones), so that the homogeneous part keeps the initial conditions of the
-//! harmonic motion alone; without one the flow is computed exactly as before.
+//! harmonic motion alone; without one the flow is the harmonic motion's closed form alone.
 
 use super::poly::{INV, Poly, RECIPROCALS};
 use crate::error::SimError;

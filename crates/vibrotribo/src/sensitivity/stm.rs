@@ -435,7 +435,8 @@ impl Sensitivity {
         Err(simultaneous(&self.batch))
     }
 
-    /// Whether every contact but `except` is closed after as before.
+    /// Whether every contact but `except` is closed after the event exactly when it was
+    /// closed before it.
     fn same_closures(&self, post: &[ClusterFlow], except: Option<usize>) -> bool {
         let n = self.field.len();
         (0..self.contacts).all(|j| Some(j) == except || is_closed(&self.last, n, j) == is_closed(post, n, j))

@@ -1,4 +1,4 @@
-//! Frequency-sweep experiments (issue 14): the chain driven by a slow chirp of the base, up
+//! Frequency-sweep experiments: the chain driven by a slow chirp of the base, up
 //! (Ω from `from` to `to`) and down (back), each condensed into a per-cycle response (one
 //! row per cycle of the chirp's phase: each mass's displacement amplitude relative to the
 //! base, impacts, harvested energy) with its largest jump. Drawn together, the up and down

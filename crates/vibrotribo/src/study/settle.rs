@@ -40,8 +40,7 @@ use crate::orbits::{PeriodicOrbit, ShootingOptions, find_periodic_orbit};
 /// How long a sweep point runs before its recorded window.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum SettleMode {
-    /// A fixed transient of [`PointOptions::transient_periods`] periods (the results of
-    /// earlier versions, bit for bit).
+    /// A fixed transient of [`PointOptions::transient_periods`] periods.
     #[default]
     Fixed,
     /// Until the motion repeats (see the module docs of `study/settle.rs`).

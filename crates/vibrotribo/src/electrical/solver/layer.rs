@@ -42,7 +42,7 @@
 //! cycle) add `δ·φ` and the layer's partial energy. Not used for the rectifier (nonlinear),
 //! with charge moments (two-way coupling, whose windows are short), or where the piece is too
 //! short for the layer (or the step doubling fails): then the layer is crossed with short
-//! steps as before (`ChargeSolver::kink_start`).
+//! steps (`ChargeSolver::kink_start`).
 
 use super::layer_term::{LayerTerm, MONO_TERMS, Mono};
 use super::state::{ChargeSolver, NOISE, RESISTOR_STAGES, Step, Trial};
