@@ -343,7 +343,11 @@ fn follow<F: Fn(f64) -> ChainParams>(
         });
         let (new, t_new) = match next {
             // A tangent turning by more than ~25° in one step: the step is too long.
-            Ok((p, tn)) if tn.dot(&t) >= 0.9 || ds <= 2.0 * opts.min_step => (p, tn),
+            Ok((p, tn))
+                if (tn.dot(&t) >= 0.9 || ds <= 2.0 * opts.min_step) && !falls_back(&branch, last_crossed.as_deref(), &current, &p, problem.p_scale) =>
+            {
+                (p, tn)
+            }
             result => {
                 ds *= 0.5;
                 if ds >= opts.min_step {
@@ -385,12 +389,16 @@ fn follow<F: Fn(f64) -> ChainParams>(
                             c.kind,
                         ));
                         branch.points.push(c.after.described.point.clone());
-                        let p = c.after.described.point.parameter;
+                        branch
+                            .points
+                            .extend(c.onward.iter().map(|o| o.described.point.clone()));
+                        let last = c.onward.into_iter().last().unwrap_or(c.after);
+                        let p = last.described.point.parameter;
                         if p <= lo || p >= hi {
                             branch.end = BranchEnd::RangeEnd { parameter: p };
                             return (branch, doublings);
                         }
-                        current = c.after;
+                        current = last;
                         t = c.tangent;
                         ds = opts.initial_step;
                         continue;
@@ -490,6 +498,25 @@ fn follow<F: Fn(f64) -> ChainParams>(
     }
     branch.end = BranchEnd::MaxPoints;
     (branch, doublings)
+}
+
+/// Whether a step from `current` to `new` goes back onto the sequence the branch left at its
+/// last crossing (`left`), near it: two orbits meet at a non-smooth fold, and a step from one
+/// may land on the other.
+fn falls_back(
+    branch: &Branch,
+    left: Option<&[(crate::dynamics::EventKind, usize)]>,
+    current: &StepPoint,
+    new: &StepPoint,
+    p_scale: f64,
+) -> bool {
+    let (Some(left), Some(last)) = (left, branch.bifurcations.last()) else {
+        return false;
+    };
+    last.crossing.is_some()
+        && new.described.signature != current.described.signature
+        && new.described.signature == left
+        && (new.described.point.parameter - last.parameter).abs() < 1e-2 * p_scale
 }
 
 /// Points a branch must have before it can be found closed.

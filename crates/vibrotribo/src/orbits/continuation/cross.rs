@@ -50,6 +50,9 @@ const PENETRATIONS: [f64; 4] = [1e-12, 1e-10, 1e-8, 1e-6];
 /// Penetration, in the length unit, at which the square-root term of the map is measured.
 const PROBE_PENETRATION: f64 = 1e-10;
 
+/// Natural steps taken along the new sequence after a crossing (each four times the last).
+const ONWARD_STEPS: i32 = 5;
+
 /// A gap minimum below this fraction of the length unit is taken as grazing.
 const NEAR_GRAZING: f64 = 1e-4;
 
@@ -59,10 +62,13 @@ pub(crate) struct Crossed {
     pub before: StepPoint,
     /// The first orbit with the new sequence.
     pub after: StepPoint,
+    /// Orbits farther along the new sequence, by natural steps away from the point.
+    pub onward: Vec<StepPoint>,
     /// Accuracy of the point in the parameter.
     pub precision: f64,
     pub kind: CrossingKind,
-    /// Tangent of the branch at `after`, oriented the way it goes on.
+    /// Tangent of the branch at the last of `onward` (or `after`), oriented the way it goes
+    /// on.
     pub tangent: DVector<f64>,
 }
 
@@ -156,7 +162,7 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                         o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
                     })
                 {
-                    return crossed(problem, ok, o, precision, sigma, kind);
+                    return crossed(problem, ok, o, precision, sigma, kind, (lo, hi));
                 }
             }
         }
@@ -241,11 +247,31 @@ fn crossed<F: Fn(f64) -> ChainParams>(
     precision: f64,
     direction: f64,
     kind: CrossingKind,
+    (lo, hi): (f64, f64),
 ) -> Option<Bridged> {
-    let tangent = problem.tangent(&after.ev, &along(problem, direction))?;
+    // Away from the point along the new sequence by natural steps growing fourfold (near a
+    // non-smooth fold the other orbit lies within the arclength corrector's reach).
+    let keep = after.described.signature.clone();
+    let p0 = after.described.point.parameter;
+    let first = (p0 - before.described.point.parameter).abs();
+    let mut onward: Vec<StepPoint> = Vec::new();
+    for k in 1..=ONWARD_STEPS {
+        let p = p0 + direction * first * 4f64.powi(k);
+        if p <= lo || p >= hi {
+            break;
+        }
+        let last = onward.last().unwrap_or(&after);
+        let s = last.described.point.arclength + (p - last.described.point.parameter).abs() / problem.p_scale;
+        match orbit_keeping(problem, &problem.state(&last.ev.u), p, s, &keep) {
+            Some(o) => onward.push(o),
+            None => break,
+        }
+    }
+    let tangent = problem.tangent(&onward.last().unwrap_or(&after).ev, &along(problem, direction))?;
     Some(Bridged::Crossed(Crossed {
         before,
         after,
+        onward,
         precision,
         kind,
         tangent,
