@@ -344,7 +344,8 @@ fn follow<F: Fn(f64) -> ChainParams>(
         let (new, t_new) = match next {
             // A tangent turning by more than ~25° in one step: the step is too long.
             Ok((p, tn))
-                if (tn.dot(&t) >= 0.9 || ds <= 2.0 * opts.min_step) && !falls_back(&branch, last_crossed.as_deref(), &current, &p, problem.p_scale) =>
+                if (tn.dot(&t) >= 0.9 || ds <= 2.0 * opts.min_step)
+                    && !falls_back(&branch, last_crossed.as_deref(), &current, &p, problem.p_scale) =>
             {
                 (p, tn)
             }

@@ -14,13 +14,16 @@
 //! 2. **The edge**: where no orbit converges any more, the last parameter `p*` with the old
 //!    sequence is found by bisection to the location tolerance.
 //! 3. **Both sides**: orbits with the new sequence are sought at `p* + σε` (persistence: the
-//!    branch goes on) and then at `p* − σε` (non-smooth fold: the two orbits meet at `p*` and
-//!    the branch turns back), ε from 1e-6 to 1e-3 of the range, from the edge orbit and from
-//!    it moved along the gradient `c = ∂h/∂z` of the grazing gap (by `−η c/|c|²`, so that
-//!    the flow from it strikes the contact with a penetration η of 1e-10 … 1e-4 of the
-//!    length unit, or `+η c/|c|²` to lift a slow impact off). Newton's method on the
-//!    square-root branch converges from the side of small penetration (the map is convex
-//!    there), which is why the guesses start shallow.
+//!    branch goes on) and, if none is found there, at `p* − σε` (non-smooth fold: the two
+//!    orbits meet at `p*` and the branch turns back), ε from 1e-6 to 1e-3 of the range, first
+//!    where the linearised square-root map (`SquareRootModel`) puts them, then from the edge
+//!    orbit moved along the gradient `c = ∂h/∂z` of the grazing gap (by `−η c/|c|²`, so that
+//!    the flow from it strikes the contact with a penetration η of 1e-12 … 1e-6 of the length
+//!    unit, or `+η c/|c|²` to lift a slow impact off). Newton's method is held to the event
+//!    sequence of its starting point, so that it cannot fall onto the old orbit; on the
+//!    square-root branch it converges from the side of small penetration (the map is convex
+//!    there), which is why the guesses start shallow. The branch then goes on along the new
+//!    sequence by a few natural steps away from the point before the arclength takes over.
 //!
 //! Feigin's rule for the square-root map (the new orbit has a multiplier that grows like the
 //! inverse of its impact speed) says which of the two happens: `det(Φ − I)` keeps its sign
@@ -144,12 +147,14 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
         signature,
     )
     .and_then(|behind| SquareRootModel::new(problem, &ok, &behind));
-    for step in SIDE_STEPS {
-        let eps = (step * problem.p_scale).max(10.0 * problem.options.location_tolerance);
-        for (sigma, kind) in [
-            (direction, CrossingKind::Persistence),
-            (-direction, CrossingKind::NonSmoothFold),
-        ] {
+    // The persistence side first, at every distance: a symmetric orbit that grazes two
+    // contacts at once may also meet orbits striking only one of them at a fold.
+    for (sigma, kind) in [
+        (direction, CrossingKind::Persistence),
+        (-direction, CrossingKind::NonSmoothFold),
+    ] {
+        for step in SIDE_STEPS {
+            let eps = (step * problem.p_scale).max(10.0 * problem.options.location_tolerance);
             let p = parameter(&ok) + sigma * eps;
             if p < lo || p > hi {
                 continue;
