@@ -274,6 +274,13 @@ fn branch_to_py<'py>(py: Python<'py>, b: &Branch, n: usize) -> PyResult<Bound<'p
         e.set_item("v", array1(py, bif.point.state.velocities.clone()))?;
         e.set_item("multipliers", complex_array(py, &bif.point.multipliers))?;
         e.set_item("child", bif.child)?;
+        if let Some(after) = &bif.after {
+            e.set_item("multipliers_after", complex_array(py, &after.multipliers))?;
+        }
+        if let Some(c) = &bif.crossing {
+            e.set_item("crossing", c.kind.name())?;
+            e.set_item("nordmark", c.nordmark.map(|n| n.name()))?;
+        }
         bifurcations.append(e)?;
     }
     d.set_item("bifurcations", bifurcations)?;

@@ -198,7 +198,7 @@ fn end_text(end: &BranchEnd) -> String {
             contact,
             gap,
         } => format!(
-            "runs into a grazing of contact {} at {parameter} (gap minimum {gap:.3e} m) it cannot cross",
+            "runs into a grazing of contact {} at {parameter} (gap minimum {gap:.3e} m): no orbit with the new impact found on either side",
             contact + 1
         ),
         BranchEnd::CascadeDepth { parameter } => {
@@ -230,8 +230,20 @@ fn print_continuation(param: &str, result: &Continuation) {
         );
         for f in &b.bifurcations {
             let (kind, detail) = describe(&f.kind);
+            let crossing = f.crossing.map_or(String::new(), |c| {
+                let nordmark = c
+                    .nordmark
+                    .map_or(String::new(), |n| format!(", square-root map: {}", n.name()));
+                let radius = |p: &BranchPoint| p.spectral_radius();
+                format!(
+                    " [{}{nordmark}; |λ|max {:.4} → {:.4}]",
+                    c.kind.name(),
+                    radius(&f.point),
+                    f.after.as_ref().map_or(f64::NAN, radius)
+                )
+            });
             println!(
-                "    {kind} at {param} = {:.10} (±{:.1e}){}",
+                "    {kind} at {param} = {:.10} (±{:.1e}){}{crossing}",
                 f.parameter,
                 f.precision,
                 if detail.is_empty() {
@@ -322,6 +334,9 @@ fn write_files(
             "detail",
             "child_branch",
             "multipliers",
+            "crossing",
+            "nordmark",
+            "multipliers_after",
         ],
     )?;
     let mut listed = Vec::new();
@@ -343,6 +358,13 @@ fn write_files(
                 csv_text(&detail),
                 f.child.map_or(String::new(), |c| c.to_string()),
                 csv_text(&multipliers_text(&f.point)),
+                f.crossing.map_or(String::new(), |c| c.kind.name().to_string()),
+                f.crossing
+                    .and_then(|c| c.nordmark)
+                    .map_or(String::new(), |n| n.name().to_string()),
+                f.after
+                    .as_ref()
+                    .map_or(String::new(), |a| csv_text(&multipliers_text(a))),
             ])?;
             listed.push(bifurcation_json(i, f));
         }
@@ -389,6 +411,9 @@ fn bifurcation_json(branch: usize, f: &Bifurcation) -> serde_json::Value {
         "precision": f.precision,
         "child_branch": f.child,
         "multipliers": f.point.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "crossing": f.crossing.map(|c| c.kind.name()),
+        "nordmark": f.crossing.and_then(|c| c.nordmark).map(|n| n.name()),
+        "multipliers_after": f.after.as_ref().map(|a| a.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
     })
 }
 

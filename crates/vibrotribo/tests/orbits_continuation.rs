@@ -302,6 +302,10 @@ fn a_grazing_is_where_the_new_impact_speed_vanishes() {
         .expect("a grazing");
     assert!(g.precision <= 1e-8, "{}", g.precision);
     let after = g.after.as_ref().unwrap();
+    println!(
+        "grazing {:?} at {} ({:?}); after at {}: impacts {:?}, slowest {:?}",
+        g.kind, g.parameter, g.crossing, after.parameter, after.impacts_per_period, after.min_closing_speed
+    );
     // Independent shooting beyond the grazing point, and a linear fit of the speed.
     let loose = ShootingOptions {
         tolerance: 1e-10,

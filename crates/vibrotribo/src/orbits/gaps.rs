@@ -4,11 +4,11 @@
 //! gaps of rigid stops count too (contacts N − 1 and N), except while a cluster is stuck
 //! to the stop.
 
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 use crate::dynamics::{Flow, Simulator, Trajectory};
 use crate::model::{ChainParams, SimOptions, StopFrame, StopSide};
-use crate::sensitivity::state_from_vector;
+use crate::sensitivity::{Sensitivity, SensitivityError, SensitivityOptions, state_from_vector};
 
 /// Samples per excitation period at which the gap rates are checked for a sign change.
 const SAMPLES: f64 = 1024.0;
@@ -16,15 +16,53 @@ const SAMPLES: f64 = 1024.0;
 /// Bisection steps on the gap rate.
 const BISECTIONS: usize = 60;
 
+/// The lowest smooth local minimum of a gap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GapMinimum {
+    /// Contact, 0-based.
+    pub contact: usize,
+    /// The gap there, m.
+    pub gap: f64,
+    /// When, s.
+    pub time: f64,
+}
+
 /// The lowest smooth local minimum of the gaps over `periods` excitation periods from `z` at
-/// t = `phase`: `(contact, gap in m)`, or `None` if no gap has one.
+/// t = `phase`, or `None` if no gap has one.
 pub(crate) fn smallest_gap_minimum(
     params: &ChainParams,
     z: &DVector<f64>,
     periods: u32,
     phase: f64,
     sim: &SimOptions,
-) -> Option<(usize, f64)> {
+) -> Option<GapMinimum> {
+    gap_minima(params, z, periods, phase, sim)
+        .into_iter()
+        .min_by(|a, b| a.gap.total_cmp(&b.gap))
+}
+
+/// Every smooth local minimum of the gaps over `periods` excitation periods from `z` at
+/// t = `phase`, in time order.
+pub(crate) fn gap_minima(
+    params: &ChainParams,
+    z: &DVector<f64>,
+    periods: u32,
+    phase: f64,
+    sim: &SimOptions,
+) -> Vec<GapMinimum> {
+    let mut out = Vec::new();
+    let _ = collect_minima(params, z, periods, phase, sim, &mut out);
+    out
+}
+
+fn collect_minima(
+    params: &ChainParams,
+    z: &DVector<f64>,
+    periods: u32,
+    phase: f64,
+    sim: &SimOptions,
+    out: &mut Vec<GapMinimum>,
+) -> Option<()> {
     let mut simulator =
         Simulator::new_at(params, phase, &state_from_vector(z.as_slice()), sim.clone()).ok()?;
     let mut trajectory = Trajectory::new(&simulator);
@@ -35,7 +73,6 @@ pub(crate) fn smallest_gap_minimum(
     let (mut gaps, mut rates) = (vec![0.0; contacts], vec![0.0; contacts]);
     let mut state = (vec![0.0; params.len()], vec![0.0; params.len()]);
     let dt = params.period() / SAMPLES;
-    let mut best: Option<(usize, f64)> = None;
     for segment in trajectory.segments() {
         let flow = trajectory.flow_at(0.5 * (segment.t_start + segment.t_end))?;
         let steps = ((segment.t_end - segment.t_start) / dt).ceil().max(1.0) as usize;
@@ -54,10 +91,13 @@ pub(crate) fn smallest_gap_minimum(
                             all_gaps(params, &flow, mid, &mut gaps, &mut rates, &mut state);
                             if rates[k] < 0.0 { lo = mid } else { hi = mid }
                         }
-                        all_gaps(params, &flow, 0.5 * (lo + hi), &mut gaps, &mut rates, &mut state);
-                        if best.is_none_or(|b| gaps[k] < b.1) {
-                            best = Some((k, gaps[k]));
-                        }
+                        let time = 0.5 * (lo + hi);
+                        all_gaps(params, &flow, time, &mut gaps, &mut rates, &mut state);
+                        out.push(GapMinimum {
+                            contact: k,
+                            gap: gaps[k],
+                            time,
+                        });
                         all_gaps(params, &flow, t, &mut gaps, &mut rates, &mut state);
                     }
                 }
@@ -65,7 +105,46 @@ pub(crate) fn smallest_gap_minimum(
             before.copy_from_slice(&rates);
         }
     }
-    best
+    Some(())
+}
+
+/// The gradient `∂d_k(t)/∂z` of the gap of `contact` at time `t` (on the flow from `z` at
+/// t = `phase`, before any event at `t` itself) with respect to the section state `z`: the
+/// gap's gradient in the state at `t` (a difference of positions, or one position against a
+/// stop) times the state-transition matrix Φ(t, phase). `None` where the flow is not
+/// differentiable on the way.
+pub(crate) fn gap_gradient(
+    params: &ChainParams,
+    z: &DVector<f64>,
+    phase: f64,
+    contact: usize,
+    t: f64,
+    sim: &SimOptions,
+    sensitivity: &SensitivityOptions,
+) -> Option<DVector<f64>> {
+    let n = params.len();
+    let dim = 2 * n;
+    let mut simulator =
+        Simulator::new_at(params, phase, &state_from_vector(z.as_slice()), sim.clone()).ok()?;
+    let mut stm = Sensitivity::new(params, sensitivity.clone());
+    simulator.run_until(t, &mut stm).ok()?;
+    let phi = match stm.stm() {
+        Ok(phi) => phi.clone(),
+        Err(SensitivityError::Empty) => DMatrix::identity(dim, dim),
+        Err(_) => return None,
+    };
+    // d_k = δ_k − (x_{k+1} − x_k) between masses; the lower stop's gap grows with x_N, the
+    // upper stop's falls with x_1.
+    let mut grad = DVector::zeros(dim);
+    match contact {
+        k if k + 1 < n => {
+            grad[k] = 1.0;
+            grad[k + 1] = -1.0;
+        }
+        k if k + 1 == n => grad[n - 1] = 1.0,
+        _ => grad[0] = -1.0,
+    }
+    Some(phi.transpose() * grad)
 }
 
 /// Gaps and their rates at time `t` of every contact: between masses from the flow, and of

@@ -57,7 +57,7 @@ mod shooting;
 
 pub use continuation::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
-    continue_orbit,
+    Crossing, CrossingKind, NordmarkScenario, continue_orbit,
 };
 pub use error::{NewtonFailure, OrbitError};
 pub use floquet::floquet_multipliers;

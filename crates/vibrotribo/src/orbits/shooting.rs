@@ -180,6 +180,19 @@ pub(crate) fn newton(
     phase: f64,
     options: &ShootingOptions,
 ) -> Result<Converged, OrbitError> {
+    newton_within(params, z0, period, phase, options, |_| true)
+}
+
+/// [`newton`] whose line search accepts only iterates whose evaluation satisfies `keep` (an
+/// event sequence held fixed, so that the iteration stays on one side of a grazing).
+pub(crate) fn newton_within(
+    params: &ChainParams,
+    z0: DVector<f64>,
+    period: u32,
+    phase: f64,
+    options: &ShootingOptions,
+    keep: impl Fn(&MapEval) -> bool,
+) -> Result<Converged, OrbitError> {
     options.validate()?;
     if period == 0 {
         return Err(OrbitError::ZeroPeriod);
@@ -215,7 +228,10 @@ pub(crate) fn newton(
             }
             let mut trial = &z + &step * damping;
             project_closed(params, &closed, &scale, 1e-6, &mut trial);
-            if let Ok(e) = eval_at(&trial) {
+            if let Ok(e) = eval_at(&trial)
+                .map_err(|_| ())
+                .and_then(|e| if keep(&e) { Ok(e) } else { Err(()) })
+            {
                 let r = scale.norm(&e.residual(&trial));
                 if r <= (1.0 - 1e-4 * damping) * residual || r <= options.tolerance {
                     break Some((trial, e, r));

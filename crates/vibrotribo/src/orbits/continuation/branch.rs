@@ -5,12 +5,13 @@ use std::collections::VecDeque;
 
 use nalgebra::DVector;
 
-use super::bridge::{bridge, locate_change_in_parameter};
 use super::corrector::{Failure, Problem};
+use super::cross::{Bridged, cross};
 use super::locate::{Located, Step, StepPoint, classify, locate_change, locate_root};
 use super::phase::{move_section, too_close};
 use super::types::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
+    Crossing, CrossingKind, NordmarkScenario,
 };
 use crate::error::ParamError;
 use crate::model::{ChainParams, ChainState};
@@ -193,10 +194,11 @@ fn start<F: Fn(f64) -> ChainParams>(
         Start::Doubling { u, direction } => {
             // The pitchfork of the doubled map: its new branch leaves along the critical
             // eigenvector with the parameter stationary. A step too short may fall back onto
-            // the orbit of the parent's period: lengthen it then.
+            // the orbit of the parent's period, one too long leave the corrector's reach:
+            // from 1/16 of the first step up to 64 times it.
             let mut last = None;
-            for k in 0..4 {
-                let ds = problem.options.initial_step * f64::from(1 << (2 * k));
+            for k in -2..4 {
+                let ds = problem.options.initial_step * 4f64.powi(k);
                 let step = Step {
                     base: u,
                     tangent: direction,
@@ -313,6 +315,8 @@ fn follow<F: Fn(f64) -> ChainParams>(
     };
     branch.points.push(current.described.point.clone());
     let mut ds = opts.initial_step;
+    // The sequence before the last change crossed by `cross` (not to be crossed back onto).
+    let mut last_crossed: Option<Vec<(crate::dynamics::EventKind, usize)>> = None;
     // Every pass adds a point or halves the step; halvings between two points are bounded
     // by log2(initial/min), so this bound is never reached by a healthy branch.
     let passes = opts.max_points * 64;
@@ -339,7 +343,12 @@ fn follow<F: Fn(f64) -> ChainParams>(
         });
         let (new, t_new) = match next {
             // A tangent turning by more than ~25° in one step: the step is too long.
-            Ok((p, tn)) if tn.dot(&t) >= 0.9 || ds <= 2.0 * opts.min_step => (p, tn),
+            Ok((p, tn))
+                if (tn.dot(&t) >= 0.9 || ds <= 2.0 * opts.min_step)
+                    && !falls_back(&branch, last_crossed.as_deref(), &current, &p, problem.p_scale) =>
+            {
+                (p, tn)
+            }
             result => {
                 ds *= 0.5;
                 if ds >= opts.min_step {
@@ -354,39 +363,58 @@ fn follow<F: Fn(f64) -> ChainParams>(
                     .map(|q| q.parameter)
                     .find(|q| *q != current.described.point.parameter);
                 let progress = before.map_or(t[problem.dim()], |q| current.described.point.parameter - q);
-                if let Some((target, t_new)) = bridge(&problem, &current, progress.signum(), (lo, hi)) {
-                    if target.described.signature != current.described.signature {
-                        let (left, right, precision) =
-                            locate_change_in_parameter(&problem, &current, &target);
-                        branch.bifurcations.push(Bifurcation {
-                            kind: classify(&left.described, &right.described, problem.scale.speed),
-                            parameter: left.described.point.parameter,
-                            precision,
-                            point: left.described.point.clone(),
-                            after: Some(right.described.point.clone()),
-                            child: None,
-                        });
+                let came_from = branch.bifurcations.last().and_then(|b| {
+                    let before = b.crossing.and(last_crossed.as_deref())?;
+                    Some((b.parameter, before))
+                });
+                match cross(&problem, &current, progress.signum(), (lo, hi), came_from) {
+                    Some(Bridged::Same(target, t_new)) => {
+                        branch.points.push(target.described.point.clone());
+                        let p = target.described.point.parameter;
+                        if p <= lo || p >= hi {
+                            branch.end = BranchEnd::RangeEnd { parameter: p };
+                            return (branch, doublings);
+                        }
+                        current = target;
+                        t = t_new;
+                        ds = opts.initial_step;
+                        continue;
                     }
-                    branch.points.push(target.described.point.clone());
-                    let p = target.described.point.parameter;
-                    if p <= lo || p >= hi {
-                        branch.end = BranchEnd::RangeEnd { parameter: p };
-                        return (branch, doublings);
+                    Some(Bridged::Crossed(c)) => {
+                        last_crossed = Some(c.before.described.signature.clone());
+                        branch.bifurcations.push(crossing_point(
+                            &problem,
+                            &c.before,
+                            &c.after,
+                            c.precision,
+                            c.kind,
+                        ));
+                        branch.points.push(c.after.described.point.clone());
+                        branch
+                            .points
+                            .extend(c.onward.iter().map(|o| o.described.point.clone()));
+                        let last = c.onward.into_iter().last().unwrap_or(c.after);
+                        let p = last.described.point.parameter;
+                        if p <= lo || p >= hi {
+                            branch.end = BranchEnd::RangeEnd { parameter: p };
+                            return (branch, doublings);
+                        }
+                        current = last;
+                        t = c.tangent;
+                        ds = opts.initial_step;
+                        continue;
                     }
-                    current = target;
-                    t = t_new;
-                    ds = opts.initial_step;
-                    continue;
+                    None => {}
                 }
                 let parameter = current.described.point.parameter;
                 let z = problem.state(&current.ev.u);
                 let params = (problem.family)(parameter);
                 let sim = &opts.shooting.sim;
                 branch.end = match smallest_gap_minimum(&params, &z, problem.period, problem.phase, sim) {
-                    Some((contact, gap)) if gap < GRAZING_GAP * problem.scale.length => BranchEnd::Grazing {
+                    Some(m) if m.gap < GRAZING_GAP * problem.scale.length => BranchEnd::Grazing {
                         parameter,
-                        contact,
-                        gap,
+                        contact: m.contact,
+                        gap: m.gap,
                     },
                     _ => step_floor(
                         parameter,
@@ -473,13 +501,32 @@ fn follow<F: Fn(f64) -> ChainParams>(
     (branch, doublings)
 }
 
+/// Whether a step from `current` to `new` goes back onto the sequence the branch left at its
+/// last crossing (`left`), near it: two orbits meet at a non-smooth fold, and a step from one
+/// may land on the other.
+fn falls_back(
+    branch: &Branch,
+    left: Option<&[(crate::dynamics::EventKind, usize)]>,
+    current: &StepPoint,
+    new: &StepPoint,
+    p_scale: f64,
+) -> bool {
+    let (Some(left), Some(last)) = (left, branch.bifurcations.last()) else {
+        return false;
+    };
+    last.crossing.is_some()
+        && new.described.signature != current.described.signature
+        && new.described.signature == left
+        && (new.described.point.parameter - last.parameter).abs() < 1e-2 * p_scale
+}
+
 /// Points a branch must have before it can be found closed.
 const CLOSED_MIN_POINTS: usize = 8;
 
 /// The earlier point the branch's newest point is back at (within a step `ds` in the scaled
 /// units of the state and the parameter), if any: from there on the branch repeats itself.
 /// A smooth solution curve can only come back to its first point (a closed curve); one with
-/// corners (grazings crossed by [`bridge`]) can also run into a loop further on.
+/// corners (non-smooth points crossed by [`cross`]) can also run into a loop further on.
 fn closes<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, branch: &Branch, ds: f64) -> Option<usize> {
     let n = branch.points.len();
     if n < CLOSED_MIN_POINTS {
@@ -494,11 +541,14 @@ fn closes<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, branch: &Branch, 
             .max((a.parameter - b.parameter).abs() / problem.p_scale)
     };
     let (last, before) = (&branch.points[n - 1], &branch.points[n - 2]);
+    // The same orbit has the same impacts: two branches meeting at a non-smooth fold do not.
+    let same =
+        |old: &BranchPoint| old.impacts_per_period == last.impacts_per_period && old.sticks == last.sticks;
     // Arriving: the newest point is within a step of an old one and nearer it than the one
     // before (so that a branch that merely moves slowly is not taken for closed).
     branch.points[..n - CLOSED_MIN_POINTS]
         .iter()
-        .position(|old| distance(last, old) < ds && distance(last, old) < distance(before, old))
+        .position(|old| same(old) && distance(last, old) < ds && distance(last, old) < distance(before, old))
 }
 
 fn step_floor(parameter: f64, f: Failure) -> BranchEnd {
@@ -528,17 +578,18 @@ fn detect<F: Fn(f64) -> ChainParams>(
     let mut intervals = vec![(base.clone(), target.clone())];
     if base.described.signature != target.described.signature {
         let (left, right, precision) = locate_change(problem, step, base, target);
-        let kind = classify(&left.described, &right.described, problem.scale.speed);
+        // The step went through the change: the parameter went on the way the branch was
+        // going (persistence) or turned back at it (non-smooth fold).
+        let dim = problem.dim();
+        let onward = (right.described.point.parameter - left.described.point.parameter) * t_base[dim];
+        let kind = if onward >= 0.0 {
+            CrossingKind::Persistence
+        } else {
+            CrossingKind::NonSmoothFold
+        };
         found.push((
             left.theta,
-            Bifurcation {
-                kind,
-                parameter: left.described.point.parameter,
-                precision,
-                point: left.described.point.clone(),
-                after: Some(right.described.point.clone()),
-                child: None,
-            },
+            crossing_point(problem, &left, &right, precision, kind),
             None,
         ));
         // The multipliers may jump across the change; look for smooth crossings on either
@@ -640,5 +691,38 @@ fn bifurcation(kind: BifurcationKind, l: &Located) -> Bifurcation {
         point: l.point.described.point.clone(),
         after: None,
         child: None,
+        crossing: None,
+    }
+}
+
+/// A change of the event sequence crossed between `before` and `after`: its kind, and for a
+/// grazing what the square-root map predicts from the multipliers of the orbit without the
+/// impact.
+fn crossing_point<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    before: &StepPoint,
+    after: &StepPoint,
+    precision: f64,
+    crossing: CrossingKind,
+) -> Bifurcation {
+    let kind = classify(&before.described, &after.described, problem.scale.speed);
+    let nordmark = match kind {
+        BifurcationKind::Grazing { appears, .. } => {
+            let free = if appears { before } else { after };
+            Some(NordmarkScenario::of(&free.described.point.multipliers))
+        }
+        _ => None,
+    };
+    Bifurcation {
+        kind,
+        parameter: before.described.point.parameter,
+        precision,
+        point: before.described.point.clone(),
+        after: Some(after.described.point.clone()),
+        child: None,
+        crossing: Some(Crossing {
+            kind: crossing,
+            nordmark,
+        }),
     }
 }

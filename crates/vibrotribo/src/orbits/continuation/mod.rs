@@ -19,13 +19,19 @@
 //!   sticking onset or end, or another change. Φ is discontinuous there, so the smooth test
 //!   functions are only searched on either side of it.
 //!
-//! At a grazing the branch has a corner (on the side with the new impact the orbit moves like
-//! the square root of the distance): when the step falls to its floor the continuation tries
-//! natural-parameter steps across it, and a branch that cannot go on ends with
-//! [`BranchEnd::Grazing`] if one of its gap minima is vanishing, else
-//! [`BranchEnd::StepFloor`] with the corrector's residuals. A doubled branch that comes back
-//! to its parent at another period doubling (a bubble) ends [`BranchEnd::Collapsed`] and is
-//! followed once.
+//! At a grazing, sticking onset or loss, or chatter onset the branch has a corner (the map
+//! has Nordmark's square-root singularity at a grazing): when the step falls to its floor the
+//! continuation crosses it in the parameter (natural-parameter
+//! Newton steps forward, the edge of the old event sequence located by bisection, and the
+//! orbit with the new sequence sought on both sides of it). The point is recorded as a
+//! bifurcation with the orbits on both sides, and a [`Crossing`]: a persistence (the branch
+//! goes on) or a non-smooth fold (the branch turns back onto the orbit with the new sequence),
+//! and, at a grazing, the [`NordmarkScenario`] the square-root map predicts from the dominant
+//! multiplier of the orbit without the impact. A branch that finds no orbit with the new
+//! sequence on either side ends with [`BranchEnd::Grazing`] if one of its gap minima is
+//! vanishing, else [`BranchEnd::StepFloor`] with the corrector's residuals. A doubled branch
+//! that comes back to its parent at another period doubling (a bubble) ends
+//! [`BranchEnd::Collapsed`] and is followed once.
 //!
 //! Internally a branch is represented on a section t ≡ θ (mod T) kept away from the orbit's
 //! events (an impact crossing the section would make the stroboscopic map jump); points are
@@ -38,8 +44,8 @@
 //! branches, corrector iterations, location steps and the step floor.
 
 mod branch;
-mod bridge;
 mod corrector;
+mod cross;
 mod locate;
 mod phase;
 mod types;
@@ -47,4 +53,5 @@ mod types;
 pub use branch::continue_orbit;
 pub use types::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
+    Crossing, CrossingKind, NordmarkScenario,
 };

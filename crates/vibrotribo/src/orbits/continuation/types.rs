@@ -178,6 +178,107 @@ pub struct Bifurcation {
     /// For a period doubling: the index of the doubled branch in
     /// [`Continuation::branches`], if it was followed.
     pub child: Option<usize>,
+    /// For a change of the event sequence the branch was continued through (a
+    /// discontinuity-induced bifurcation): how it was crossed and what the square-root map
+    /// predicts there.
+    pub crossing: Option<Crossing>,
+}
+
+/// How a branch goes on through a change of its event sequence (grazing, sticking onset or
+/// loss, chatter onset): the orbits on the two sides of the point, `point` and `after` of
+/// its [`Bifurcation`], with their multipliers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Crossing {
+    /// Persistence or non-smooth fold.
+    pub kind: CrossingKind,
+    /// What the one-dimensional square-root map of the grazing orbit predicts for the
+    /// attractor beyond it (grazings only; `None` for other changes).
+    pub nordmark: Option<NordmarkScenario>,
+}
+
+/// Whether the branch goes on through a discontinuity-induced bifurcation or turns back.
+///
+/// Feigin's rule for the square-root map: the orbit with the new sequence has a multiplier
+/// that grows like the inverse of its grazing impact speed, so `det(Φ − I)` has the same
+/// sign on both sides for a persistence and opposite signs at a non-smooth fold. The kind
+/// is read from where the new orbit was found (beyond the point, or before it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CrossingKind {
+    /// The orbit with the new sequence exists beyond the point: the branch goes on in the
+    /// same direction of the parameter.
+    Persistence,
+    /// The orbit with the new sequence exists on the same side as the old one: the two meet
+    /// and end at the point, and the branch turns back in the parameter.
+    NonSmoothFold,
+}
+
+/// The attractor near a grazing of a stable impact-free orbit, as Nordmark's
+/// one-dimensional square-root map `x ↦ μ + λx (x ≤ 0), μ − √x (x > 0)` predicts it from
+/// the dominant multiplier λ of that orbit at the grazing (Nordmark 1991; Chin, Ott, Nusse &
+/// Grebogi 1994), for small μ > 0 (just past the grazing).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum NordmarkScenario {
+    /// −1 < λ < 0: an orbit of twice the period with one impact in two periods.
+    PeriodTwo,
+    /// 0 < λ < 1/4: a period-adding sequence of periodic orbits with one impact per period
+    /// and a number of impact-free periods that grows without bound as μ → 0.
+    PeriodAdding,
+    /// 1/4 ≤ λ < 2/3: period adding with chaotic bands between the periodic windows.
+    PeriodAddingWithChaos,
+    /// 2/3 ≤ λ < 1: a chaotic attractor born at the grazing.
+    Chaos,
+    /// The dominant multiplier is complex, zero, or not inside the unit circle: the
+    /// one-dimensional map does not apply.
+    Undetermined,
+}
+
+impl CrossingKind {
+    /// Its name in files: `persistence` or `non_smooth_fold`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            CrossingKind::Persistence => "persistence",
+            CrossingKind::NonSmoothFold => "non_smooth_fold",
+        }
+    }
+}
+
+impl NordmarkScenario {
+    /// Its name in files: `period_two`, `period_adding`, `period_adding_with_chaos`, `chaos`
+    /// or `undetermined`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            NordmarkScenario::PeriodTwo => "period_two",
+            NordmarkScenario::PeriodAdding => "period_adding",
+            NordmarkScenario::PeriodAddingWithChaos => "period_adding_with_chaos",
+            NordmarkScenario::Chaos => "chaos",
+            NordmarkScenario::Undetermined => "undetermined",
+        }
+    }
+
+    /// The scenario for the multipliers of the impact-free orbit at the grazing (largest
+    /// modulus first, as on a [`BranchPoint`]).
+    pub fn of(multipliers: &[Complex<f64>]) -> Self {
+        let Some(l) = multipliers.first() else {
+            return NordmarkScenario::Undetermined;
+        };
+        // A complex pair (or a second multiplier as large) leaves no single dominant real
+        // direction.
+        let dominant = multipliers
+            .get(1)
+            .is_none_or(|m| m.norm() < (1.0 - 1e-9) * l.norm());
+        if l.im.abs() > 1e-9 * l.norm().max(f64::MIN_POSITIVE) || !dominant {
+            return NordmarkScenario::Undetermined;
+        }
+        match l.re {
+            x if x > -1.0 && x < 0.0 => NordmarkScenario::PeriodTwo,
+            x if x > 0.0 && x < 0.25 => NordmarkScenario::PeriodAdding,
+            x if (0.25..2.0 / 3.0).contains(&x) => NordmarkScenario::PeriodAddingWithChaos,
+            x if (2.0 / 3.0..1.0).contains(&x) => NordmarkScenario::Chaos,
+            _ => NordmarkScenario::Undetermined,
+        }
+    }
 }
 
 /// Why a branch ended.
@@ -205,7 +306,7 @@ pub enum BranchEnd {
     },
     /// The branch runs into a grazing it cannot cross: a smooth local minimum of the gap at
     /// `contact` tends to zero (last seen at `gap` m), and no orbit with the new impact was
-    /// found beyond it (the branch may turn back there, or the orbit cease to exist).
+    /// found on either side of it (neither a persistence nor a non-smooth fold).
     Grazing {
         /// Parameter of the last point.
         parameter: f64,
