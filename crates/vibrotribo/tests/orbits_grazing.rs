@@ -90,7 +90,7 @@ fn closed_form_speed(omega_ratio: f64, guess: (f64, f64)) -> Option<(f64, f64)> 
 }
 
 /// The first bifurcation of `kind` on `branch`.
-fn first<'a>(branch: &'a Branch, f: impl Fn(&BifurcationKind) -> bool) -> Option<&'a Bifurcation> {
+fn first(branch: &Branch, f: impl Fn(&BifurcationKind) -> bool) -> Option<&Bifurcation> {
     branch.bifurcations.iter().find(|b| f(&b.kind))
 }
 

@@ -369,6 +369,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                 });
                 match cross(&problem, &current, progress.signum(), (lo, hi), came_from) {
                     Some(Bridged::Same(target, t_new)) => {
+                        let target = *target;
                         branch.points.push(target.described.point.clone());
                         let p = target.described.point.parameter;
                         if p <= lo || p >= hi {

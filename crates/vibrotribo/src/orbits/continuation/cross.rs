@@ -78,9 +78,9 @@ pub(crate) struct Crossed {
 /// What a crossing attempt found.
 pub(crate) enum Bridged {
     /// An orbit with the same sequence farther on, and its tangent.
-    Same(StepPoint, DVector<f64>),
+    Same(Box<StepPoint>, DVector<f64>),
     /// A change of sequence, crossed.
-    Crossed(Crossed),
+    Crossed(Box<Crossed>),
 }
 
 /// Tries to take the branch past `current` in the parameter's `direction` (±1), within
@@ -120,7 +120,7 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
             return None;
         }
         let t = problem.tangent(&ok.ev, &along(problem, direction))?;
-        return Some(Bridged::Same(ok, t));
+        return Some(Bridged::Same(Box::new(ok), t));
     };
     // 2. The edge of the old sequence.
     for _ in 0..MAX_LOCATE {
@@ -273,14 +273,14 @@ fn crossed<F: Fn(f64) -> ChainParams>(
         }
     }
     let tangent = problem.tangent(&onward.last().unwrap_or(&after).ev, &along(problem, direction))?;
-    Some(Bridged::Crossed(Crossed {
+    Some(Bridged::Crossed(Box::new(Crossed {
         before,
         after,
         onward,
         precision,
         kind,
         tangent,
-    }))
+    })))
 }
 
 /// Initial states for the orbit with the new sequence near the edge orbit `edge`: the orbit
@@ -389,7 +389,7 @@ impl SquareRootModel {
         let z = problem.state(&edge.ev.u);
         let minima = gap_minima(&params, &z, problem.period, problem.phase, &opts.sim);
         let smallest = minima.iter().map(|m| m.gap).fold(f64::INFINITY, f64::min);
-        if !(smallest < NEAR_GRAZING * length) {
+        if smallest.is_nan() || smallest >= NEAR_GRAZING * length {
             return None;
         }
         let grazing: Vec<_> = minima
@@ -523,7 +523,7 @@ impl SquareRootModel {
             let step = j.lu().solve(&f)?;
             w -= step;
         }
-        if w.iter().any(|v| !(*v > 0.0)) {
+        if w.iter().any(|v| v.is_nan() || *v <= 0.0) {
             return None;
         }
         let mut kick = &self.b * dp;
