@@ -1,11 +1,11 @@
-//! Issue 13: every sweep point classified honestly. The default-case sweep of the issue
-//! (`--from 0.4 --to 1.6 --steps 300`) called Ω = 1.20–1.45 non-periodic after the default
-//! 50 transient periods; with the default `--settle auto` a few of those values come out
-//! `periodic`, period 1, as a 600-period transient shows them to be.
+//! Every sweep point classified honestly. A default-case sweep (`--from 0.4 --to 1.6
+//! --steps 300`) called Ω = 1.20–1.45 non-periodic after a fixed 50 transient periods; with
+//! the default `--settle auto` a few of those values come out `periodic`, period 1, as a
+//! 600-period transient shows them to be.
 
 use super::util::*;
 
-/// Values of the issue's grid in Ω = 1.20–1.45 (j = 200, 212, 237, 261 of 0…299).
+/// Values of that sweep's grid in Ω = 1.20–1.45 (j = 200, 212, 237, 261 of 0…299).
 const VALUES: [usize; 4] = [200, 212, 237, 261];
 
 fn grid_value(j: usize) -> f64 {
