@@ -22,7 +22,11 @@ use super::keys::PerMass;
 /// let ratio = Param::new(&base, "mass_ratio")?;
 /// let point = base.with_values(&[(&ratio, 3.0)])?;
 /// assert_eq!(point.chain().masses[1], 3.0 * point.chain().masses[0]);
-/// let one_mass = Config::from_toml_str("[oscillator]\nmasses = [0.05]\n")?;
+/// // One mass against a stop (an impact oscillator): no m2, so no mass ratio.
+/// let one_mass = Config::from_toml_str(
+///     "[oscillator]\nmasses = [0.05]\nstiffness = 120.0\ndamping = 0.1\n\
+///      [oscillator.stops.upper]\ngap = 0.001\nrestitution = 0.8\n",
+/// )?;
 /// assert!(Param::new(&one_mass, "mass_ratio").is_err());
 /// # Ok::<(), vibrotribo::config::ConfigError>(())
 /// ```
