@@ -18,149 +18,18 @@
 //! The one-way run of the same case closes the mechanical balance alone and misses the full
 //! identity by E_load + ΔU, far outside the tolerance: the check can fail.
 
+use vibrotribo::Simulator;
 use vibrotribo::config::{Config, apply_overrides};
-use vibrotribo::study::{RunObserver, RunSpec, Sample, Sampling, simulate};
-use vibrotribo::{Event, Flow, Simulator, StateView};
+use vibrotribo::study::{Sampling, simulate};
 
 mod common;
+use common::balance::Balance;
 use common::base_motion::Base;
 use common::electrostatics::field_energy;
-use common::quadrature::{Sum, gauss_legendre};
 
 /// Relative tolerance of the full identity, of |W_base| (tests/coupling_checks.rs's, under
 /// the sine, at the default coupling tolerance 1e-11 m).
 const TOLERANCE: f64 = 1e-8;
-
-/// The terms of the balance over a run.
-struct Balance<'a> {
-    base: Base<'a>,
-    m: Vec<f64>,
-    k: Vec<f64>,
-    c: Vec<f64>,
-    deltas: Vec<f64>,
-    /// Longest quadrature interval, s.
-    h_max: f64,
-    nodes: (Vec<f64>, Vec<f64>),
-    work: Sum,
-    damping: Sum,
-    lost: Sum,
-    /// Energy changes between pieces of flow that no event reports, J.
-    unreported: Sum,
-    events: usize,
-    /// Time, positions, velocities after the last flow or event.
-    last: (f64, Vec<f64>, Vec<f64>),
-    /// (time, charge, gaps) of every sample (one per period boundary).
-    samples: Vec<(f64, f64, Vec<f64>)>,
-}
-
-impl<'a> Balance<'a> {
-    fn new(spec: &RunSpec, base: Base<'a>, omega_max: f64) -> Self {
-        let chain = &spec.chain;
-        assert!(chain.forces.is_empty() && chain.stops.upper.is_none() && chain.stops.lower.is_none());
-        Balance {
-            base,
-            m: chain.masses.clone(),
-            k: chain.stiffness.clone(),
-            c: chain.damping.clone(),
-            deltas: chain.gaps.clone(),
-            // Products of terms up to ω_max: 12 nodes over 0.5/ω_max are exact far below
-            // rounding.
-            h_max: 0.5 / omega_max,
-            nodes: gauss_legendre(12),
-            work: Sum::default(),
-            damping: Sum::default(),
-            lost: Sum::default(),
-            unreported: Sum::default(),
-            events: 0,
-            last: (
-                0.0,
-                spec.initial.positions.clone(),
-                spec.initial.velocities.clone(),
-            ),
-            samples: Vec::new(),
-        }
-    }
-
-    /// E = Σ ½ m v² + ½ k (x − y)², J.
-    fn energy(&self, t: f64, x: &[f64], v: &[f64]) -> f64 {
-        let (y, _) = self.base.value(t);
-        (0..self.m.len())
-            .map(|i| 0.5 * self.m[i] * v[i] * v[i] + 0.5 * self.k[i] * (x[i] - y).powi(2))
-            .sum()
-    }
-
-    fn gaps(&self, x: &[f64]) -> Vec<f64> {
-        (0..self.deltas.len())
-            .map(|k| self.deltas[k] - (x[k + 1] - x[k]))
-            .collect()
-    }
-}
-
-impl RunObserver for Balance<'_> {
-    fn flow(&mut self, flow: &Flow<'_>) {
-        let n = self.m.len();
-        let (a, b) = (flow.t_start, flow.t_end);
-        let (mut x, mut v) = (vec![0.0; n], vec![0.0; n]);
-        flow.state_at(a, &mut x, &mut v);
-        assert!(
-            (a - self.last.0).abs() <= 1e-12 * a.max(1.0),
-            "flow at {a}, last {}",
-            self.last.0
-        );
-        let gain = self.energy(a, &x, &v) - self.energy(a, &self.last.1, &self.last.2);
-        self.unreported.add(gain);
-        let (xs, ws) = std::mem::take(&mut self.nodes);
-        for (p0, p1, piece) in self.base.parts(a, b) {
-            let len = p1 - p0;
-            if len <= 0.0 {
-                continue;
-            }
-            let parts = (len / self.h_max).ceil().max(1.0) as usize;
-            let h = len / parts as f64;
-            for j in 0..parts {
-                let lo = p0 + j as f64 * h;
-                let hi = if j + 1 == parts { p1 } else { lo + h };
-                let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-                let (mut p, mut d) = (0.0, 0.0);
-                for (z, w) in xs.iter().zip(&ws) {
-                    let t = mid + half * z;
-                    flow.state_at(t, &mut x, &mut v);
-                    let (y, yd) = self.base.at(t, piece);
-                    for i in 0..n {
-                        let f = -self.k[i] * (x[i] - y) - self.c[i] * (v[i] - yd);
-                        p += w * f * yd;
-                        d += w * self.c[i] * (v[i] - yd).powi(2);
-                    }
-                }
-                self.work.add(half * p);
-                self.damping.add(half * d);
-            }
-        }
-        self.nodes = (xs, ws);
-        flow.state_at(b, &mut x, &mut v);
-        self.last = (b, x, v);
-    }
-
-    fn event(&mut self, event: &Event, state: &StateView<'_>) {
-        let t = event.time;
-        let before = self.energy(t, &self.last.1, &self.last.2);
-        let after = self.energy(t, state.positions, state.velocities);
-        self.lost.add(before - after);
-        self.events += 1;
-        self.last = (t, state.positions.to_vec(), state.velocities.to_vec());
-    }
-
-    fn wants_samples(&self) -> bool {
-        true
-    }
-
-    fn sample(&mut self, sample: &Sample<'_>) {
-        let e = sample
-            .electrical
-            .expect("an electrical sample at every period boundary");
-        self.samples.push((sample.time, e.charge_c, sample.gaps.to_vec()));
-    }
-}
 
 /// What the balance of one run came to.
 #[derive(Debug, Clone, Copy)]

@@ -35,8 +35,9 @@ use vibrotribo::study::{RunObserver, Sample, Sampling, simulate};
 use vibrotribo::{ChainParams, ChainState, Event, Flow, SimOptions, Simulator, StateView};
 
 mod common;
+use common::balance::Balance;
+use common::base_motion::Base;
 use common::electrostatics::{VACUUM_PERMITTIVITY, electrostatic_forces, equilibrium_charge, field_energy};
-use common::quadrature::{Sum, gauss_legendre};
 
 /// The charge at rest: the initial charge in open circuit, otherwise where −∂U/∂Q = 0.
 fn charge_at_rest(h: &HarvesterParams, gaps: &[f64]) -> f64 {
@@ -239,143 +240,6 @@ fn static_equilibrium_contact_separation() {
 // In one-way mode the masses feel no force, so W_base = ΔE + D + L alone; the load's energy
 // and ΔU are then energy the model creates: the full identity misses by E_load + ΔU.
 
-/// The mechanical terms of the balance under y = A sin ωt, and the run's samples.
-struct Balance {
-    m: Vec<f64>,
-    k: Vec<f64>,
-    c: Vec<f64>,
-    deltas: Vec<f64>,
-    amplitude: f64,
-    omega: f64,
-    /// Longest quadrature interval, s.
-    h_max: f64,
-    nodes: (Vec<f64>, Vec<f64>),
-    work: Sum,
-    damping: Sum,
-    lost: Sum,
-    /// Energy changes between pieces of flow that no event reports, J.
-    unreported: Sum,
-    events: usize,
-    quadrature_intervals: usize,
-    /// Time, positions, velocities after the last flow or event.
-    last: (f64, Vec<f64>, Vec<f64>),
-    /// (time, charge, gaps) of every sample (one per period boundary).
-    samples: Vec<(f64, f64, Vec<f64>)>,
-}
-
-impl Balance {
-    fn new(chain: &ChainParams) -> Self {
-        assert!(chain.forces.is_empty() && chain.stops.upper.is_none() && chain.stops.lower.is_none());
-        let n = chain.len();
-        let wn = (0..n)
-            .map(|i| (chain.stiffness[i] / chain.masses[i]).sqrt())
-            .fold(chain.omega(), f64::max);
-        Balance {
-            m: chain.masses.clone(),
-            k: chain.stiffness.clone(),
-            c: chain.damping.clone(),
-            deltas: chain.gaps.clone(),
-            amplitude: chain.excitation.amplitude,
-            omega: chain.omega(),
-            // Integrands are products of terms up to the natural frequencies: 12 nodes over
-            // 0.5/(2ω_max) leave a relative error far below rounding.
-            h_max: 0.5 / (2.0 * wn),
-            nodes: gauss_legendre(12),
-            work: Sum::default(),
-            damping: Sum::default(),
-            lost: Sum::default(),
-            unreported: Sum::default(),
-            events: 0,
-            quadrature_intervals: 0,
-            last: (0.0, vec![0.0; n], vec![0.0; n]),
-            samples: Vec::new(),
-        }
-    }
-
-    fn base(&self, t: f64) -> (f64, f64) {
-        let (s, c) = (self.omega * t).sin_cos();
-        (self.amplitude * s, self.amplitude * self.omega * c)
-    }
-
-    /// E = Σ ½ m v² + ½ k (x − y)², J.
-    fn energy(&self, t: f64, x: &[f64], v: &[f64]) -> f64 {
-        let (y, _) = self.base(t);
-        (0..self.m.len())
-            .map(|i| 0.5 * self.m[i] * v[i] * v[i] + 0.5 * self.k[i] * (x[i] - y).powi(2))
-            .sum()
-    }
-
-    fn gaps(&self, x: &[f64]) -> Vec<f64> {
-        (0..self.deltas.len())
-            .map(|k| self.deltas[k] - (x[k + 1] - x[k]))
-            .collect()
-    }
-}
-
-impl RunObserver for Balance {
-    fn flow(&mut self, flow: &Flow<'_>) {
-        let n = self.m.len();
-        let (a, b) = (flow.t_start, flow.t_end);
-        let (mut x, mut v) = (vec![0.0; n], vec![0.0; n]);
-        flow.state_at(a, &mut x, &mut v);
-        assert!(
-            (a - self.last.0).abs() <= 1e-12 * a.max(1.0),
-            "flow at {a}, last {}",
-            self.last.0
-        );
-        let gain = self.energy(a, &x, &v) - self.energy(a, &self.last.1, &self.last.2);
-        self.unreported.add(gain);
-        let (xs, ws) = std::mem::take(&mut self.nodes);
-        let len = b - a;
-        if len > 0.0 {
-            let pieces = (len / self.h_max).ceil().max(1.0) as usize;
-            let h = len / pieces as f64;
-            for j in 0..pieces {
-                let lo = a + j as f64 * h;
-                let hi = if j + 1 == pieces { b } else { lo + h };
-                let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-                let (mut p, mut d) = (0.0, 0.0);
-                for (z, w) in xs.iter().zip(&ws) {
-                    let t = mid + half * z;
-                    flow.state_at(t, &mut x, &mut v);
-                    let (y, yd) = self.base(t);
-                    for i in 0..n {
-                        let f = -self.k[i] * (x[i] - y) - self.c[i] * (v[i] - yd);
-                        p += w * f * yd;
-                        d += w * self.c[i] * (v[i] - yd).powi(2);
-                    }
-                }
-                self.work.add(half * p);
-                self.damping.add(half * d);
-                self.quadrature_intervals += 1;
-            }
-        }
-        self.nodes = (xs, ws);
-        flow.state_at(b, &mut x, &mut v);
-        self.last = (b, x, v);
-    }
-
-    fn event(&mut self, event: &Event, state: &StateView<'_>) {
-        let t = event.time;
-        let before = self.energy(t, &self.last.1, &self.last.2);
-        let after = self.energy(t, state.positions, state.velocities);
-        self.lost.add(before - after);
-        self.events += 1;
-        self.last = (t, state.positions.to_vec(), state.velocities.to_vec());
-    }
-
-    fn wants_samples(&self) -> bool {
-        true
-    }
-
-    fn sample(&mut self, sample: &Sample<'_>) {
-        let e = sample
-            .electrical
-            .expect("an electrical sample at every period boundary");
-        self.samples.push((sample.time, e.charge_c, sample.gaps.to_vec()));
-    }
-}
-
 /// What the balance of one run came to.
 #[derive(Debug, Clone, Copy)]
 struct Closure {
@@ -401,7 +265,17 @@ fn coupled_balance(name: &str, text: &str) -> Closure {
     let mut spec = config.run_spec(false);
     spec.sampling = Some(Sampling::PerPeriod(1));
     let h = spec.harvester.as_ref().unwrap().params.clone();
-    let mut obs = Balance::new(&spec.chain);
+    let chain = &spec.chain;
+    // Integrands are products of terms up to the natural frequencies: 12 nodes over
+    // 0.5/(2ω_max) leave a relative error far below rounding.
+    let wn = (0..chain.len())
+        .map(|i| (chain.stiffness[i] / chain.masses[i]).sqrt())
+        .fold(chain.omega(), f64::max);
+    let base = Base::Sine {
+        amplitude: chain.excitation.amplitude,
+        omega: chain.omega(),
+    };
+    let mut obs = Balance::new(&spec, base, 2.0 * wn);
     let started = std::time::Instant::now();
     let outcome = simulate(&spec, &mut obs).unwrap();
     let elapsed = started.elapsed().as_secs_f64();

@@ -236,11 +236,13 @@ pub fn simulate<O: RunObserver + ?Sized>(spec: &RunSpec, observer: &mut O) -> Re
                 ending = Ending::Stopped;
                 break;
             }
-            Err(StudyError::Sim(SimError::Observer(_))) => {
-                let e = rec
-                    .electrical_error()
-                    .expect("only the charge solver fails a run");
-                ending = Ending::Failed(StudyError::Electrical(e));
+            Err(StudyError::Sim(SimError::Observer(message))) => {
+                // The charge solver is the observer that stops a run; its own error says more
+                // than the engine's message about it.
+                ending = Ending::Failed(match rec.electrical_error() {
+                    Some(e) => StudyError::Electrical(e),
+                    None => StudyError::Sim(SimError::Observer(message)),
+                });
                 break;
             }
             Err(e) => {

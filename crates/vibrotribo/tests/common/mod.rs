@@ -2,6 +2,7 @@
 //! `ode_solvers`, not the closed form under test) and reference-data loading.
 #![allow(dead_code)]
 
+pub mod balance;
 pub mod base_motion;
 pub mod electrostatics;
 pub mod fd;
