@@ -18,7 +18,7 @@ use vibrotribo::{ChainParams, ChainState, Simulator};
 
 use crate::config::ConfigArgs;
 use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
-use crate::plot::{self, Figure, Legend, Series, both};
+use crate::plot::{self, Figure, Legend, Series, Shape, both};
 
 /// Options of `vibrotribo continue`.
 #[derive(Debug, clap::Args)]
@@ -516,42 +516,108 @@ pub fn plot_branches(
             }
         }
     }
-    // Bifurcations: vertical green lines across the data.
-    let (y_lo, y_hi) = dy
-        .iter()
-        .chain(curves.iter().flat_map(|c| c.1.iter()))
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    let marks: Vec<([f64; 2], [f64; 2])> = result
-        .branches
-        .iter()
-        .flat_map(|b| b.bifurcations.iter())
-        .map(|f| ([f.parameter; 2], [y_lo, y_hi]))
-        .collect();
-    let mut lines: Vec<Series> = curves
-        .iter()
-        .map(|(x, y, stable)| {
-            let s = Series::unlabelled(x, y);
-            if *stable {
-                s.colour(0)
-            } else {
-                s.colour(3).dashed()
+    // Bifurcations: a marker per kind on the branch, at each section point of its orbit.
+    let mut marks: Vec<(&'static str, Shape, usize, Vec<f64>, Vec<f64>)> = Vec::new();
+    for b in &result.branches {
+        for f in &b.bifurcations {
+            let (label, shape, colour) = marker_of(&f.kind);
+            let ys = section_positions(&family(f.parameter), &f.point.state, b.period, mass, config);
+            let at = match marks.iter().position(|m| m.0 == label) {
+                Some(i) => i,
+                None => {
+                    marks.push((label, shape, colour, Vec::new(), Vec::new()));
+                    marks.len() - 1
+                }
+            };
+            for y in ys {
+                marks[at].3.push(f.parameter);
+                marks[at].4.push(y);
             }
-        })
-        .collect();
-    lines.extend(marks.iter().map(|(x, y)| Series::unlabelled(x, y).colour(2)));
+        }
+    }
+    let mut lines: Vec<Series> = Vec::new();
+    let (mut stable_named, mut unstable_named) = (false, false);
+    for (x, y, stable) in &curves {
+        let named = if *stable {
+            &mut stable_named
+        } else {
+            &mut unstable_named
+        };
+        let s = if *named {
+            Series::unlabelled(x, y)
+        } else {
+            Series::new(if *stable { "stable" } else { "unstable" }, x, y)
+        };
+        *named = true;
+        lines.push(if *stable {
+            s.colour(0)
+        } else {
+            s.colour(3).dashed()
+        });
+    }
+    let mut points = vec![Series::new("brute force", &dx, &dy).colour(7)];
+    points.extend(
+        marks
+            .iter()
+            .map(|(label, shape, colour, x, y)| Series::new(label, x, y).colour(*colour).marker(*shape, 11)),
+    );
     let mut fig = Figure::new(
-        format!(
-            "Branches in {}: stable solid, unstable dashed, bifurcations green",
-            diagram.param
-        ),
+        format!("Periodic orbits in {}", diagram.param),
         diagram.param,
         format!("x{} at t = nT [m]", mass + 1),
     );
-    fig.legend = Legend::Hidden;
+    let all_x = dx.iter().chain(curves.iter().flat_map(|c| c.0.iter()));
+    let all_y = dy.iter().chain(curves.iter().flat_map(|c| c.1.iter()));
+    fig.legend = emptier_upper_corner(all_x.copied().zip(all_y.copied()));
     both(dir, name, |path| {
-        plot::lines_and_points(path, &fig, &lines, &[Series::unlabelled(&dx, &dy).colour(7)], 3)
+        plot::lines_and_points(path, &fig, &lines, &points, 3)
     })
+}
+
+/// The upper corner of the data's box with fewer points in its top-left or top-right third
+/// (where the legend hides the least).
+fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Legend {
+    let finite = points.filter(|(x, y)| x.is_finite() && y.is_finite());
+    let bounds = |pick: fn(&(f64, f64)) -> f64| {
+        finite
+            .clone()
+            .map(|p| pick(&p))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    let ((x0, x1), (y0, y1)) = (bounds(|p| p.0), bounds(|p| p.1));
+    let top = y1 - (y1 - y0) / 3.0;
+    let count = |left: bool| {
+        finite
+            .clone()
+            .filter(|(x, y)| {
+                *y >= top
+                    && if left {
+                        *x <= x0 + (x1 - x0) / 3.0
+                    } else {
+                        *x >= x1 - (x1 - x0) / 3.0
+                    }
+            })
+            .count()
+    };
+    if count(true) < count(false) {
+        Legend::UpperLeft
+    } else {
+        Legend::UpperRight
+    }
+}
+
+/// The legend entry, marker shape and palette colour of a bifurcation's kind.
+fn marker_of(kind: &BifurcationKind) -> (&'static str, Shape, usize) {
+    match kind {
+        BifurcationKind::Fold => ("fold", Shape::Triangle, 1),
+        BifurcationKind::BranchPoint => ("branch point", Shape::Square, 4),
+        BifurcationKind::PeriodDoubling => ("period doubling", Shape::Circle, 2),
+        BifurcationKind::NeimarkSacker { .. } => ("Neimark–Sacker", Shape::Diamond, 6),
+        BifurcationKind::Grazing { .. } => ("grazing", Shape::Cross, 5),
+        BifurcationKind::Sticking { .. } => ("sticking", Shape::Square, 8),
+        BifurcationKind::SequenceChange => ("sequence change", Shape::Diamond, 9),
+        _ => ("other", Shape::Diamond, 7),
+    }
 }

@@ -106,6 +106,33 @@ pub struct Series<'a> {
     pub dashed: bool,
     /// Colour: an index into the palette; `None` (default) takes the series' position.
     pub colour: Option<usize>,
+    /// As points: a marker of its own (shape and size) instead of the chart's small squares;
+    /// for a few points that must stand out, such as bifurcations on a branch.
+    pub marker: Option<Marker>,
+}
+
+/// A point marker: a shape drawn `size_px` pixels across, filled (a cross is stroked).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Marker {
+    /// The shape.
+    pub shape: Shape,
+    /// Width and height, pixels.
+    pub size_px: u32,
+}
+
+/// The shape of a [`Marker`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    /// A disc.
+    Circle,
+    /// A triangle pointing up.
+    Triangle,
+    /// A square standing on a corner.
+    Diamond,
+    /// A square.
+    Square,
+    /// A diagonal cross.
+    Cross,
 }
 
 impl<'a> Series<'a> {
@@ -117,6 +144,7 @@ impl<'a> Series<'a> {
             y,
             dashed: false,
             colour: None,
+            marker: None,
         }
     }
 
@@ -128,12 +156,21 @@ impl<'a> Series<'a> {
             y,
             dashed: false,
             colour: None,
+            marker: None,
         }
     }
 
     /// The same series drawn dashed (as a line).
     pub fn dashed(self) -> Self {
         Series { dashed: true, ..self }
+    }
+
+    /// The same series drawn (as points) with `shape` markers `size_px` pixels across.
+    pub fn marker(self, shape: Shape, size_px: u32) -> Self {
+        Series {
+            marker: Some(Marker { shape, size_px }),
+            ..self
+        }
     }
 
     /// The same series in palette colour `index` (0 blue, 1 orange, 2 green, 3 red, …).

@@ -72,9 +72,38 @@ pub(super) fn titled<DB: DrawingBackend>(
     title: &str,
 ) -> Result<DrawingArea<DB, Shift>> {
     root.fill(&WHITE).map_err(err)?;
-    root.margin(10, 0, 0, 0)
-        .titled(title, font(TITLE_PX))
-        .map_err(err)
+    let (width, _) = root.dim_in_pixel();
+    let room = width.saturating_sub(24);
+    let (text, px) = fitted_title(title, room, |t, px| {
+        root.estimate_text_size(t, &font(px))
+            .map(|(w, _)| w)
+            .unwrap_or(u32::MAX)
+    });
+    root.margin(10, 0, 0, 0).titled(&text, font(px)).map_err(err)
+}
+
+/// Smallest title size, pixels: below it a title is shortened instead.
+pub(super) const TITLE_MIN_PX: u32 = 18;
+
+/// The title as it fits in `room` pixels (`width` measures a text at a size): at
+/// [`TITLE_PX`], else at the largest size down to [`TITLE_MIN_PX`] that fits, else
+/// shortened at that size with an ellipsis.
+pub(super) fn fitted_title(title: &str, room: u32, width: impl Fn(&str, u32) -> u32) -> (String, u32) {
+    for px in (TITLE_MIN_PX..=TITLE_PX).rev().step_by(2) {
+        if width(title, px) <= room {
+            return (title.to_string(), px);
+        }
+    }
+    let chars: Vec<char> = title.chars().collect();
+    let mut keep = chars.len();
+    while keep > 1 {
+        keep -= 1;
+        let short: String = chars[..keep].iter().collect::<String>().trim_end().to_string() + "…";
+        if width(&short, TITLE_MIN_PX) <= room {
+            return (short, TITLE_MIN_PX);
+        }
+    }
+    ("…".to_string(), TITLE_MIN_PX)
 }
 
 /// Compact tick label: plain decimals for moderate magnitudes, else scientific notation.

@@ -311,3 +311,43 @@ fn dashes_cover_the_line_in_alternating_pieces() {
     let corner = dashes(&[(0, 0), (5, 0), (5, 10)], 9.0, 6.0);
     assert_eq!(corner[0], vec![(0, 0), (5, 0), (5, 4)]);
 }
+
+#[test]
+fn titles_shrink_then_shorten_to_fit() {
+    use super::style::{TITLE_MIN_PX, TITLE_PX, fitted_title};
+    // A stand-in measure: every character half the font size wide.
+    let width = |t: &str, px: u32| t.chars().count() as u32 * px / 2;
+    let short = "Orbit diagram";
+    assert_eq!(fitted_title(short, 1000, width), (short.to_string(), TITLE_PX));
+    let long = "x".repeat(80);
+    let (text, px) = fitted_title(&long, 80 * 11, width);
+    assert_eq!(text, long, "fits at a smaller size");
+    assert!(px < TITLE_PX && px >= TITLE_MIN_PX && width(&text, px) <= 80 * 11);
+    let (text, px) = fitted_title(&long, 300, width);
+    assert_eq!(px, TITLE_MIN_PX);
+    assert!(text.ends_with('…') && width(&text, px) <= 300, "{text}");
+    assert!(text.chars().count() > 20, "shortened no more than needed: {text}");
+}
+
+#[test]
+fn markers_stay_inside_their_size() {
+    use super::figure::{Marker, Shape};
+    use super::xy::marker_outline;
+    for shape in [
+        Shape::Circle,
+        Shape::Triangle,
+        Shape::Diamond,
+        Shape::Square,
+        Shape::Cross,
+    ] {
+        let marker = Marker { shape, size_px: 12 };
+        let outline = marker_outline(marker, (100, 50));
+        assert!(outline.len() >= 3, "{shape:?}");
+        for (x, y) in outline {
+            assert!(
+                (x - 100).abs() <= 6 && (y - 50).abs() <= 6,
+                "{shape:?}: ({x}, {y})"
+            );
+        }
+    }
+}

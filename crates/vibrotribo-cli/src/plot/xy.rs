@@ -1,7 +1,7 @@
 //! Rendering: the PNG and SVG backends, axis ranges and ticks, and x–y charts (lines,
 //! rasterised points, clipping).
 
-use super::figure::{Figure, Format, HeatMap, Legend, Scale, Series};
+use super::figure::{Figure, Format, HeatMap, Legend, Marker, Scale, Series, Shape};
 use super::heat::draw_heat_map;
 use super::style::{
     LABEL_PX, PALETTE, TICK_PX, ensure_font, err, finite_bounds, font, tick_label, titled, widen,
@@ -293,12 +293,21 @@ where
             }
         }
         if let Some(label) = s.label {
+            let dashed = s.dashed;
             chart
                 .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                 .map_err(err)?
                 .label(label)
                 .legend(move |(lx, ly)| {
-                    PathElement::new(vec![(lx, ly), (lx + 24, ly)], colour.stroke_width(3))
+                    // Two strokes: touching for a solid line, apart for a dashed one.
+                    let (first_end, second_start) = if dashed {
+                        (lx + 9, lx + 15)
+                    } else {
+                        (lx + 12, lx + 12)
+                    };
+                    EmptyElement::at((lx, ly))
+                        + PathElement::new(vec![(0, 0), (first_end - lx, 0)], colour.stroke_width(3))
+                        + PathElement::new(vec![(second_start - lx, 0), (24, 0)], colour.stroke_width(3))
                 });
         }
     }
@@ -331,7 +340,9 @@ where
                 continue;
             }
             occupied[cell] = true;
-            if half == 0 {
+            if let Some(marker) = s.marker {
+                draw_marker(root, marker, (bx, by), colour)?;
+            } else if half == 0 {
                 root.draw_pixel((bx, by), &colour).map_err(err)?;
             } else {
                 root.draw(&Rectangle::new(
@@ -342,13 +353,26 @@ where
             }
         }
         if let Some(label) = s.label {
-            chart
+            let series = chart
                 .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                 .map_err(err)?
-                .label(label)
-                .legend(move |(lx, ly)| {
-                    Rectangle::new([(lx + 6, ly - 5), (lx + 16, ly + 5)], colour.filled())
-                });
+                .label(label);
+            match s.marker {
+                Some(marker) => {
+                    let shown = Marker {
+                        size_px: marker.size_px.min(14),
+                        ..marker
+                    };
+                    series.legend(move |(lx, ly)| {
+                        Polygon::new(marker_outline(shown, (lx + 11, ly)), colour.filled())
+                    });
+                }
+                None => {
+                    series.legend(move |(lx, ly)| {
+                        Rectangle::new([(lx + 6, ly - 5), (lx + 16, ly + 5)], colour.filled())
+                    });
+                }
+            }
         }
     }
 
@@ -369,6 +393,66 @@ where
             .map_err(err)?;
     }
     Ok(())
+}
+
+/// The outline of `marker` centred on the pixel `at`, as a polygon (a disc as 16 sides, a
+/// cross as its twelve corners), so that every shape is one kind of element.
+pub(super) fn marker_outline(marker: Marker, at: (i32, i32)) -> Vec<(i32, i32)> {
+    let r = f64::from(marker.size_px.max(3)) / 2.0;
+    let (cx, cy) = (f64::from(at.0), f64::from(at.1));
+    let corners: Vec<(f64, f64)> = match marker.shape {
+        Shape::Circle => (0..16)
+            .map(|k| {
+                let a = std::f64::consts::TAU * f64::from(k) / 16.0;
+                (r * a.cos(), r * a.sin())
+            })
+            .collect(),
+        // Pixel y grows downwards: the apex has the smallest y.
+        Shape::Triangle => vec![(0.0, -r), (r, 0.8 * r), (-r, 0.8 * r)],
+        Shape::Diamond => vec![(0.0, -r), (r, 0.0), (0.0, r), (-r, 0.0)],
+        Shape::Square => {
+            let h = 0.85 * r;
+            vec![(-h, -h), (h, -h), (h, h), (-h, h)]
+        }
+        Shape::Cross => {
+            // An X of arms `w` wide: the twelve corners of two crossed bars.
+            let (a, w) = (0.8 * r, 0.25 * r);
+            vec![
+                (-a, -a + w),
+                (-a + w, -a),
+                (0.0, -w),
+                (a - w, -a),
+                (a, -a + w),
+                (w, 0.0),
+                (a, a - w),
+                (a - w, a),
+                (0.0, w),
+                (-a + w, a),
+                (-a, a - w),
+                (-w, 0.0),
+            ]
+        }
+    };
+    corners
+        .into_iter()
+        .map(|(dx, dy)| ((cx + dx).round() as i32, (cy + dy).round() as i32))
+        .collect()
+}
+
+/// Draws `marker` at the pixel `at` of `root`, filled, with a darker outline.
+fn draw_marker<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    marker: Marker,
+    at: (i32, i32),
+    colour: RGBColor,
+) -> Result<()> {
+    let outline = marker_outline(marker, at);
+    root.draw(&Polygon::new(outline.clone(), colour.filled()))
+        .map_err(err)?;
+    let mut closed = outline;
+    closed.push(closed[0]);
+    root.draw(&PathElement::new(closed, BLACK.mix(0.6).stroke_width(1)))
+        .map_err(err)
 }
 
 /// The visible pieces of a polyline inside the rectangle `[0, w) × [0, h)` (drawing areas
