@@ -218,8 +218,9 @@ def ours(binary, config, periods, workdir):
     """vibrotribo's impacts, positions at t = kT and its first accumulation point, if any."""
     out = workdir / "ours"
     subprocess.run([binary, "simulate", str(config), "--mechanics-only",
-                    "--set", f"run.periods={periods}", "--set", "run.samples_per_period=1", "--set", "run.transient_periods=0",
-                    "--out", str(out), "--quiet"], check=True, stdout=subprocess.DEVNULL)
+                    "--set", f"run.periods={periods}", "--set", "run.samples_per_period=1",
+                    "--set", "run.transient_periods=0", "--out", str(out), "--quiet"],
+                   check=True, stdout=subprocess.DEVNULL)
     impacts, first_chatter = [], None
     with open(out / "events.csv") as f:
         head = f.readline().strip().split(",")
