@@ -396,6 +396,13 @@ impl Config {
         }
     }
 
+    /// The effective settings: every field of the schema with its value (the defaults filled
+    /// in where the file and the overrides leave it out), shaped like the file, as JSON
+    /// (`null` for an optional key left absent).
+    pub fn effective(&self) -> serde_json::Value {
+        serde_json::to_value(&self.doc).unwrap_or(serde_json::Value::Null)
+    }
+
     /// The TOML tree: the file with the overrides applied (what a run records as its
     /// settings).
     pub fn table(&self) -> &Table {
