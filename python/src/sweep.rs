@@ -14,6 +14,7 @@ use vibrotribo::sweep::{
     SweepError, run_continued, run_grid_on,
 };
 
+use vibrotribo::attractors::initial_condition_index;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::limits;
 
@@ -312,7 +313,17 @@ pub fn map<'py>(
         .iter()
         .flat_map(|&yv| x_values.iter().map(move |&xv| vec![(xk, xv), (yk, yv)]))
         .collect();
-    check_points(&runner, &points)?;
+    // An initial-condition axis is checked for its index only: a start whose masses
+    // interpenetrate is a row with its error (as `basins` skips it), not a failed map.
+    let initial = |k: &str| k.starts_with("run.initial_");
+    for k in [xk, yk].into_iter().filter(|k| initial(k)) {
+        initial_condition_index(k, runner.masses()).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    }
+    let others: Vec<Vec<(&str, f64)>> = points
+        .iter()
+        .map(|p| p.iter().copied().filter(|(k, _)| !initial(k)).collect())
+        .collect();
+    check_points(&runner, &others)?;
     let columns = settings_of.columns(&runner);
     let mut table = SweepColumns::new(&["x", "y"], runner.masses(), columns, false);
     let pool = settings_of.pool()?;
