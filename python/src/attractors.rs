@@ -158,31 +158,36 @@ pub fn basins<'py>(
     let (xs, ys) = (grid(x_from, x_to, nx), grid(y_from, y_to, ny));
     let points = basin_points(&xs, &ys);
     let pool = settings_of.pool()?;
-    let (xk, yk) = (x.as_str(), y.as_str());
-    let results: Vec<Result<Fingerprint, String>> = py.detach(|| {
-        let mut signals = Signals::new();
-        let mut out = Vec::with_capacity(points.len());
-        for chunk in points.chunks(pool.current_num_threads() * 4) {
-            let part: Vec<Result<Fingerprint, String>> = pool.install(|| {
-                chunk
-                    .par_iter()
-                    .map(|&(xv, yv)| {
-                        starts
-                            .run(&[(xk, xv), (yk, yv)], None)
-                            .map_err(|e| format!("{e:#}"))
-                    })
-                    .collect()
-            });
-            out.extend(part);
-            if signals.check() {
-                break;
-            }
-        }
-        signals.result().map(|()| out)
-    })?;
+    let results = run_starts(py, &pool, &starts, &points, &x, &y)?;
+    let out = basin_tables(py, starts.point_runner().base().chain(), &points, &results, &options)?;
+    let o = starts.point_runner().options();
+    let s = PyDict::new(py);
+    s.set_item("command", "basins")?;
+    s.set_item("x", x)?;
+    s.set_item("x_values", xs)?;
+    s.set_item("y", y)?;
+    s.set_item("y_values", ys)?;
+    s.set_item("transient_periods", o.transient_periods)?;
+    s.set_item("recorded_periods", o.recorded_periods)?;
+    s.set_item("mechanics_only", mechanics_only)?;
+    s.set_item("settings", table_to_dict(py, starts.point_runner().base().table())?)?;
+    out.set_item("settings", s)?;
+    Ok(out)
+}
+
+/// The tables of a basin grid from its starts' fingerprints (grid order), classified in
+/// that order: `starts`, `basins` and `attractors`.
+fn basin_tables<'py>(
+    py: Python<'py>,
+    chain: &vibrotribo::ChainParams,
+    points: &[(f64, f64)],
+    results: &[Result<Fingerprint, String>],
+    options: &AttractorOptions,
+) -> PyResult<Bound<'py, PyDict>> {
+    let masses = chain.len();
     let fingerprints: Vec<Option<Fingerprint>> = results.iter().map(|r| r.as_ref().ok().cloned()).collect();
-    let scale = SectionScale::of(starts.point_runner().base().chain());
-    let c = classify(&fingerprints, &scale, &options);
+    let scale = SectionScale::of(chain);
+    let c = classify(&fingerprints, &scale, options);
     let mut starts_table = table(
         &[
             ("x", Kind::Float),
@@ -245,22 +250,137 @@ pub fn basins<'py>(
     out.set_item("starts", table_to_py(py, &starts_table)?)?;
     out.set_item("basins", table_to_py(py, &basin_table)?)?;
     out.set_item("attractors", table_to_py(py, &attractor_table)?)?;
-    let o = starts.point_runner().options();
-    let s = PyDict::new(py);
-    s.set_item("command", "basins")?;
-    s.set_item("x", x)?;
-    s.set_item("x_values", xs)?;
-    s.set_item("y", y)?;
-    s.set_item("y_values", ys)?;
-    s.set_item("transient_periods", o.transient_periods)?;
-    s.set_item("recorded_periods", o.recorded_periods)?;
-    s.set_item("mechanics_only", mechanics_only)?;
-    s.set_item(
-        "settings",
-        table_to_dict(py, starts.point_runner().base().table())?,
-    )?;
-    out.set_item("settings", s)?;
     Ok(out)
+}
+
+/// A start's fingerprint as a tuple `(period, impacts_per_period, power_w, points, cells,
+/// error)` (`error` None for a start that ran).
+type StartTuple = (usize, f64, Option<f64>, Vec<f64>, Vec<i32>, Option<String>);
+
+fn fingerprint_to_py(r: &Result<Fingerprint, String>) -> StartTuple {
+    match r {
+        Ok(f) => (f.period, f.impacts_per_period, f.power_w, f.points.clone(), f.cells.clone(), None),
+        Err(e) => (0, f64::NAN, None, Vec::new(), Vec::new(), Some(e.clone())),
+    }
+}
+
+fn fingerprint_of(t: StartTuple) -> Result<Fingerprint, String> {
+    match t {
+        (_, _, _, _, _, Some(e)) => Err(e),
+        (period, impacts_per_period, power_w, points, cells, None) => Ok(Fingerprint {
+            period,
+            points,
+            cells,
+            impacts_per_period,
+            power_w,
+        }),
+    }
+}
+
+/// The fingerprints of the starts of a basin grid (grid order), without classifying them:
+/// what `vibrotribo.dask.basins` runs on a worker for some rows.
+#[pyfunction]
+#[pyo3(signature = (config, x, x_values, y, y_values, *, cell = 0.05, section_tolerance = 1e-3, match_tolerance = 3e-3, transient = None, recorded = None, mechanics_only = false, period_tolerance = DEFAULT_PERIOD_TOLERANCE, floquet = false, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP, threads = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn basin_starts(
+    py: Python<'_>,
+    config: &Bound<'_, PyAny>,
+    x: String,
+    x_values: Vec<f64>,
+    y: String,
+    y_values: Vec<f64>,
+    cell: f64,
+    section_tolerance: f64,
+    match_tolerance: f64,
+    transient: Option<u64>,
+    recorded: Option<u64>,
+    mechanics_only: bool,
+    period_tolerance: f64,
+    floquet: bool,
+    settle: String,
+    settle_cap: u64,
+    threads: Option<usize>,
+) -> PyResult<Vec<StartTuple>> {
+    let base = config_of(config)?;
+    let settings_of = PointSettings {
+        transient,
+        recorded,
+        mechanics_only,
+        threads,
+        period_tolerance,
+        settle,
+        settle_cap,
+        floquet,
+        lyapunov: false,
+        allow_large: true,
+    };
+    let options = attractor_options(cell, section_tolerance, match_tolerance, None);
+    let starts = StartRunner::new(settings_of.runner_or(base, DEFAULT_START_PERIODS)?, options)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let points = basin_points(&x_values, &y_values);
+    let pool = settings_of.pool()?;
+    let results = run_starts(py, &pool, &starts, &points, &x, &y)?;
+    Ok(results.iter().map(fingerprint_to_py).collect())
+}
+
+/// The tables of a basin grid from fingerprints computed elsewhere (see [`basin_starts`]).
+#[pyfunction]
+#[pyo3(signature = (config, x_values, y_values, fingerprints, *, cell = 0.05, section_tolerance = 1e-3, match_tolerance = 3e-3))]
+#[allow(clippy::too_many_arguments)]
+pub fn classify_basins<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    x_values: Vec<f64>,
+    y_values: Vec<f64>,
+    fingerprints: Vec<StartTuple>,
+    cell: f64,
+    section_tolerance: f64,
+    match_tolerance: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let base = config_of(config)?;
+    let points = basin_points(&x_values, &y_values);
+    if fingerprints.len() != points.len() {
+        return Err(PyValueError::new_err(format!(
+            "fingerprints: {} for a grid of {} starts",
+            fingerprints.len(),
+            points.len()
+        )));
+    }
+    let options = attractor_options(cell, section_tolerance, match_tolerance, None);
+    options
+        .validate()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let results: Vec<Result<Fingerprint, String>> = fingerprints.into_iter().map(fingerprint_of).collect();
+    basin_tables(py, base.chain(), &points, &results, &options)
+}
+
+/// Runs the starts at `points` on the pool in grid order, chunk by chunk, stopping at a
+/// chunk's end if a signal handler raised.
+fn run_starts(
+    py: Python<'_>,
+    pool: &rayon::ThreadPool,
+    starts: &StartRunner,
+    points: &[(f64, f64)],
+    xk: &str,
+    yk: &str,
+) -> PyResult<Vec<Result<Fingerprint, String>>> {
+    py.detach(|| {
+        let mut signals = Signals::new();
+        let mut out = Vec::with_capacity(points.len());
+        for chunk in points.chunks(pool.current_num_threads() * 4) {
+            let part: Vec<Result<Fingerprint, String>> = pool.install(|| {
+                chunk
+                    .par_iter()
+                    .map(|&(xv, yv)| starts.run(&[(xk, xv), (yk, yv)], None).map_err(|e| format!("{e:#}")))
+                    .collect()
+            });
+            out.extend(part);
+            if signals.check() {
+                break;
+            }
+        }
+        signals.result().map(|()| out)
+    })
 }
 
 /// The attractors of random starts across a parameter (see the Python

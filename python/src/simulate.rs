@@ -38,12 +38,14 @@ pub fn simulate<'py>(
     spec.breakdown_check = true;
     let spp = config.run().samples_per_period;
     check_memory(
-        &format!(
-            "run.periods = {} ({} samples per period held in memory{})",
-            spec.periods,
-            if samples { spp } else { 0 },
-            if samples { "; samples=False keeps none" } else { "" }
-        ),
+        &if samples {
+            format!(
+                "run.periods = {} with run.samples_per_period = {spp} held in memory (samples=False keeps none)",
+                spec.periods
+            )
+        } else {
+            format!("run.periods = {} (per-period statistics)", spec.periods)
+        },
         limits::run_memory_bytes(&spec, spp, samples),
         allow_large,
     )?;
