@@ -32,8 +32,8 @@ def cells(text: str) -> List[Tuple[str, str]]:
 def notebook(text: str) -> Dict[str, Any]:
     """A notebook (nbformat 4) of the cells of ``text``, without outputs."""
     nb_cells = []
-    for kind, source in cells(text):
-        cell: Dict[str, Any] = {"cell_type": kind, "metadata": {}, "source": source}
+    for j, (kind, source) in enumerate(cells(text)):
+        cell: Dict[str, Any] = {"cell_type": kind, "id": f"cell-{j}", "metadata": {}, "source": source}
         if kind == "code":
             cell.update(execution_count=None, outputs=[])
         nb_cells.append(cell)

@@ -159,7 +159,13 @@ pub fn basins<'py>(
     let points = basin_points(&xs, &ys);
     let pool = settings_of.pool()?;
     let results = run_starts(py, &pool, &starts, &points, &x, &y)?;
-    let out = basin_tables(py, starts.point_runner().base().chain(), &points, &results, &options)?;
+    let out = basin_tables(
+        py,
+        starts.point_runner().base().chain(),
+        &points,
+        &results,
+        &options,
+    )?;
     let o = starts.point_runner().options();
     let s = PyDict::new(py);
     s.set_item("command", "basins")?;
@@ -170,7 +176,10 @@ pub fn basins<'py>(
     s.set_item("transient_periods", o.transient_periods)?;
     s.set_item("recorded_periods", o.recorded_periods)?;
     s.set_item("mechanics_only", mechanics_only)?;
-    s.set_item("settings", table_to_dict(py, starts.point_runner().base().table())?)?;
+    s.set_item(
+        "settings",
+        table_to_dict(py, starts.point_runner().base().table())?,
+    )?;
     out.set_item("settings", s)?;
     Ok(out)
 }
@@ -210,7 +219,7 @@ fn basin_tables<'py>(
         ],
         Vec::new(),
     );
-    for ((&(xv, yv), r), label) in points.iter().zip(&results).zip(&c.labels) {
+    for ((&(xv, yv), r), label) in points.iter().zip(results).zip(&c.labels) {
         let (period, impacts, power, error) = match r {
             Ok(f) => (
                 Cell::Int(f.period as i64),
@@ -259,7 +268,14 @@ type StartTuple = (usize, f64, Option<f64>, Vec<f64>, Vec<i32>, Option<String>);
 
 fn fingerprint_to_py(r: &Result<Fingerprint, String>) -> StartTuple {
     match r {
-        Ok(f) => (f.period, f.impacts_per_period, f.power_w, f.points.clone(), f.cells.clone(), None),
+        Ok(f) => (
+            f.period,
+            f.impacts_per_period,
+            f.power_w,
+            f.points.clone(),
+            f.cells.clone(),
+            None,
+        ),
         Err(e) => (0, f64::NAN, None, Vec::new(), Vec::new(), Some(e.clone())),
     }
 }
@@ -371,7 +387,11 @@ fn run_starts(
             let part: Vec<Result<Fingerprint, String>> = pool.install(|| {
                 chunk
                     .par_iter()
-                    .map(|&(xv, yv)| starts.run(&[(xk, xv), (yk, yv)], None).map_err(|e| format!("{e:#}")))
+                    .map(|&(xv, yv)| {
+                        starts
+                            .run(&[(xk, xv), (yk, yv)], None)
+                            .map_err(|e| format!("{e:#}"))
+                    })
                     .collect()
             });
             out.extend(part);

@@ -51,25 +51,6 @@ pub fn unknown_key_message(key: &str) -> String {
     format!("unknown parameter `{key}`{hint} (Config.keys() lists every key)")
 }
 
-/// The effective settings as `(key, value)` pairs in the schema's order: every key with a
-/// value (tables flattened to `section.name`, arrays kept whole).
-fn flatten(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, serde_json::Value)>) {
-    match v {
-        serde_json::Value::Object(o) => {
-            for (k, x) in o {
-                let key = if prefix.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{prefix}.{k}")
-                };
-                flatten(&key, x, out);
-            }
-        }
-        serde_json::Value::Null => {}
-        other => out.push((prefix.to_string(), other.clone())),
-    }
-}
-
 /// `v` without its `null` entries (tables emptied by that dropped too).
 fn without_nulls(v: &serde_json::Value) -> Option<serde_json::Value> {
     match v {
@@ -200,8 +181,9 @@ pub fn table_to_dict<'py>(py: Python<'py>, t: &Table) -> PyResult<Bound<'py, PyD
 ///
 /// A `Config` is an immutable, hashable, read-only mapping of its effective values:
 /// `cfg["excitation.amplitude"]` (the default where the file leaves a key out),
-/// `cfg["oscillator.gaps[1]"]`, derived keys (`cfg["mass_ratio"]`), `"key" in cfg`,
-/// `dict(cfg)`; `to_dict()` the same nested like the file. Two configurations are equal when
+/// `cfg["oscillator.gaps[1]"]`, derived keys (`cfg["mass_ratio"]`), None for an optional
+/// key left absent; its keys are `Config.keys()`; `to_dict()` the values nested like the
+/// file. Two configurations are equal when
 /// their effective values are. `with_(**changes)` (or `replace`) returns a changed copy,
 /// `without(*keys)` a copy with keys back at their defaults.
 #[pyclass(module = "vibrotribo", name = "Config", frozen)]
@@ -248,21 +230,10 @@ impl PyConfig {
 }
 
 impl PyConfig {
-    /// The effective settings as `(section.name, value)` pairs.
-    fn flat(&self) -> Vec<(String, serde_json::Value)> {
-        let mut out = Vec::new();
-        flatten("", &self.inner.effective(), &mut out);
-        out
-    }
-
     /// Whether `key` names a key of the schema (with or without an element) or a derived one.
     fn known(&self, key: &str) -> bool {
         let base = key.split('[').next().unwrap_or(key);
         known_keys().iter().any(|k| k == base) || DERIVED_KEYS.iter().any(|(k, _)| *k == base)
-    }
-
-    fn contains(&self, key: &str) -> bool {
-        self.value(key).is_some()
     }
 
     /// The effective value of `key`: a key of the file, an element `name[i]`, or a derived
@@ -371,7 +342,7 @@ impl PyConfig {
                 };
             }
             if t.remove(*last).is_none() {
-                let message = if self.contains(&key) {
+                let message = if self.known(&key) {
                     format!("`{key}` is not set in this configuration (it has its default)")
                 } else {
                     unknown_key_message(&key)
@@ -399,19 +370,20 @@ impl PyConfig {
     }
 
     /// The effective value of `key` (a key of the file, an element `name[i]`, or a derived
-    /// key); `KeyError` with the closest keys for an unknown one.
+    /// key; None for an optional key left absent); `KeyError` with the closest keys for an
+    /// unknown one.
     fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
         match self.value(key) {
             Some(v) => json_to_py(py, &v),
-            None => Err(PyKeyError::new_err(if self.known(key) {
-                format!("`{key}` has no value in this configuration (an optional key left absent)")
-            } else {
-                unknown_key_message(key)
-            })),
+            None if key.contains('[') && self.known(key) => Err(PyKeyError::new_err(format!(
+                "`{key}`: no such element in this configuration (index out of range)"
+            ))),
+            None if self.known(key) => Ok(py.None().into_bound(py)),
+            None => Err(PyKeyError::new_err(unknown_key_message(key))),
         }
     }
 
-    /// The effective value of `key`, or `default`.
+    /// The effective value of `key`, or `default` if it has none or is unknown.
     #[pyo3(signature = (key, default = None))]
     fn get<'py>(
         &self,
@@ -425,18 +397,23 @@ impl PyConfig {
         }
     }
 
+    /// Whether `key` is a key of the configuration (of the file, an element of an array
+    /// key within its length, or derived).
     fn __contains__(&self, key: &str) -> bool {
-        self.contains(key)
+        self.known(key) && (!key.contains('[') || self.value(key).is_some())
     }
 
-    /// The keys with a value, in the schema's order (`section.name`).
+    /// Every key, as `Config.keys()`: those of the file (`section.name`), then the derived
+    /// ones.
     fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let keys: Vec<String> = self.flat().into_iter().map(|(k, _)| k).collect();
-        PyList::new(py, keys)?.into_any().try_iter().map(|i| i.into_any())
+        PyList::new(py, Self::keys())?
+            .into_any()
+            .try_iter()
+            .map(|i| i.into_any())
     }
 
     fn __len__(&self) -> usize {
-        self.flat().len()
+        Self::keys().len()
     }
 
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {

@@ -57,7 +57,10 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(attractors::classify_basins, m)?)?;
     m.add_function(wrap_pyfunction!(mass_ratio::optimize_mass_ratio, m)?)?;
     m.add_function(wrap_pyfunction!(spice::export_spice, m)?)?;
-    m.add("DEFAULT_START_PERIODS", vibrotribo::attractors::DEFAULT_START_PERIODS)?;
+    m.add(
+        "DEFAULT_START_PERIODS",
+        vibrotribo::attractors::DEFAULT_START_PERIODS,
+    )?;
     m.add("MAX_GRID_POINTS", vibrotribo::study::limits::MAX_GRID_POINTS)?;
     m.add("MAX_MEMORY_BYTES", vibrotribo::study::limits::MAX_MEMORY_BYTES)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;

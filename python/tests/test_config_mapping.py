@@ -55,7 +55,7 @@ def test_without_restores_defaults():
 def test_unknown_keys_suggest_the_closest():
     with pytest.raises(KeyError, match=r"did you mean `excitation.amplitude`"):
         vt.Config(excitation__amplitdue=0.1)
-    with pytest.raises(KeyError, match=r"did you mean `omega_ratio`"):
+    with pytest.raises(KeyError, match=r"did you mean .*`omega_ratio`"):
         vt.sweep(None, "omega_ratoi", [0.6])
     with pytest.raises(KeyError, match="did you mean"):
         vt.Config()["excitation.amplitdue"]

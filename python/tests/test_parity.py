@@ -140,16 +140,21 @@ def options(cli, command):
     `<NAME>`, each with the default its help shows (or None)."""
     text = help_text(cli, command)
     out = {}
-    usage = text.splitlines()[0]
-    for positional in re.findall(r"\[?(<[A-Z_]+>)\]?", usage):
-        out[positional] = None
-    for line in text.splitlines():
+    if "Arguments:" in text:
+        for line in text.split("Arguments:")[1].split("Options:")[0].splitlines():
+            m = re.match(r"\s+[\[<]([A-Z_]+)[\]>]", line)
+            if m:
+                out[f"<{m.group(1)}>"] = None
+    name = None
+    for line in text.split("Options:")[-1].splitlines():
         m = re.match(r"\s+(?:(-\w), )?(--[\w-]+)", line)
         if m:
-            default = re.search(r"\[default: ([^\]]+)\]", line)
-            out[m.group(2)] = default.group(1) if default else None
-            if m.group(1) == "-q":
-                out["-q"] = None
+            name = "-q" if m.group(2) == "--quiet" else m.group(2)
+            out[name] = None
+        # The default closes the option's help, on its first line or a later one.
+        default = re.search(r"\[default: ([^\]]+)\]", line)
+        if default and name is not None:
+            out[name] = default.group(1)
     return out
 
 

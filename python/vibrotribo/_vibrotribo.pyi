@@ -279,3 +279,38 @@ def export_spice(
     check: bool = False,
 ) -> Dict[str, Any]:
     """The ngspice netlist of a run and its gap waveforms."""
+
+DEFAULT_START_PERIODS: Tuple[int, int]
+
+def basin_starts(
+    config: Any,
+    x: str,
+    x_values: List[float],
+    y: str,
+    y_values: List[float],
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = 1e-4,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = 2000,
+    threads: Optional[int] = None,
+) -> List[Tuple[int, float, Optional[float], List[float], List[int], Optional[str]]]:
+    """The fingerprints of a basin grid's starts (grid order), not classified."""
+
+def classify_basins(
+    config: Any,
+    x_values: List[float],
+    y_values: List[float],
+    fingerprints: List[Tuple[int, float, Optional[float], List[float], List[int], Optional[str]]],
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+) -> Dict[str, Any]:
+    """The tables of a basin grid from its starts' fingerprints."""

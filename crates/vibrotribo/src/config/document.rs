@@ -405,7 +405,8 @@ impl Config {
         let c = &self.chain;
         let o = &mut doc.oscillator;
         o.masses.get_or_insert_with(|| c.masses.clone());
-        o.stiffness.get_or_insert_with(|| PerMass::Many(c.stiffness.clone()));
+        o.stiffness
+            .get_or_insert_with(|| PerMass::Many(c.stiffness.clone()));
         o.damping.get_or_insert_with(|| PerMass::Many(c.damping.clone()));
         o.gaps.get_or_insert_with(|| PerMass::Many(c.gaps.clone()));
         o.restitution.get_or_insert(c.restitution);
