@@ -444,3 +444,18 @@ fn edit_distance(a: &str, b: &str) -> usize {
     }
     row[b.len()]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn similar_keys_find_a_transposition_and_a_key_without_its_section() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(similar_keys("excitation.amplitdue")[0], "excitation.amplitude");
+        assert!(similar_keys("omega_ratoi").contains(&"omega_ratio".to_string()));
+        assert!(similar_keys("masses").contains(&"oscillator.masses".to_string()));
+        assert!(similar_keys("completely_unrelated_words").is_empty());
+    }
+}
