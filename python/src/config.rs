@@ -8,7 +8,9 @@ use pyo3::exceptions::{PyFileNotFoundError, PyKeyError, PyOSError, PyTypeError, 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use toml::{Table, Value};
-use vibrotribo::config::{Config, ConfigError, DERIVED_KEYS, known_keys};
+use vibrotribo::config::{Config, ConfigError, DERIVED_KEYS, known_keys, similar_keys};
+
+use crate::convert::json_to_py;
 
 /// The exception for a configuration error: `KeyError` for an unknown key, `OSError` for an
 /// unreadable file, `ValueError` for anything else (a bad value, bad TOML). The message
@@ -22,12 +24,45 @@ pub fn config_error(e: ConfigError) -> PyErr {
     }
     let message = e.to_string();
     match innermost(&e) {
-        ConfigError::UnknownKey { .. } => PyKeyError::new_err(message),
+        ConfigError::UnknownKey { key, .. } => PyKeyError::new_err(unknown_key_message(key)),
         ConfigError::Io { path, .. } if !std::path::Path::new(path).exists() => {
             PyFileNotFoundError::new_err(message)
         }
         ConfigError::Io { .. } => PyOSError::new_err(message),
         _ => PyValueError::new_err(message),
+    }
+}
+
+/// "unknown parameter `key`", with the closest keys ("did you mean …?").
+pub fn unknown_key_message(key: &str) -> String {
+    let similar = similar_keys(key);
+    let hint = if similar.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; did you mean {}?",
+            similar
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(" or ")
+        )
+    };
+    format!("unknown parameter `{key}`{hint} (Config.keys() lists every key)")
+}
+
+/// `v` without its `null` entries (tables emptied by that dropped too).
+fn without_nulls(v: &serde_json::Value) -> Option<serde_json::Value> {
+    match v {
+        serde_json::Value::Null => None,
+        serde_json::Value::Object(o) => {
+            let kept: serde_json::Map<String, serde_json::Value> = o
+                .iter()
+                .filter_map(|(k, x)| without_nulls(x).map(|x| (k.clone(), x)))
+                .collect();
+            (!kept.is_empty()).then_some(serde_json::Value::Object(kept))
+        }
+        other => Some(other.clone()),
     }
 }
 
@@ -141,11 +176,18 @@ pub fn table_to_dict<'py>(py: Python<'py>, t: &Table) -> PyResult<Bound<'py, PyD
 /// (`excitation__omega_ratio=0.6`), or the key is passed as it is with `**{...}`. Overrides
 /// are applied in order and the whole is validated once. Units are SI (kg, m, s, N/m, Ω, F).
 ///
-/// An unknown key raises `KeyError`, a bad value `ValueError`, a missing file
-/// `FileNotFoundError`; each message names the key or the file. A `Config` is immutable:
-/// `replace(**overrides)` returns a changed copy.
-#[pyclass(module = "vibrotribo", name = "Config", frozen, eq)]
-#[derive(Clone, PartialEq)]
+/// An unknown key raises `KeyError` (with the closest keys: "did you mean …?"), a bad value
+/// `ValueError`, a missing file `FileNotFoundError`; each message names the key or the file.
+///
+/// A `Config` is an immutable, hashable, read-only mapping of its effective values:
+/// `cfg["excitation.amplitude"]` (the default where the file leaves a key out),
+/// `cfg["oscillator.gaps[1]"]`, derived keys (`cfg["mass_ratio"]`), None for an optional
+/// key left absent; its keys are `Config.keys()`; `to_dict()` the values nested like the
+/// file. Two configurations are equal when
+/// their effective values are. `with_(**changes)` (or `replace`) returns a changed copy,
+/// `without(*keys)` a copy with keys back at their defaults.
+#[pyclass(module = "vibrotribo", name = "Config", frozen)]
+#[derive(Clone)]
 pub struct PyConfig {
     /// The library's configuration.
     pub inner: Config,
@@ -187,6 +229,55 @@ impl PyConfig {
     }
 }
 
+impl PyConfig {
+    /// Whether `key` names a key of the schema (with or without an element) or a derived one.
+    fn known(&self, key: &str) -> bool {
+        let base = key.split('[').next().unwrap_or(key);
+        known_keys().iter().any(|k| k == base) || DERIVED_KEYS.iter().any(|(k, _)| *k == base)
+    }
+
+    /// The effective value of `key`: a key of the file, an element `name[i]`, or a derived
+    /// key (`mass_ratio` m₂/m₁, `mass_ratio_m2_fixed` the same, `gap_ratio` δ₂/δ₁, `gap`
+    /// the common gap if all are equal, `omega_ratio`, `frequency_hz`, `amplitude`,
+    /// `restitution`).
+    fn value(&self, key: &str) -> Option<serde_json::Value> {
+        use serde_json::json;
+        let chain = self.inner.chain();
+        let derived = match key {
+            "mass_ratio" | "mass_ratio_m2_fixed" if chain.masses.len() > 1 => {
+                Some(json!(chain.masses[1] / chain.masses[0]))
+            }
+            "gap_ratio" if chain.gaps.len() > 1 => Some(json!(chain.gaps[1] / chain.gaps[0])),
+            "gap" => chain
+                .gaps
+                .first()
+                .filter(|g| chain.gaps.iter().all(|x| x == *g))
+                .map(|g| json!(g)),
+            "omega_ratio" => Some(json!(chain.omega_ratio())),
+            "frequency_hz" => Some(json!(chain.omega() / std::f64::consts::TAU)),
+            "amplitude" => return self.value("excitation.amplitude"),
+            "restitution" => return self.value("oscillator.restitution"),
+            _ => None,
+        };
+        if derived.is_some() {
+            return derived;
+        }
+        let (base, index) = match key.split_once('[') {
+            Some((b, rest)) => (b, Some(rest.strip_suffix(']')?.parse::<usize>().ok()?)),
+            None => (key, None),
+        };
+        let mut v = self.inner.effective();
+        for part in base.split('.') {
+            v = v.get(part)?.clone();
+        }
+        let v = match index {
+            Some(i) => v.get(i)?.clone(),
+            None => v,
+        };
+        (!v.is_null()).then_some(v)
+    }
+}
+
 /// The configuration `obj` stands for (a `Config`, a dict, a path, or `None`: the defaults),
 /// to be run: refused, naming the reason, if its base motion cannot drive its chain
 /// (`Config::check_runnable`, as the command line refuses it).
@@ -222,10 +313,120 @@ impl PyConfig {
         })
     }
 
-    /// The settings as a dict shaped like the TOML file: what was read, with the overrides
-    /// applied (keys left out take their defaults). `Config(c.to_dict()) == c`.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// A copy with the keyword overrides applied (the same as `replace`).
+    #[pyo3(signature = (**changes))]
+    fn with_(&self, changes: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        self.replace(changes)
+    }
+
+    /// A copy with `keys` (`section.name`, or a whole `section`) removed from the settings:
+    /// back at their defaults. A key that is not set is refused (`KeyError`).
+    #[pyo3(signature = (*keys))]
+    fn without(&self, keys: Vec<String>) -> PyResult<Self> {
+        let mut table = self.inner.table().clone();
+        for key in &keys {
+            let key = key_of(key);
+            let parts: Vec<&str> = key.split('.').collect();
+            let (last, path) = parts
+                .split_last()
+                .ok_or_else(|| PyKeyError::new_err("empty key"))?;
+            let mut t = &mut table;
+            for p in path {
+                t = match t.get_mut(*p) {
+                    Some(Value::Table(inner)) => inner,
+                    _ => {
+                        return Err(PyKeyError::new_err(format!(
+                            "`{key}` is not set in this configuration"
+                        )));
+                    }
+                };
+            }
+            if t.remove(*last).is_none() {
+                let message = if self.known(&key) {
+                    format!("`{key}` is not set in this configuration (it has its default)")
+                } else {
+                    unknown_key_message(&key)
+                };
+                return Err(PyKeyError::new_err(message));
+            }
+        }
+        Ok(PyConfig {
+            inner: Config::from_table(table).map_err(config_error)?,
+        })
+    }
+
+    /// The effective settings as a dict shaped like the TOML file: every key with its value,
+    /// the defaults filled in (optional keys left absent are left out).
+    /// `Config(c.to_dict()) == c`.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let v = without_nulls(&self.inner.effective()).unwrap_or(serde_json::json!({}));
+        json_to_py(py, &v)
+    }
+
+    /// The settings as given: what was read and overridden, shaped like the TOML file (keys
+    /// left out are absent; they take their defaults).
+    fn settings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         table_to_dict(py, self.inner.table())
+    }
+
+    /// The effective value of `key` (a key of the file, an element `name[i]`, or a derived
+    /// key; None for an optional key left absent); `KeyError` with the closest keys for an
+    /// unknown one.
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        match self.value(key) {
+            Some(v) => json_to_py(py, &v),
+            None if key.contains('[') && self.known(key) => Err(PyKeyError::new_err(format!(
+                "`{key}`: no such element in this configuration (index out of range)"
+            ))),
+            None if self.known(key) => Ok(py.None().into_bound(py)),
+            None => Err(PyKeyError::new_err(unknown_key_message(key))),
+        }
+    }
+
+    /// The effective value of `key`, or `default` if it has none or is unknown.
+    #[pyo3(signature = (key, default = None))]
+    fn get<'py>(
+        &self,
+        py: Python<'py>,
+        key: &str,
+        default: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        match self.value(key) {
+            Some(v) => json_to_py(py, &v),
+            None => Ok(default.unwrap_or_else(|| py.None().into_bound(py))),
+        }
+    }
+
+    /// Whether `key` is a key of the configuration (of the file, an element of an array
+    /// key within its length, or derived).
+    fn __contains__(&self, key: &str) -> bool {
+        self.known(key) && (!key.contains('[') || self.value(key).is_some())
+    }
+
+    /// Every key, as `Config.keys()`: those of the file (`section.name`), then the derived
+    /// ones.
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        PyList::new(py, Self::keys())?
+            .into_any()
+            .try_iter()
+            .map(|i| i.into_any())
+    }
+
+    fn __len__(&self) -> usize {
+        Self::keys().len()
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<PyConfig>()
+            .is_ok_and(|o| o.get().inner.effective() == self.inner.effective())
+    }
+
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.inner.effective().to_string().hash(&mut h);
+        h.finish()
     }
 
     /// The settings as TOML text.

@@ -2,13 +2,15 @@
 //! Floquet multipliers, and their continuation in a configuration key
 //! ([`vibrotribo::orbits`]).
 
+use std::ops::ControlFlow;
+
 use numpy::{Complex64, PyArray1, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibrotribo::ChainState;
-use vibrotribo::branch::{BranchError, BranchOptions, continue_config};
+use vibrotribo::branch::{BranchError, BranchOptions, branch_powers, continue_config, orbit_power};
 use vibrotribo::config::Config;
 use vibrotribo::nalgebra::Complex;
 use vibrotribo::orbits::{
@@ -18,6 +20,7 @@ use vibrotribo::orbits::{
 
 use crate::config::{config_error, config_of};
 use crate::convert::{array1, array2};
+use crate::interrupt::Signals;
 
 create_exception!(
     vibrotribo,
@@ -106,7 +109,8 @@ fn state_of(guess: (Vec<f64>, Vec<f64>), n: usize) -> PyResult<ChainState> {
 
 /// Finds a periodic orbit (see the Python `vibrotribo.periodic`).
 #[pyfunction]
-#[pyo3(signature = (config, *, period = None, transient = 100, guess = None, tolerance = None, max_iterations = None))]
+#[pyo3(signature = (config, *, period = None, transient = 200, guess = None, tolerance = None, max_iterations = None, mechanics_only = false))]
+#[allow(clippy::too_many_arguments)]
 pub fn periodic<'py>(
     py: Python<'py>,
     config: &Bound<'py, PyAny>,
@@ -115,7 +119,11 @@ pub fn periodic<'py>(
     guess: Option<(Vec<f64>, Vec<f64>)>,
     tolerance: Option<f64>,
     max_iterations: Option<usize>,
+    mechanics_only: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if period == Some(0) {
+        return Err(PyValueError::new_err("period: must be at least 1"));
+    }
     let config = config_of(config)?;
     config.check_uncoupled("periodic").map_err(config_error)?;
     config.check_periodic("periodic orbits").map_err(config_error)?;
@@ -127,17 +135,39 @@ pub fn periodic<'py>(
             let period = period.ok_or_else(|| PyValueError::new_err("period: give it with a guess"))?;
             py.detach(|| find_periodic_orbit(&chain, &state, period, &options))
         }
+        // As the command line: no transient shoots from the configured initial state itself.
+        None if transient == 0 => {
+            let initial = config.initial_state().clone();
+            py.detach(|| find_periodic_orbit(&chain, &initial, period.unwrap_or(1), &options))
+        }
         None => {
             let initial = config.initial_state().clone();
             py.detach(|| periodic_orbit_from_transient(&chain, &initial, transient, period, &options))
         }
-    }
-    .map_err(orbit_error)?;
-    orbit_to_py(py, &orbit)
+    };
+    // A Ctrl-C during the search raises here, before any array is made.
+    py.check_signals()?;
+    let orbit = orbit.map_err(orbit_error)?;
+    let power = if mechanics_only {
+        None
+    } else {
+        py.detach(|| orbit_power(&config, &orbit))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?
+    };
+    let d = orbit_to_py(py, &orbit)?;
+    let p = power.as_ref().and_then(|p| p.power.as_ref());
+    d.set_item("average_power_w", p.map(|p| p.average_power_w))?;
+    d.set_item("energy_per_period_j", p.map(|p| p.energy_per_period_j))?;
+    Ok(d)
 }
 
 /// The points of a branch as arrays.
-fn points_to_py<'py>(py: Python<'py>, points: &[BranchPoint], n: usize) -> PyResult<Bound<'py, PyDict>> {
+fn points_to_py<'py>(
+    py: Python<'py>,
+    points: &[BranchPoint],
+    n: usize,
+    power: Option<&[f64]>,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let flat = |f: &dyn Fn(&BranchPoint) -> &[f64]| -> Vec<f64> {
         points.iter().flat_map(|p| f(p).to_vec()).collect()
@@ -180,6 +210,28 @@ fn points_to_py<'py>(py: Python<'py>, points: &[BranchPoint], n: usize) -> PyRes
         "spectral_radius",
         array1(py, points.iter().map(|p| p.spectral_radius()).collect()),
     )?;
+    // The smallest closing speed of an impact on the orbit (NaN without impacts), m/s, and
+    // its contact (1-based, 0 without impacts): branch.csv's min_closing_speed_m_s.
+    d.set_item(
+        "min_closing_speed_m_s",
+        array1(
+            py,
+            points
+                .iter()
+                .map(|p| p.min_closing_speed.map_or(f64::NAN, |m| m.1))
+                .collect(),
+        ),
+    )?;
+    let contacts: Vec<i64> = points
+        .iter()
+        .map(|p| p.min_closing_speed.map_or(0, |m| m.0 as i64 + 1))
+        .collect();
+    d.set_item("min_closing_contact", PyArray1::from_vec(py, contacts))?;
+    let power = match power {
+        Some(p) => p.to_vec(),
+        None => vec![f64::NAN; points.len()],
+    };
+    d.set_item("average_power_w", array1(py, power))?;
     Ok(d)
 }
 
@@ -259,11 +311,16 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
     Ok(d)
 }
 
-fn branch_to_py<'py>(py: Python<'py>, b: &Branch, n: usize) -> PyResult<Bound<'py, PyDict>> {
+fn branch_to_py<'py>(
+    py: Python<'py>,
+    b: &Branch,
+    n: usize,
+    power: Option<&[f64]>,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("period", b.period)?;
     d.set_item("parent", b.parent)?;
-    d.set_item("points", points_to_py(py, &b.points, n)?)?;
+    d.set_item("points", points_to_py(py, &b.points, n, power)?)?;
     let bifurcations = PyList::empty(py);
     for bif in &b.bifurcations {
         let e = PyDict::new(py);
@@ -290,7 +347,7 @@ fn branch_to_py<'py>(py: Python<'py>, b: &Branch, n: usize) -> PyResult<Bound<'p
 
 /// Continues a periodic orbit in a configuration key (see the Python `vibrotribo.continue_`).
 #[pyfunction]
-#[pyo3(signature = (config, param, start, stop, *, period = None, transient = None, guess = None, max_points = None, doubling_depth = None, initial_step = None, max_step = None))]
+#[pyo3(signature = (config, param, start, stop, *, period = None, transient = None, guess = None, max_points = None, doubling_depth = None, initial_step = None, max_step = None, mechanics_only = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn continue_<'py>(
     py: Python<'py>,
@@ -305,7 +362,16 @@ pub fn continue_<'py>(
     doubling_depth: Option<u32>,
     initial_step: Option<f64>,
     max_step: Option<f64>,
+    mechanics_only: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if period == Some(0) {
+        return Err(PyValueError::new_err("period: must be at least 1"));
+    }
+    if !(start.is_finite() && stop.is_finite()) || start == stop {
+        return Err(PyValueError::new_err(format!(
+            "start and stop must be finite and different (got {start} and {stop})"
+        )));
+    }
     let base = config_of(config)?;
     base.check_uncoupled("continue_").map_err(config_error)?;
     base.check_periodic("continuation of periodic orbits")
@@ -330,18 +396,39 @@ pub fn continue_<'py>(
         )),
         None => None,
     };
-    let c = py
-        .detach(|| continue_config(&base, &param, start, stop, guess, &options))
-        .map_err(|e| match e {
-            BranchError::Value { source, .. } => config_error(source),
-            BranchError::FirstOrbit { source, .. } | BranchError::Continuation(source) => orbit_error(source),
-            other => PyRuntimeError::new_err(other.to_string()),
-        })?;
+    let c = py.detach(|| continue_config(&base, &param, start, stop, guess, &options));
+    // The continuation has no checkpoint of its own: a Ctrl-C during it raises here, when it
+    // returns, before any array is made.
+    py.check_signals()?;
+    let c = c.map_err(|e| match e {
+        BranchError::Value { source, .. } => config_error(source),
+        BranchError::FirstOrbit { source, .. } | BranchError::Continuation(source) => orbit_error(source),
+        other => PyRuntimeError::new_err(other.to_string()),
+    })?;
+    let powers = if mechanics_only {
+        None
+    } else {
+        // The power along the branches, point by point, with a Ctrl-C checkpoint after each.
+        let (powers, signals) = py.detach(|| {
+            let mut signals = Signals::new();
+            let p = branch_powers(&base, &param, &c, || {
+                if signals.check_now_and_then() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            });
+            (p, signals)
+        });
+        signals.result()?;
+        Some(powers)
+    };
     let out = PyDict::new(py);
     out.set_item("parameter", &c.parameter)?;
     let branches = PyList::empty(py);
-    for b in &c.branches {
-        branches.append(branch_to_py(py, b, n)?)?;
+    for (j, b) in c.branches.iter().enumerate() {
+        let power = powers.as_ref().map(|p| p[j].as_slice());
+        branches.append(branch_to_py(py, b, n, power)?)?;
     }
     out.set_item("branches", branches)?;
     Ok(out)

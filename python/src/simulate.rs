@@ -10,43 +10,91 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibrotribo::electrical::LoadKind;
 use vibrotribo::report::{failure_text, motion_json, run_summary};
-use vibrotribo::study::{Ending, Recording, RunMotion, simulate as run};
+use vibrotribo::study::{
+    DEFAULT_SETTLE_CAP, Ending, Recording, RunMotion, SettleMode, limits, settle as settle_run,
+    simulate as run,
+};
 
-use crate::config::config_of;
+use crate::config::{config_error, config_of};
 use crate::convert::{array1, array2, json_to_py};
 use crate::interrupt::Signals;
+use crate::limits::check_memory;
 
 /// Runs the configuration (see the Python `vibrotribo.simulate`) and returns a dict of
 /// arrays, the events and the summary.
 #[pyfunction]
-#[pyo3(signature = (config, *, mechanics_only = false, samples = true))]
+#[pyo3(signature = (config, *, mechanics_only = false, samples = true, settle = String::from("fixed"), settle_cap = DEFAULT_SETTLE_CAP, allow_large = false))]
 pub fn simulate<'py>(
     py: Python<'py>,
     config: &Bound<'py, PyAny>,
     mechanics_only: bool,
     samples: bool,
+    settle: String,
+    settle_cap: u64,
+    allow_large: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config_of(config)?;
     let mut spec = config.sampled_run_spec(mechanics_only);
     spec.breakdown_check = true;
+    let spp = config.run().samples_per_period;
+    check_memory(
+        &if samples {
+            format!(
+                "run.periods = {} with run.samples_per_period = {spp} held in memory (samples=False keeps none)",
+                spec.periods
+            )
+        } else {
+            format!("run.periods = {} (per-period statistics)", spec.periods)
+        },
+        limits::run_memory_bytes(&spec, spp, samples),
+        allow_large,
+    )?;
+    let mode: SettleMode = settle
+        .parse()
+        .map_err(|e: vibrotribo::study::UnknownSettleMode| PyValueError::new_err(format!("settle: {e}")))?;
+    let mode = mode.with_cap(settle_cap);
     let mut motion = RunMotion::new(&spec).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if let SettleMode::Auto(_) = &mode {
+        config
+            .check_periodic("simulate(settle=\"auto\") (settling to a periodic motion)")
+            .map_err(config_error)?;
+        if settle_cap == 0 {
+            return Err(PyValueError::new_err("settle_cap: must be at least 1"));
+        }
+    }
+    motion.options_mut().settle = mode;
+    let periodic = config.is_periodic();
     let (outcome, recording, elapsed, signals, report) = py.detach(|| {
         let mut recording = Recording::new(samples);
         let mut signals = Signals::new();
         let started = Instant::now();
+        let settled = match &mode {
+            SettleMode::Auto(auto) => {
+                match settle_run(&spec.chain, &spec.initial, &spec.options, motion.options(), auto) {
+                    Ok(s) => {
+                        spec.initial = s.state.clone();
+                        Some(s)
+                    }
+                    Err(e) => return Err(PyValueError::new_err(format!("while settling: {e}"))),
+                }
+            }
+            SettleMode::Fixed => None,
+        };
         let outcome = run(&spec, &mut (&mut recording, (&mut signals, motion.observer())));
-        // The motion after the transient, as the command line's summary.json reports it.
+        // The motion after the transient, as the command line's summary.json reports it (a
+        // base motion that is not periodic has no period to classify against).
         let report = outcome.as_ref().ok().and_then(|o| {
-            (o.ending == Ending::Completed).then(|| motion.finish(&spec, &o.final_state, None))
+            (o.ending == Ending::Completed && periodic)
+                .then(|| motion.finish(&spec, &o.final_state, settled.as_ref()))
         });
-        (
+        Ok((
             outcome,
             recording,
             started.elapsed().as_secs_f64(),
             signals,
             report,
-        )
-    });
+        ))
+    })?;
     signals.result()?;
     let outcome = outcome.map_err(|e| PyValueError::new_err(e.to_string()))?;
     let n = spec.chain.len();
@@ -81,7 +129,10 @@ pub fn simulate<'py>(
     events.set_item("v", array2(py, e.velocities, n)?)?;
     out.set_item("events", events)?;
     let mut summary = run_summary(&config, &spec, &outcome, elapsed);
-    summary["settle"] = "fixed".into();
+    summary["settle"] = settle.as_str().into();
+    if let SettleMode::Auto(a) = &motion.options().settle {
+        summary["settle_cap_periods"] = a.cap_periods.into();
+    }
     summary["motion"] = motion_json(report.as_ref());
     out.set_item("summary", json_to_py(py, &summary)?)?;
     out.set_item("error", failure_text(&outcome))?;

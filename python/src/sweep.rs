@@ -8,15 +8,20 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use vibrotribo::config::Config;
-use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, SettleMode};
+use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, PointResult, SettleMode};
 use vibrotribo::sweep::{
     Continuation, Delivery, PointColumns, PointRequest, PointRequestError, PointRunner, SweepColumns,
-    run_continued, run_grid_on,
+    SweepError, run_continued, run_grid_on,
 };
+
+use vibrotribo::attractors::initial_condition_index;
+use vibrotribo::lyapunov::LyapunovOptions;
+use vibrotribo::study::limits;
 
 use crate::config::{config_error, config_of, table_to_dict};
 use crate::convert::table_to_py;
 use crate::interrupt::Signals;
+use crate::limits::{check_grid, check_memory};
 
 /// Settings shared by sweeps and maps.
 pub struct PointSettings {
@@ -29,11 +34,26 @@ pub struct PointSettings {
     pub settle: String,
     /// Most periods `"auto"` settles (`--settle-cap`).
     pub settle_cap: u64,
+    /// Whether each point's orbit is shot for its largest Floquet multiplier (`--floquet`).
+    pub floquet: bool,
+    /// Whether each point's largest Lyapunov exponent is estimated (`sweep --lyapunov`).
+    pub lyapunov: bool,
+    /// Whether sizes above the limits are allowed (`--allow-large`).
+    pub allow_large: bool,
 }
 
 impl PointSettings {
-    /// The point runner on `base`, the options checked by the library ([`PointRequest`]).
-    fn runner(&self, base: Config) -> PyResult<PointRunner> {
+    /// The point runner on `base`, the options checked by the library ([`PointRequest`]),
+    /// with `(transient, recorded)` periods by default from its `[run]` table.
+    pub fn runner(&self, base: Config) -> PyResult<PointRunner> {
+        let run = base.run();
+        let defaults = (run.transient(), run.periods - run.transient());
+        self.runner_or(base, defaults)
+    }
+
+    /// The point runner on `base` with `(transient, recorded)` periods where the settings do
+    /// not give them.
+    pub fn runner_or(&self, base: Config, defaults: (u64, u64)) -> PyResult<PointRunner> {
         let settle: SettleMode = self
             .settle
             .parse()
@@ -42,18 +62,42 @@ impl PointSettings {
             transient: self.transient,
             recorded: self.recorded,
             period_tolerance: self.period_tolerance,
-            floquet: false,
+            floquet: self.floquet,
             settle: settle.with_cap(self.settle_cap),
         };
-        let options = request.options_of_run(&base).map_err(|e| match e {
+        let mut options = request.options(&base, defaults).map_err(|e| match e {
             PointRequestError::Config(e) => config_error(e),
             e => PyValueError::new_err(e.to_string()),
         })?;
+        if self.lyapunov {
+            base.check_periodic("lyapunov (Lyapunov exponents)")
+                .map_err(config_error)?;
+            options.lyapunov = Some(LyapunovOptions::default());
+        }
+        check_memory(
+            "one point (transient + recorded periods) on each thread",
+            limits::point_memory_bytes(&options, base.chain().len()) * 4.0 * self.threads_f64(),
+            self.allow_large,
+        )?;
         Ok(PointRunner::new(base, options, self.mechanics_only))
     }
 
+    fn threads_f64(&self) -> f64 {
+        self.threads
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from)) as f64
+    }
+
+    /// The columns of a point's row under these settings.
+    pub fn columns(&self, runner: &PointRunner) -> PointColumns {
+        PointColumns {
+            contacts: runner.contacts(),
+            floquet: self.floquet,
+            lyapunov: self.lyapunov,
+        }
+    }
+
     /// A thread pool of `threads` threads (all cores by default).
-    fn pool(&self) -> PyResult<rayon::ThreadPool> {
+    pub fn pool(&self) -> PyResult<rayon::ThreadPool> {
         if self.threads == Some(0) {
             return Err(PyValueError::new_err("threads must be at least 1"));
         }
@@ -65,7 +109,7 @@ impl PointSettings {
 }
 
 /// Checks that every point's configuration is valid, naming the first bad one.
-fn check_points(runner: &PointRunner, points: &[Vec<(&str, f64)>]) -> PyResult<()> {
+pub fn check_points(runner: &PointRunner, points: &[Vec<(&str, f64)>]) -> PyResult<()> {
     for keys in points {
         runner.configure(keys).map_err(config_error)?;
     }
@@ -73,7 +117,7 @@ fn check_points(runner: &PointRunner, points: &[Vec<(&str, f64)>]) -> PyResult<(
 }
 
 /// The settings of a sweep or a map as a dict (what `sweep.json`/`map.json` record).
-fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'py, PyDict>> {
+pub fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'py, PyDict>> {
     let o = runner.options();
     let d = PyDict::new(py);
     d.set_item("transient_periods", o.transient_periods)?;
@@ -93,13 +137,13 @@ fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'py, P
     Ok(d)
 }
 
-/// Runs `points` on the pool, collecting them into `table` in grid order; stops at a chunk's
-/// end if a signal handler raised.
-fn run_points(
+/// Runs `points` on the pool, handing each point's keys and result to `each` in grid order;
+/// stops at a chunk's end if a signal handler raised.
+pub fn run_grid(
     pool: &rayon::ThreadPool,
     runner: &PointRunner,
     points: &[Vec<(&str, f64)>],
-    table: &mut SweepColumns,
+    mut each: impl FnMut(&[(&str, f64)], &Result<PointResult, SweepError>),
 ) -> PyResult<()> {
     let mut signals = Signals::new();
     let chunk = pool.current_num_threads() * 4;
@@ -111,8 +155,7 @@ fn run_points(
         chunk,
         |d| match d {
             Delivery::Point(keys, r) => {
-                let values: Vec<f64> = keys.iter().map(|&(_, v)| v).collect();
-                table.push(&values, &r);
+                each(keys, &r);
                 ControlFlow::Continue(())
             }
             Delivery::Chunk(_) => {
@@ -127,9 +170,22 @@ fn run_points(
     signals.result()
 }
 
+/// Runs `points` on the pool, collecting them into `table` in grid order.
+fn run_points(
+    pool: &rayon::ThreadPool,
+    runner: &PointRunner,
+    points: &[Vec<(&str, f64)>],
+    table: &mut SweepColumns,
+) -> PyResult<()> {
+    run_grid(pool, runner, points, |keys, r| {
+        let values: Vec<f64> = keys.iter().map(|&(_, v)| v).collect();
+        table.push(&values, r);
+    })
+}
+
 /// Runs a one-parameter sweep (see the Python `vibrotribo.sweep`).
 #[pyfunction]
-#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = DEFAULT_PERIOD_TOLERANCE, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP))]
+#[pyo3(signature = (config, param, values, *, continuation = String::from("none"), transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = DEFAULT_PERIOD_TOLERANCE, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP, floquet = false, lyapunov = false, allow_large = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep<'py>(
     py: Python<'py>,
@@ -144,8 +200,12 @@ pub fn sweep<'py>(
     period_tolerance: f64,
     settle: String,
     settle_cap: u64,
+    floquet: bool,
+    lyapunov: bool,
+    allow_large: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let continuation: Continuation = continuation.parse().map_err(PyValueError::new_err)?;
+    check_grid("values", values.len() as f64)?;
     let settings_of = PointSettings {
         transient,
         recorded,
@@ -154,6 +214,9 @@ pub fn sweep<'py>(
         period_tolerance,
         settle,
         settle_cap,
+        floquet,
+        lyapunov,
+        allow_large,
     };
     let base = config_of(config)?;
     if continuation != Continuation::None {
@@ -164,7 +227,7 @@ pub fn sweep<'py>(
     let runner = settings_of.runner(base)?;
     let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
     check_points(&runner, &points)?;
-    let columns = PointColumns::of_contacts(runner.contacts());
+    let columns = settings_of.columns(&runner);
     let mut table = SweepColumns::new(&["param"], runner.masses(), columns, true);
     match continuation {
         Continuation::None => {
@@ -200,13 +263,15 @@ pub fn sweep<'py>(
     s.set_item("param", param)?;
     s.set_item("values", values)?;
     s.set_item("continuation", continuation.as_str())?;
+    s.set_item("floquet", floquet)?;
+    s.set_item("lyapunov", lyapunov)?;
     out.set_item("settings", s)?;
     Ok(out)
 }
 
 /// Runs a two-parameter map (see the Python `vibrotribo.map`).
 #[pyfunction]
-#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = DEFAULT_PERIOD_TOLERANCE, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP))]
+#[pyo3(signature = (config, x, x_values, y, y_values, *, transient = None, recorded = None, mechanics_only = false, threads = None, period_tolerance = DEFAULT_PERIOD_TOLERANCE, settle = String::from("auto"), settle_cap = DEFAULT_SETTLE_CAP, floquet = false, allow_large = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn map<'py>(
     py: Python<'py>,
@@ -222,7 +287,13 @@ pub fn map<'py>(
     period_tolerance: f64,
     settle: String,
     settle_cap: u64,
+    floquet: bool,
+    allow_large: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    check_grid(
+        "x_values × y_values",
+        x_values.len() as f64 * y_values.len() as f64,
+    )?;
     let settings_of = PointSettings {
         transient,
         recorded,
@@ -231,6 +302,9 @@ pub fn map<'py>(
         period_tolerance,
         settle,
         settle_cap,
+        floquet,
+        lyapunov: false,
+        allow_large,
     };
     let runner = settings_of.runner(config_of(config)?)?;
     // Grid order as map.csv: y outer, x inner.
@@ -239,8 +313,18 @@ pub fn map<'py>(
         .iter()
         .flat_map(|&yv| x_values.iter().map(move |&xv| vec![(xk, xv), (yk, yv)]))
         .collect();
-    check_points(&runner, &points)?;
-    let columns = PointColumns::of_contacts(runner.contacts());
+    // An initial-condition axis is checked for its index only: a start whose masses
+    // interpenetrate is a row with its error (as `basins` skips it), not a failed map.
+    let initial = |k: &str| k.starts_with("run.initial_");
+    for k in [xk, yk].into_iter().filter(|k| initial(k)) {
+        initial_condition_index(k, runner.masses()).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    }
+    let others: Vec<Vec<(&str, f64)>> = points
+        .iter()
+        .map(|p| p.iter().copied().filter(|(k, _)| !initial(k)).collect())
+        .collect();
+    check_points(&runner, &others)?;
+    let columns = settings_of.columns(&runner);
     let mut table = SweepColumns::new(&["x", "y"], runner.masses(), columns, false);
     let pool = settings_of.pool()?;
     py.detach(|| run_points(&pool, &runner, &points, &mut table))?;
@@ -252,6 +336,7 @@ pub fn map<'py>(
     s.set_item("x_values", x_values)?;
     s.set_item("y", y)?;
     s.set_item("y_values", y_values)?;
+    s.set_item("floquet", floquet)?;
     out.set_item("settings", s)?;
     Ok(out)
 }

@@ -60,3 +60,25 @@ def assert_bits(got: np.ndarray, expected: np.ndarray, what: str) -> None:
 
 def read_json(path: Path):
     return json.loads(Path(path).read_text())
+
+
+def compare_tables(result_tables, directory, files):
+    """Each table equals its CSV file: the same columns, text and flags equal, integers equal
+    (an empty cell is -1), floats bit for bit (an empty cell is NaN)."""
+    for table, file in zip(result_tables, files):
+        header, cols = read_csv(directory / file)
+        assert table.columns == header, f"{file}: {table.columns} != {header}"
+        for name in header:
+            got = table[name]
+            cells = cols[name]
+            if got.dtype == np.bool_:
+                assert list(got) == [c == "true" for c in cells], f"{file} {name}"
+            elif got.dtype.kind == "U":
+                assert list(got) == cells, f"{file} {name}"
+            elif got.dtype == np.int64:
+                # Failed points leave the file's cell empty; the table holds -1.
+                expected = [int(c) if c != "" else -1 for c in cells]
+                assert got.tolist() == expected, f"{file} {name}"
+            else:
+                assert got.dtype == np.float64
+                assert_bits(got, numbers(cells), f"{file} {name}")

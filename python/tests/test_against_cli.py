@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import vibrotribo as vt
-from conftest import CONFIGS, assert_bits, numbers, read_csv, read_json, run_cli
+from conftest import CONFIGS, assert_bits, compare_tables, numbers, read_csv, read_json, run_cli
 
 # (name, command-line arguments, the same configuration for Python)
 RUNS = [
@@ -98,26 +98,6 @@ def test_simulate_equals_the_files(cli, tmp_path, name, args, config):
 
     same_json(without_wall_time(r.summary), without_wall_time(read_json(tmp_path / "summary.json")))
     assert isinstance(r.summary["wall_time_s"], float)
-
-
-def compare_tables(result_tables, directory, files):
-    for table, file in zip(result_tables, files):
-        header, cols = read_csv(directory / file)
-        assert table.columns == header, f"{file}: {table.columns} != {header}"
-        for name in header:
-            got = table[name]
-            cells = cols[name]
-            if got.dtype == np.bool_:
-                assert list(got) == [c == "true" for c in cells], f"{file} {name}"
-            elif got.dtype.kind == "U":
-                assert list(got) == cells, f"{file} {name}"
-            elif got.dtype == np.int64:
-                # Failed points leave the file's cell empty; the table holds -1.
-                expected = [int(c) if c != "" else -1 for c in cells]
-                assert got.tolist() == expected, f"{file} {name}"
-            else:
-                assert got.dtype == np.float64
-                assert_bits(got, numbers(cells), f"{file} {name}")
 
 
 SWEEPS = [

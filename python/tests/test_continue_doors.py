@@ -43,6 +43,9 @@ def test_python_and_cli_continue_give_the_same_branch(cli, tmp_path):
         sticks = np.array([s == "true" for s in np.array(cols["sticks"])[rows]])
         assert (np.asarray(pts["sticks"], dtype=bool) == sticks).all(), f"{what}: sticking differs"
         assert b.period == int(numbers(cols["period"])[rows][0]), f"{what}: period differs"
+        # The harvester along the branch and the smallest closing speed, as branch.csv.
+        assert_bits(pts["average_power_w"], numbers(cols["average_power_w"])[rows], f"{what} power")
+        assert_bits(pts["min_closing_speed_m_s"], numbers(cols["min_closing_speed_m_s"])[rows], f"{what} closing")
     _, bif = read_csv(out / "bifurcations.csv")
     got = [(b["branch"], b["parameter"]) for b in c.bifurcations]
     expected = list(zip(numbers(bif["branch"]).astype(int).tolist(), numbers(bif["param"]).tolist()))

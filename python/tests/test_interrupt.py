@@ -20,7 +20,7 @@ CHILD = textwrap.dedent(
     config = vt.Config(run__periods=10**8)  # about an hour of work
     print("start", flush=True)
     try:
-        vt.simulate(config, samples=False)
+        vt.simulate(config, samples=False, allow_large=True)  # interrupted long before it grows
     except KeyboardInterrupt:
         print("interrupted", time.monotonic(), flush=True)
         sys.exit(0)

@@ -28,8 +28,11 @@ checkpoint (a period of a run, a chunk of sweep points) and raises KeyboardInter
 
 from __future__ import annotations
 
+import collections.abc
+import hashlib
 import os
-from typing import Any, Iterable, Mapping, Optional, Union
+import tempfile
+from typing import Any, Iterable, Literal, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -47,7 +50,11 @@ from ._results import (
     Sweep,
     Table,
 )
+from ._studies import Attractors, Basins, Chirp, MassRatioOptimum, SpiceExport
 from ._vibrotribo import Config, OrbitNotFound, __version__, grid, log_spaced
+
+# A Config is a read-only mapping of its effective values (cfg["excitation.amplitude"]).
+collections.abc.Mapping.register(Config)
 
 __all__ = [
     "Config",
@@ -59,6 +66,17 @@ __all__ = [
     "continue_",
     "lyapunov",
     "Lyapunov",
+    "chirp",
+    "Chirp",
+    "basins",
+    "Basins",
+    "attractors",
+    "Attractors",
+    "optimize_mass_ratio",
+    "MassRatioOptimum",
+    "export_spice",
+    "SpiceExport",
+    "with_base_motion",
     "grid",
     "log_spaced",
     "Simulation",
@@ -76,6 +94,22 @@ __all__ = [
 ]
 
 ConfigLike = Union[Config, Mapping[str, Any], str, "os.PathLike[str]", None]
+SettleMode = Literal["auto", "fixed"]
+ContinuationMode = Literal["none", "up", "down"]
+ChirpSweep = Literal["linear", "logarithmic"]
+Quantity = Literal["displacement", "acceleration"]
+
+
+def _count(value: Optional[int], name: str, *, least: int = 0) -> Optional[int]:
+    """``value`` as a whole number of at least ``least`` (None stays None), or a ValueError
+    naming the argument."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be a whole number, got {value!r}")
+    if value < least:
+        raise ValueError(f"{name} must be at least {least}, got {value}")
+    return int(value)
 
 
 def _config(config: ConfigLike) -> Config:
@@ -91,7 +125,15 @@ def _values(values: Iterable[float], name: str) -> list:
     return a.tolist()
 
 
-def simulate(config: ConfigLike = None, *, mechanics_only: bool = False, samples: bool = True) -> Simulation:
+def simulate(
+    config: ConfigLike = None,
+    *,
+    mechanics_only: bool = False,
+    samples: bool = True,
+    settle: SettleMode = "fixed",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    allow_large: bool = False,
+) -> Simulation:
     """Simulates the configuration: ``run.periods`` excitation periods from
     ``run.initial_positions``/``run.initial_velocities``, the harvester's charge solved
     alongside (unless ``mechanics_only``), sampled ``run.samples_per_period`` times per
@@ -102,9 +144,23 @@ def simulate(config: ConfigLike = None, *, mechanics_only: bool = False, samples
     equal what ``vibrotribo simulate --out DIR`` writes. Raises :class:`SimulationError`
     if the run fails on the way (its ``result`` holds the periods before),
     ``KeyboardInterrupt`` on Ctrl-C, ``ValueError``/``KeyError`` on bad input.
+
+    ``settle``: ``"fixed"`` runs the configuration as it is; ``"auto"`` first settles (at
+    most ``settle_cap`` periods, mechanics only, as a sweep point settles) and then runs the
+    configuration from the settled state (``summary["motion"]["settle_periods"]`` says how
+    many periods came before), as ``--settle``/``--settle-cap``. A run whose samples and
+    per-period statistics would need more than 4 GiB is refused with ``MemoryError`` before
+    anything is allocated (``allow_large=True`` runs it; ``samples=False`` keeps no samples).
     """
     cfg = _config(config)
-    raw = _vibrotribo.simulate(cfg, mechanics_only=mechanics_only, samples=samples)
+    raw = _vibrotribo.simulate(
+        cfg,
+        mechanics_only=mechanics_only,
+        samples=samples,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap", least=1),
+        allow_large=allow_large,
+    )
     result = Simulation._from(raw, cfg)
     if raw["error"] is not None:
         raise SimulationError(raw["error"], result)
@@ -116,14 +172,17 @@ def sweep(
     param: str,
     values: Iterable[float],
     *,
-    continuation: str = "none",
+    continuation: ContinuationMode = "none",
     transient: Optional[int] = None,
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
-    settle: str = "auto",
+    settle: SettleMode = "auto",
     settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    floquet: bool = False,
+    lyapunov: bool = False,
+    allow_large: bool = False,
 ) -> Sweep:
     """A one-parameter sweep: the configuration with ``param`` set to each of ``values``,
     simulated for ``transient`` periods (default ``run.transient_periods``) and then
@@ -143,20 +202,28 @@ def sweep(
     motion repeats, at most ``settle_cap`` periods, then ``recorded`` periods; see the
     README's "How a point is classified") or ``"fixed"`` (exactly ``transient`` periods
     first), as ``--settle``/``--settle-cap``; the summary's ``motion`` column says whether a
-    point is ``periodic``, ``settling``, ``quasiperiodic`` or ``chaotic``.
+    point is ``periodic``, ``settling``, ``quasiperiodic`` or ``chaotic``. ``floquet``:
+    also shoot each point's orbit for its largest Floquet multiplier modulus (column
+    ``max_abs_multiplier``); ``lyapunov``: also estimate each point's largest Lyapunov
+    exponent (columns ``lyapunov_max_1_s``, ``lyapunov_spread_1_s``), as
+    ``--floquet``/``--lyapunov``. More than 10⁷ values raise ``ValueError``, an estimated
+    memory above 4 GiB ``MemoryError`` (``allow_large=True`` runs it).
     """
     raw = _vibrotribo.sweep(
         _config(config),
         param,
         _values(values, "values"),
         continuation=continuation,
-        transient=transient,
-        recorded=recorded,
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
         mechanics_only=mechanics_only,
-        threads=threads,
+        threads=_count(threads, "threads", least=1),
         period_tolerance=period_tolerance,
         settle=settle,
-        settle_cap=settle_cap,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        floquet=floquet,
+        lyapunov=lyapunov,
+        allow_large=allow_large,
     )
     return Sweep._from(raw)
 
@@ -173,24 +240,31 @@ def map(  # noqa: A001 - the command's name
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
-    settle: str = "auto",
+    settle: SettleMode = "auto",
     settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    floquet: bool = False,
+    allow_large: bool = False,
 ) -> Map:
     """A two-parameter map: every point (x, y) of the grid (y outer, x inner), each run as a
-    sweep point (see :func:`sweep`); its ``summary`` is ``vibrotribo map``'s ``map.csv``."""
+    sweep point (see :func:`sweep`); its ``summary`` is ``vibrotribo map``'s ``map.csv``.
+    When an axis is an initial condition (``run.initial_positions[i]``,
+    ``run.initial_velocities[i]``), a start whose masses interpenetrate is a row with its
+    ``error`` (as ``vibrotribo basins`` skips it) instead of failing the map."""
     raw = _vibrotribo.map(
         _config(config),
         x,
         _values(x_values, "x_values"),
         y,
         _values(y_values, "y_values"),
-        transient=transient,
-        recorded=recorded,
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
         mechanics_only=mechanics_only,
-        threads=threads,
+        threads=_count(threads, "threads", least=1),
         period_tolerance=period_tolerance,
         settle=settle,
-        settle_cap=settle_cap,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        floquet=floquet,
+        allow_large=allow_large,
     )
     return Map._from(raw)
 
@@ -217,8 +291,8 @@ def load_sweep(
         resistances=None if resistances is None else _values(resistances, "resistances"),
         low=low,
         high=high,
-        steps=steps,
-        vq_points=vq_points,
+        steps=_count(steps, "steps", least=1),
+        vq_points=_count(vq_points, "vq_points"),
     )
     return LoadSweep._from(raw)
 
@@ -227,10 +301,11 @@ def periodic(
     config: ConfigLike = None,
     *,
     period: Optional[int] = None,
-    transient: int = 100,
+    transient: int = 200,
     guess: Optional[tuple] = None,
     tolerance: Optional[float] = None,
     max_iterations: Optional[int] = None,
+    mechanics_only: bool = False,
 ) -> Orbit:
     """A periodic orbit of the configuration's chain by Newton shooting on the stroboscopic
     map, and its Floquet multipliers (stable and unstable orbits alike).
@@ -239,18 +314,22 @@ def periodic(
     starts Newton there, with ``period`` (in excitation periods) or, if None, the period read
     off 128 further stroboscopic samples. With ``guess=(x, v)`` (positions in m, velocities in
     m/s at t = 0) Newton starts from it (``period`` needed). ``tolerance``: scaled residual
-    (default 1e-12). Raises :class:`OrbitNotFound` if Newton does not converge or the motion
-    is not periodic.
+    (default 1e-12). ``transient=0`` shoots from the configured initial state itself (period
+    default 1), as ``vibrotribo periodic --transient 0``. Unless ``mechanics_only``, the
+    harvester is run along the orbit: ``Orbit.average_power_w``, as ``vibrotribo periodic``
+    reports it. Raises :class:`OrbitNotFound` if Newton does not converge or the motion is
+    not periodic.
     """
     raw = _vibrotribo.periodic(
         _config(config),
-        period=period,
-        transient=transient,
+        period=_count(period, "period", least=1),
+        transient=_count(transient, "transient"),
         guess=None if guess is None else (list(_floats(guess[0])), list(_floats(guess[1]))),
         tolerance=tolerance,
-        max_iterations=max_iterations,
+        max_iterations=_count(max_iterations, "max_iterations", least=1),
+        mechanics_only=mechanics_only,
     )
-    return Orbit(**raw)
+    return Orbit._from(raw)
 
 
 def continue_(
@@ -266,6 +345,7 @@ def continue_(
     doubling_depth: Optional[int] = None,
     initial_step: Optional[float] = None,
     max_step: Optional[float] = None,
+    mechanics_only: bool = False,
 ) -> Continuation:
     """Follows the periodic orbit found at ``param = start`` (after ``transient`` periods
     from the configured initial state, default 200, as ``vibrotribo continue`` finds it; or
@@ -273,21 +353,25 @@ def continue_(
     (following the doubled branches to ``doubling_depth`` levels, default 3),
     Neimark–Sacker points, grazings and sticking onsets. ``param`` is any numeric
     configuration key or derived key. Steps are in scaled arclength (defaults: initial 0.02,
-    largest 0.1); ``max_points`` per branch (default 2000). Interrupting takes effect only
-    when it returns.
+    largest 0.1); ``max_points`` per branch (default 2000). Unless ``mechanics_only``, the
+    harvester's average power on every point is computed (``Branch.points["average_power_w"]``,
+    as ``vibrotribo continue`` writes it in ``branch.csv``). Ctrl-C raises
+    ``KeyboardInterrupt``: during the power, at the next point; during the continuation
+    itself (which has no checkpoint), when it returns.
     """
     raw = _vibrotribo.continue_(
         _config(config),
         param,
         float(start),
         float(stop),
-        period=period,
-        transient=transient,
+        period=_count(period, "period", least=1),
+        transient=_count(transient, "transient"),
         guess=None if guess is None else (list(_floats(guess[0])), list(_floats(guess[1]))),
-        max_points=max_points,
-        doubling_depth=doubling_depth,
+        max_points=_count(max_points, "max_points", least=1),
+        doubling_depth=_count(doubling_depth, "doubling_depth"),
         initial_step=initial_step,
         max_step=max_step,
+        mechanics_only=mechanics_only,
     )
     return Continuation._from(raw)
 
@@ -308,10 +392,281 @@ def lyapunov(
     ``KeyboardInterrupt`` within a second.
     """
     raw = _vibrotribo.lyapunov(
-        _config(config), periods=int(periods), transient=int(transient), seed=int(seed), batches=int(batches)
+        _config(config),
+        periods=_count(periods, "periods", least=1),
+        transient=_count(transient, "transient"),
+        seed=_count(seed, "seed"),
+        batches=_count(batches, "batches", least=1),
     )
     return Lyapunov(**raw)
 
+
+
+def chirp(
+    config: ConfigLike,
+    from_: float,
+    to: float,
+    duration: float,
+    *,
+    sweep: ChirpSweep = "linear",
+    amplitude: Optional[float] = None,
+    mechanics_only: bool = False,
+    from_rest: bool = False,
+    samples_per_cycle: int = 200,
+    jump_window: int = 5,
+) -> Chirp:
+    """The frequency-sweep experiment of ``vibrotribo chirp``: the base driven by a slow
+    chirp in Ω from ``from_`` to ``to`` over ``duration`` seconds, then back down; the
+    response per cycle (amplitudes, impacts, power), the largest jump each way and the
+    hysteresis between them (:class:`Chirp`). ``sweep``: ``"linear"`` or ``"logarithmic"``
+    in frequency; ``amplitude`` the base amplitude, m (default ``excitation.amplitude``);
+    each chirp starts from the steady motion at its start frequency unless ``from_rest``.
+    ``samples_per_cycle`` samples per cycle at the highest frequency; the jump compares the
+    median amplitudes of ``jump_window`` cycles on each side of a boundary. Raises
+    :class:`SimulationError` (with the result) if a chirp fails on the way."""
+    raw = _vibrotribo.chirp(
+        _config(config),
+        float(from_),
+        float(to),
+        float(duration),
+        sweep=sweep,
+        amplitude=amplitude,
+        mechanics_only=mechanics_only,
+        from_rest=from_rest,
+        samples_per_cycle=_count(samples_per_cycle, "samples_per_cycle", least=1),
+        jump_window=_count(jump_window, "jump_window", least=1),
+    )
+    result = Chirp._from(raw)
+    for name in ("up", "down"):
+        run = raw[name]
+        if run is not None and run["failure"]:
+            raise SimulationError(f"the {name} chirp stopped after {run['periods']} periods: {run['failure']}", result)  # type: ignore[arg-type]
+    return result
+
+
+def basins(
+    config: ConfigLike,
+    x: str,
+    x_from: float,
+    x_to: float,
+    y: str,
+    y_from: float,
+    y_to: float,
+    grid: Tuple[int, int],
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> Basins:
+    """Basins of attraction over two initial conditions, as ``vibrotribo basins``: ``x`` and
+    ``y`` are ``run.initial_positions[i]`` (m) or ``run.initial_velocities[i]`` (m/s), i
+    0-based; ``grid=(nx, ny)`` nodes from ``x_from`` to ``x_to`` and ``y_from`` to ``y_to``
+    (``--grid NXxNY``). Every start runs ``transient`` (default 500) and ``recorded``
+    (default 100) periods and is fingerprinted by its stroboscopic section; the starts are
+    then classified in grid order, so the result does not depend on ``threads``. A start
+    whose masses interpenetrate does not run (attractor −1, its ``error`` in ``starts``).
+    ``cell``, ``section_tolerance`` and ``match_tolerance`` (scaled units) are those of the
+    command line. Returns :class:`Basins` equal to its ``basins.csv`` and ``attractors.csv``."""
+    nx, ny = grid
+    raw = _vibrotribo.basins(
+        _config(config),
+        x,
+        float(x_from),
+        float(x_to),
+        y,
+        float(y_from),
+        float(y_to),
+        (_count(nx, "grid[0]", least=1), _count(ny, "grid[1]", least=1)),
+        cell=cell,
+        section_tolerance=section_tolerance,
+        match_tolerance=match_tolerance,
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
+        mechanics_only=mechanics_only,
+        period_tolerance=period_tolerance,
+        floquet=floquet,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        threads=_count(threads, "threads", least=1),
+        allow_large=allow_large,
+    )
+    return Basins._from(raw)
+
+
+def attractors(
+    config: ConfigLike,
+    param: str,
+    values: Iterable[float],
+    *,
+    samples: int = 100,
+    seed: int = 1,
+    position_range: Optional[float] = None,
+    velocity_range: Optional[float] = None,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    continuation_distance: float = 0.25,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> Attractors:
+    """The attractors of ``samples`` random starts at each of ``values`` of ``param``, as
+    ``vibrotribo attractors`` (``values=vt.grid(from, to, steps)``): starts uniform in
+    ±``position_range`` (m; default the base amplitude) and ±``velocity_range`` (m/s; default
+    its peak speed), the same starts at every value (``seed``); each value's attractors
+    with their basin fractions and power, followed from value to value, and the expected
+    power of an unknown start (:class:`Attractors`)."""
+    raw = _vibrotribo.attractors(
+        _config(config),
+        param,
+        _values(values, "values"),
+        samples=_count(samples, "samples", least=1),
+        seed=_count(seed, "seed"),
+        position_range=position_range,
+        velocity_range=velocity_range,
+        cell=cell,
+        section_tolerance=section_tolerance,
+        match_tolerance=match_tolerance,
+        continuation_distance=continuation_distance,
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
+        mechanics_only=mechanics_only,
+        period_tolerance=period_tolerance,
+        floquet=floquet,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        threads=_count(threads, "threads", least=1),
+        allow_large=allow_large,
+    )
+    return Attractors._from(raw)
+
+
+def optimize_mass_ratio(
+    config: ConfigLike = None,
+    *,
+    omega_from: float = 0.55,
+    omega_to: float = 0.95,
+    omega_steps: int = 9,
+    rm_from: float = 1.2,
+    rm_to: float = 7.0,
+    rm_steps: int = 59,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> MassRatioOptimum:
+    """The optimal mass ratio R_mo(Ω) = m₂/m₁ (m₁ and m₃ fixed) of the paper's Fig. 16, as
+    ``vibrotribo optimize-mass-ratio``: the average power on ``omega_steps`` values of Ω
+    from ``omega_from`` to ``omega_to`` × ``rm_steps`` mass ratios from ``rm_from`` to
+    ``rm_to``, the best ratio at each Ω refined by a parabola, and a quadratic fit through
+    them compared with the paper's (:class:`MassRatioOptimum`)."""
+    raw = _vibrotribo.optimize_mass_ratio(
+        _config(config),
+        omega_from=float(omega_from),
+        omega_to=float(omega_to),
+        omega_steps=_count(omega_steps, "omega_steps", least=1),
+        rm_from=float(rm_from),
+        rm_to=float(rm_to),
+        rm_steps=_count(rm_steps, "rm_steps", least=1),
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
+        period_tolerance=period_tolerance,
+        floquet=floquet,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        threads=_count(threads, "threads", least=1),
+        allow_large=allow_large,
+    )
+    return MassRatioOptimum._from(raw)
+
+
+def export_spice(
+    config: Union[ConfigLike, Simulation],
+    *,
+    from_period: Optional[int] = None,
+    periods: int = 2,
+    dt_fraction: float = 0.0005,
+    check: bool = False,
+) -> SpiceExport:
+    """An ngspice netlist of the harvester of a run (a :class:`Simulation` or its
+    configuration), driven by the run's gap waveforms over ``periods`` excitation periods
+    from ``from_period`` (default: the first after the transient), sampled every
+    ``dt_fraction`` of a period (every impact also a breakpoint): the text ``vibrotribo
+    export-spice RUN_DIR`` writes for the same run. ``check=True`` also runs ngspice and
+    compares the energy delivered (:class:`SpiceExport`). ``result.write(path)`` writes it."""
+    cfg = config.config if isinstance(config, Simulation) else _config(config)
+    raw = _vibrotribo.export_spice(
+        cfg,
+        from_period=_count(from_period, "from_period"),
+        periods=_count(periods, "periods", least=1),
+        dt_fraction=float(dt_fraction),
+        check=check,
+    )
+    return SpiceExport(**{k: (tuple(v) if k == "window_s" else v) for k, v in raw.items()})
+
+
+def with_base_motion(
+    config: ConfigLike,
+    times: Iterable[float],
+    values: Iterable[float],
+    quantity: Quantity = "acceleration",
+    *,
+    directory: Optional[Union[str, "os.PathLike[str]"]] = None,
+    **scaling: Any,
+) -> Config:
+    """``config`` driven by a recorded base motion given as arrays: ``times`` (s, increasing)
+    and ``values`` (the base ``quantity``: ``"acceleration"`` in m/s², integrated exactly and
+    baseline-corrected, or ``"displacement"`` in m), as ``excitation.kind = "record"`` reads
+    it from a file. The samples are written once, exactly (shortest round-trip decimals),
+    to a file named by their hash in ``directory`` (default: a ``vibrotribo-records`` folder
+    in the temporary directory), so that the configuration pickles (to Dask workers on the
+    same machine or a shared file system) and equals the command line's run of that file.
+    ``scaling`` takes the record's other keys (``peak_acceleration=9.8``,
+    ``omega_ratio=0.7`` for the reference period, …)."""
+    t = np.asarray(times, dtype=float)
+    y = np.asarray(values, dtype=float)
+    if t.ndim != 1 or y.shape != t.shape or t.size < 2:
+        raise ValueError(
+            f"times and values must be 1-D arrays of the same length (at least 2), got shapes {t.shape} and {y.shape}"
+        )
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
+        raise ValueError("times and values must be finite numbers")
+    if not np.all(np.diff(t) > 0):
+        raise ValueError("times must be strictly increasing")
+    if quantity not in ("acceleration", "displacement"):
+        raise ValueError(f'quantity must be "acceleration" or "displacement", got {quantity!r}')
+    column = "acceleration_m_s2" if quantity == "acceleration" else "displacement_m"
+    text = f"time_s,{column}\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), y.tolist()))
+    folder = os.fspath(directory) if directory is not None else os.path.join(tempfile.gettempdir(), "vibrotribo-records")
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, hashlib.sha256(text.encode()).hexdigest()[:24] + ".csv")
+    if not os.path.exists(path):
+        part = path + f".{os.getpid()}.part"
+        with open(part, "w") as f:
+            f.write(text)
+        os.replace(part, path)
+    keys = {"excitation.kind": "record", "excitation.file": os.path.abspath(path), "excitation.quantity": quantity}
+    keys.update({f"excitation.{k}": v for k, v in scaling.items()})
+    return _config(config).replace(**keys)
 
 def _floats(values: Iterable[float]) -> list:
     """``values`` as a list of Python floats."""

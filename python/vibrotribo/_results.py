@@ -9,6 +9,8 @@ from typing import Any, Dict, Iterator, List, Mapping, Optional
 
 import numpy as np
 
+from ._display import Display
+
 __all__ = [
     "Table",
     "Events",
@@ -100,7 +102,16 @@ class Table(Mapping[str, np.ndarray]):
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        return f"Table({self.rows} rows: {', '.join(self.columns)})"
+        names = ", ".join(self.columns)
+        if len(names) > 200:
+            names = names[:197] + "..."
+        return f"Table({self.rows} rows: {names})"
+
+    def _repr_html_(self) -> str:
+        try:
+            return self.to_pandas().head(10)._repr_html_()  # type: ignore[no-any-return]
+        except ImportError:  # pragma: no cover - without pandas
+            return "<pre>" + repr(self) + "</pre>"
 
     def to_pandas(self):
         """The table as a pandas DataFrame (same column names)."""
@@ -122,8 +133,8 @@ def _numbered(prefix: str, n: int, suffix: str) -> List[str]:
     return [f"{prefix}{i}{suffix}" for i in range(1, n + 1)]
 
 
-@dataclass(frozen=True, eq=False)
-class Events:
+@dataclass(frozen=True, eq=False, repr=False)
+class Events(Display):
     """The events of a run, one entry per event, in time order.
 
     Attributes:
@@ -154,6 +165,12 @@ class Events:
     def __len__(self) -> int:
         return len(self.t)
 
+    def __getitem__(self, name: str) -> np.ndarray:
+        """A field by name (``events["t"]``), as a periodic orbit's events are read."""
+        if name not in self.__dataclass_fields__:
+            raise KeyError(name)
+        return getattr(self, name)
+
     def table(self) -> Table:
         """The events as ``events.csv`` has them (same column names)."""
         n = self.x.shape[1]
@@ -183,8 +200,8 @@ class SimulationError(RuntimeError):
         self.result = result
 
 
-@dataclass(frozen=True, eq=False)
-class Simulation:
+@dataclass(frozen=True, eq=False, repr=False)
+class Simulation(Display):
     """One run of :func:`vibrotribo.simulate`: samples on the uniform grid of
     ``run.samples_per_period`` samples per excitation period (period boundaries included,
     the last one too), the events, and the summary.
@@ -235,6 +252,23 @@ class Simulation:
         """Average power after the transient, W (None without a harvester)."""
         return self.summary.get("average_power_w")
 
+    @property
+    def period_energy_j(self) -> Optional[np.ndarray]:
+        """The energy delivered to the load in each excitation period, J, exact (the charge
+        solver's integral of the power through every impact and sticking interval; None
+        without a harvester). The samples of ``v_load * i`` miss the event instants, so
+        integrating them undercounts a run with impacts between samples (chatter); these
+        energies do not: ``period_energy_j[transient:].mean() / T`` is ``average_power_w``,
+        with ``transient = summary["transient_periods"]`` and ``T = summary["excitation_period_s"]``."""
+        e = self.summary.get("energy_in_each_period_j")
+        return None if e is None else np.asarray(e, dtype=float)
+
+    @property
+    def period_power_w(self) -> Optional[np.ndarray]:
+        """The average power of each excitation period, W: ``period_energy_j / T``."""
+        e = self.period_energy_j
+        return None if e is None else e / float(self.summary["excitation_period_s"])
+
     def table(self) -> Table:
         """The samples as ``trajectory.csv`` has them (same column names)."""
         n = self.x.shape[1]
@@ -268,8 +302,8 @@ def _equal_values(a: Any, b: Any) -> bool:
     return a == b
 
 
-@dataclass(frozen=True, eq=False)
-class Sweep:
+@dataclass(frozen=True, eq=False, repr=False)
+class Sweep(Display):
     """A one-parameter sweep of :func:`vibrotribo.sweep`, in the order the values were run
     (decreasing for ``continuation="down"``), as the command line writes it.
 
@@ -317,8 +351,8 @@ class Sweep:
         return self.summary.to_pandas()
 
 
-@dataclass(frozen=True, eq=False)
-class Map:
+@dataclass(frozen=True, eq=False, repr=False)
+class Map(Display):
     """A two-parameter map of :func:`vibrotribo.map`: ``summary`` is ``map.csv`` (``x``,
     ``y`` and the columns of a sweep's summary), y outer and x inner; ``settings`` what
     ``map.json`` records."""
@@ -340,8 +374,8 @@ class Map:
         return self.summary.to_pandas()
 
 
-@dataclass(frozen=True, eq=False)
-class LoadSweep:
+@dataclass(frozen=True, eq=False, repr=False)
+class LoadSweep(Display):
     """Average power against the load resistance on one mechanical run
     (:func:`vibrotribo.load_sweep`), as ``vibrotribo load-sweep`` writes it.
 
@@ -379,8 +413,8 @@ class LoadSweep:
         return self.points.to_pandas()
 
 
-@dataclass(frozen=True, eq=False)
-class Orbit:
+@dataclass(frozen=True, eq=False, repr=False)
+class Orbit(Display):
     """A periodic orbit of :func:`vibrotribo.periodic`, on the section t ≡ 0 (mod T).
 
     Attributes:
@@ -396,7 +430,13 @@ class Orbit:
         residual: scaled residual of the converged Newton iteration; ``residuals`` its history.
         duration_s: period·T, s.
         monodromy: the monodromy matrix Φ(PT), (2N, 2N), state order [x1…xN, v1…vN].
-        events: the events along one period (t, kind, contact 1-based, speed_before).
+        events: the events along one period, a :class:`Table` with ``t`` (s), ``kind``,
+            ``contact`` (1-based) and ``speed_before`` (m/s), read as a simulation's events
+            are (``orbit.events.t``, ``orbit.events["kind"]``).
+        average_power_w: the harvester's average power on the orbit, W (2 periods of the
+            orbit to settle the charge, then 4 averaged, as ``vibrotribo periodic``; None with
+            ``mechanics_only`` or a single mass).
+        energy_per_period_j: the energy per excitation period there, J.
     """
 
     period: int
@@ -412,11 +452,32 @@ class Orbit:
     residuals: np.ndarray
     duration_s: float
     monodromy: np.ndarray
-    events: Dict[str, Any]
+    events: Any
+    average_power_w: Optional[float] = None
+    energy_per_period_j: Optional[float] = None
+
+    @classmethod
+    def _from(cls, raw: Dict[str, Any]) -> "Orbit":
+        return cls(**dict(raw, events=Table(raw["events"])))
+
+    def to_pandas(self):
+        """The orbit as a one-row pandas DataFrame: period, stability, spectral radius,
+        power and the state ``x1_m …``, ``v1_m_s …`` at t = 0."""
+        row: Dict[str, Any] = {
+            "period": self.period,
+            "stable": self.stable,
+            "spectral_radius": self.spectral_radius,
+            "unstable_dimension": self.unstable_dimension,
+            "sticks": self.sticks,
+            "average_power_w": np.nan if self.average_power_w is None else self.average_power_w,
+        }
+        row.update(zip(_numbered("x", len(self.x), "_m"), self.x))
+        row.update(zip(_numbered("v", len(self.v), "_m_s"), self.v))
+        return _pandas().DataFrame([row])
 
 
-@dataclass(frozen=True, eq=False)
-class Lyapunov:
+@dataclass(frozen=True, eq=False, repr=False)
+class Lyapunov(Display):
     """The Lyapunov spectrum of :func:`vibrotribo.lyapunov` (the numbers of ``lyapunov.json``).
 
     Attributes:
@@ -446,9 +507,16 @@ class Lyapunov:
     running_periods: np.ndarray
     running: np.ndarray
 
+    def to_pandas(self):
+        """The running estimates as a pandas DataFrame: ``periods`` and one column
+        ``lambda1_1_s …`` per exponent (1/s), a row per batch."""
+        columns: Dict[str, Any] = {"periods": self.running_periods}
+        columns.update(zip(_numbered("lambda", self.running.shape[1], "_1_s"), self.running.T))
+        return _pandas().DataFrame(columns)
 
-@dataclass(frozen=True, eq=False)
-class Branch:
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Branch(Display):
     """One branch of a continuation.
 
     Attributes:
@@ -456,7 +524,11 @@ class Branch:
         parent: (parent branch, index of the period doubling in its ``bifurcations``), or None.
         points: arrays along the branch: ``parameter``, ``x`` and ``v`` (P, N),
             ``multipliers`` (P, 2N) complex, ``stable``, ``sticks``, ``impacts_per_period``
-            (P, N−1), ``arclength``, ``spectral_radius``.
+            (P, contacts), ``arclength``, ``spectral_radius``, ``average_power_w`` (W, the
+            harvester on each orbit as ``vibrotribo continue`` computes it; NaN with
+            ``mechanics_only`` or where the charge solver failed), ``min_closing_speed_m_s``
+            (the smallest closing speed of an impact on the orbit, m/s; NaN without impacts)
+            and ``min_closing_contact`` (its contact, 1-based; 0 without impacts).
         bifurcations: located bifurcations in order along the branch, each a dict with
             ``kind`` (``fold``, ``branch_point``, ``period_doubling``, ``neimark_sacker``
             with ``angle``, ``grazing`` with ``contact``/``appears``, ``sticking`` with
@@ -478,9 +550,26 @@ class Branch:
         """The parameter along the branch."""
         return self.points["parameter"]
 
+    def table(self) -> Table:
+        """The points as columns: ``parameter``, ``x1_m …``, ``v1_m_s …``, ``stable``,
+        ``spectral_radius``, ``min_closing_speed_m_s``, ``sticks``, ``average_power_w``,
+        ``arclength``."""
+        p = self.points
+        n = p["x"].shape[1] if p["x"].ndim == 2 else 0
+        columns: Dict[str, Any] = {"parameter": p["parameter"]}
+        columns.update(zip(_numbered("x", n, "_m"), p["x"].T))
+        columns.update(zip(_numbered("v", n, "_m_s"), p["v"].T))
+        for k in ("stable", "spectral_radius", "min_closing_speed_m_s", "sticks", "average_power_w", "arclength"):
+            columns[k] = p[k]
+        return Table(columns)
 
-@dataclass(frozen=True, eq=False)
-class Continuation:
+    def to_pandas(self):
+        """The points as a pandas DataFrame (the columns of :meth:`table`)."""
+        return self.table().to_pandas()
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Continuation(Display):
     """The branches of :func:`vibrotribo.continue_`: the first, then the period-doubled ones
     in the order they were found."""
 
@@ -495,3 +584,15 @@ class Continuation:
     def bifurcations(self) -> List[Dict[str, Any]]:
         """Every bifurcation of every branch, each with its ``branch`` index."""
         return [dict(b, branch=j) for j, br in enumerate(self.branches) for b in br.bifurcations]
+
+    def to_pandas(self):
+        """Every point of every branch as one pandas DataFrame: ``branch`` (index),
+        ``period`` and the columns of :meth:`Branch.table`."""
+        pd = _pandas()
+        frames = []
+        for j, b in enumerate(self.branches):
+            f = b.to_pandas()
+            f.insert(0, "period", b.period)
+            f.insert(0, "branch", j)
+            frames.append(f)
+        return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()

@@ -2,7 +2,19 @@
 public API is the package `vibrotribo`, which wraps these into result objects."""
 
 import os
-from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
+from typing import Any, Dict, Iterator, List, Literal, Mapping, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+SettleMode = Literal["auto", "fixed"]
+ContinuationMode = Literal["none", "up", "down"]
+ChirpSweep = Literal["linear", "logarithmic"]
+
+DEFAULT_PERIOD_TOLERANCE: float
+DEFAULT_SETTLE_CAP: int
+MAX_GRID_POINTS: float
+MAX_MEMORY_BYTES: float
 
 __version__: str
 
@@ -53,9 +65,30 @@ class Config:
     @property
     def transient_periods(self) -> int:
         """`run.transient_periods` (or its default)."""
+    def with_(self, **changes: Any) -> "Config":
+        """A copy with the changes applied (the same as `replace`)."""
+    def without(self, *keys: str) -> "Config":
+        """A copy with `keys` back at their defaults."""
+    def settings(self) -> Dict[str, Any]:
+        """The settings as given (what was read and overridden)."""
+    def __getitem__(self, key: str) -> Any:
+        """The effective value of `key` (`section.name`, `name[i]`, a derived key)."""
+    def get(self, key: str, default: Any = None) -> Any: ...
+    def __contains__(self, key: object) -> bool: ...
+    def __iter__(self) -> Iterator[str]: ...
+    def __len__(self) -> int: ...
+    def __hash__(self) -> int: ...
     def __eq__(self, other: object) -> bool: ...
 
-def simulate(config: Any, *, mechanics_only: bool = False, samples: bool = True) -> Dict[str, Any]:
+def simulate(
+    config: Any,
+    *,
+    mechanics_only: bool = False,
+    samples: bool = True,
+    settle: SettleMode = "fixed",
+    settle_cap: int = 2000,
+    allow_large: bool = False,
+) -> Dict[str, Any]:
     """One run: arrays t, x, v, y, d (and q, i, v_load, c, voc, vs), events, summary, error."""
 
 def sweep(
@@ -63,14 +96,17 @@ def sweep(
     param: str,
     values: List[float],
     *,
-    continuation: str = "none",
+    continuation: ContinuationMode = "none",
     transient: Optional[int] = None,
     recorded: Optional[int] = None,
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = 1e-4,
-    settle: str = "auto",
+    settle: SettleMode = "auto",
     settle_cap: int = 2000,
+    floquet: bool = False,
+    lyapunov: bool = False,
+    allow_large: bool = False,
 ) -> Dict[str, Any]:
     """A sweep: the columns of summary.csv, orbit.csv, impacts.csv and the settings."""
 
@@ -86,8 +122,10 @@ def map(
     mechanics_only: bool = False,
     threads: Optional[int] = None,
     period_tolerance: float = 1e-4,
-    settle: str = "auto",
+    settle: SettleMode = "auto",
     settle_cap: int = 2000,
+    floquet: bool = False,
+    allow_large: bool = False,
 ) -> Dict[str, Any]:
     """A map: the columns of map.csv and the settings."""
 
@@ -106,10 +144,11 @@ def periodic(
     config: Any,
     *,
     period: Optional[int] = None,
-    transient: int = 100,
+    transient: int = 200,
     guess: Optional[Tuple[List[float], List[float]]] = None,
     tolerance: Optional[float] = None,
     max_iterations: Optional[int] = None,
+    mechanics_only: bool = False,
 ) -> Dict[str, Any]:
     """A periodic orbit and its Floquet multipliers."""
 
@@ -130,17 +169,148 @@ def continue_(
     stop: float,
     *,
     period: Optional[int] = None,
-    transient: int = 100,
+    transient: Optional[int] = None,
     guess: Optional[Tuple[List[float], List[float]]] = None,
     max_points: Optional[int] = None,
     doubling_depth: Optional[int] = None,
     initial_step: Optional[float] = None,
     max_step: Optional[float] = None,
+    mechanics_only: bool = False,
 ) -> Dict[str, Any]:
     """A continuation: the parameter's name and the branches."""
 
-def grid(start: float, stop: float, steps: int) -> List[float]:
+def grid(start: float, stop: float, steps: int) -> npt.NDArray[np.float64]:
     """`steps` values equally spaced from `start` to `stop` (both included, `stop` exactly)."""
 
-def log_spaced(start: float, stop: float, steps: int) -> List[float]:
-    """`steps` values evenly spaced in the logarithm from `start` to `stop`."""
+def log_spaced(start: float, stop: float, steps: int) -> npt.NDArray[np.float64]:
+    """`steps` values evenly spaced in the logarithm from `start` to `stop` (both exactly)."""
+
+def chirp(
+    config: Any,
+    from_: float,
+    to: float,
+    duration: float,
+    *,
+    sweep: ChirpSweep = "linear",
+    amplitude: Optional[float] = None,
+    mechanics_only: bool = False,
+    from_rest: bool = False,
+    samples_per_cycle: int = 200,
+    jump_window: int = 5,
+) -> Dict[str, Any]:
+    """The chirp experiment: the columns of response.csv, the runs up and down."""
+
+def basins(
+    config: Any,
+    x: str,
+    x_from: float,
+    x_to: float,
+    y: str,
+    y_from: float,
+    y_to: float,
+    grid_size: Tuple[int, int],
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = 1e-4,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = 2000,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> Dict[str, Any]:
+    """Basins: the columns of basins.csv, attractors.csv and the starts."""
+
+def attractors(
+    config: Any,
+    param: str,
+    values: List[float],
+    *,
+    samples: int = 100,
+    seed: int = 1,
+    position_range: Optional[float] = None,
+    velocity_range: Optional[float] = None,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    continuation_distance: float = 0.25,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = 1e-4,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = 2000,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> Dict[str, Any]:
+    """The attractor census: the columns of attractors.csv and expected_power.csv."""
+
+def optimize_mass_ratio(
+    config: Any,
+    *,
+    omega_from: float = 0.55,
+    omega_to: float = 0.95,
+    omega_steps: int = 9,
+    rm_from: float = 1.2,
+    rm_to: float = 7.0,
+    rm_steps: int = 59,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    period_tolerance: float = 1e-4,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = 2000,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> Dict[str, Any]:
+    """The optimal mass ratio: power_grid.csv, optimum.csv and the fits."""
+
+def export_spice(
+    config: Any,
+    *,
+    from_period: Optional[int] = None,
+    periods: int = 2,
+    dt_fraction: float = 0.0005,
+    check: bool = False,
+) -> Dict[str, Any]:
+    """The ngspice netlist of a run and its gap waveforms."""
+
+DEFAULT_START_PERIODS: Tuple[int, int]
+
+def basin_starts(
+    config: Any,
+    x: str,
+    x_values: List[float],
+    y: str,
+    y_values: List[float],
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = 1e-4,
+    floquet: bool = False,
+    settle: SettleMode = "auto",
+    settle_cap: int = 2000,
+    threads: Optional[int] = None,
+) -> List[Tuple[int, float, Optional[float], List[float], List[int], Optional[str]]]:
+    """The fingerprints of a basin grid's starts (grid order), not classified."""
+
+def classify_basins(
+    config: Any,
+    x_values: List[float],
+    y_values: List[float],
+    fingerprints: List[Tuple[int, float, Optional[float], List[float], List[int], Optional[str]]],
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+) -> Dict[str, Any]:
+    """The tables of a basin grid from its starts' fingerprints."""

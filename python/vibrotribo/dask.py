@@ -1,9 +1,15 @@
-"""Sweeps spread over a Dask cluster: ``vibrotribo.dask.sweep(client, config, param,
-values, ...)`` splits the values into chunks, runs each chunk as one task calling the
-serial :func:`vibrotribo.sweep` on a worker, and joins the chunks in order, so that it
-returns exactly what the serial ``vibrotribo.sweep`` returns for the same arguments (every
-point of a sweep without continuation is independent of the others and of the thread
-count).
+"""Sweeps, maps and basins spread over a Dask cluster: ``vibrotribo.dask.sweep(client,
+config, param, values, ...)`` splits the values into chunks, runs each chunk as one task
+calling the serial :func:`vibrotribo.sweep` on a worker, and joins the chunks in order, so
+that it returns exactly what the serial ``vibrotribo.sweep`` returns for the same arguments
+(every point of a sweep without continuation is independent of the others and of the thread
+count). ``vibrotribo.dask.map`` spreads the rows of a map the same way, and
+``vibrotribo.dask.basins`` the rows of a basin grid (the starts run on the workers; their
+fingerprints are classified here, in grid order, so the result equals the serial
+:func:`vibrotribo.basins`).
+
+Ctrl-C (``KeyboardInterrupt``) while waiting cancels every submitted task before it is
+raised, so that the workers stop instead of finishing work nobody will collect.
 
 Needs ``dask[distributed]`` (and, on Slurm, ``dask-jobqueue``); nothing from dask is
 imported until a sweep is submitted::
@@ -26,10 +32,30 @@ from typing import Any, Iterable, List, Optional
 
 import numpy as np
 
-from . import Config, Sweep, Table, _config, _values, _vibrotribo
+from . import Basins, Config, Map, Sweep, Table, _config, _values, _vibrotribo
+from . import map as _serial_map
 from . import sweep as _serial_sweep
 
-__all__ = ["sweep"]
+__all__ = ["sweep", "map", "basins"]
+
+
+def _gather(client: Any, futures: List[Any]) -> List[Any]:
+    """The results of ``futures`` in order; on an interrupt or an error the futures not yet
+    done are cancelled first (the workers stop), then the exception is raised."""
+    try:
+        return client.gather(futures)
+    except BaseException:
+        client.cancel(futures, force=True)
+        raise
+
+
+def _chunk_size(client: Any, n: int, chunk_size: Optional[int]) -> int:
+    if chunk_size is None:
+        workers = sum(client.nthreads().values()) or 1
+        return max(1, math.ceil(n / (4 * workers)))
+    if chunk_size < 1:
+        raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
+    return chunk_size
 
 
 def _run_chunk(config: Config, param: str, values: List[float], kwargs: dict) -> Sweep:
@@ -84,11 +110,7 @@ def sweep(
         return _serial_sweep(cfg, param, vals, **kwargs)
     # Fail early and here, not on a worker, on a bad key or value (as the serial sweep does).
     _check(cfg, param, vals)
-    if chunk_size is None:
-        workers = sum(client.nthreads().values()) or 1
-        chunk_size = max(1, math.ceil(len(vals) / (4 * workers)))
-    if chunk_size < 1:
-        raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
+    chunk_size = _chunk_size(client, len(vals), chunk_size)
     chunks = [vals[j : j + chunk_size] for j in range(0, len(vals), chunk_size)]
     futures = client.map(
         _run_chunk,
@@ -98,7 +120,7 @@ def sweep(
         [kwargs] * len(chunks),
         pure=False,
     )
-    parts: List[Sweep] = client.gather(futures)
+    parts: List[Sweep] = _gather(client, futures)
     settings = dict(parts[0].settings)
     settings["values"] = vals
     return Sweep(
@@ -113,3 +135,140 @@ def _check(config: Config, param: str, values: List[float]) -> None:
     """Raises the serial sweep's KeyError/ValueError for a bad key or value."""
     for v in values:
         config.replace(**{param: v})
+
+
+def _run_map_rows(config: Config, x: str, x_values: List[float], y: str, y_values: List[float], kwargs: dict) -> Map:
+    """One task: the serial map of some rows."""
+    return _serial_map(config, x, x_values, y, y_values, **kwargs)
+
+
+def map(  # noqa: A001 - the command's name
+    client: Any,
+    config: Any,
+    x: str,
+    x_values: Iterable[float],
+    y: str,
+    y_values: Iterable[float],
+    *,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    threads: Optional[int] = 1,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    settle: str = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    floquet: bool = False,
+    chunk_size: Optional[int] = None,
+) -> Map:
+    """:func:`vibrotribo.map` with its rows (values of ``y``) spread over the workers of the
+    Dask ``client``, ``chunk_size`` rows per task. Returns exactly what the serial map
+    returns for the same arguments."""
+    cfg = _config(config)
+    xs, ys = _values(x_values, "x_values"), _values(y_values, "y_values")
+    kwargs = dict(
+        transient=transient,
+        recorded=recorded,
+        mechanics_only=mechanics_only,
+        threads=threads,
+        period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=settle_cap,
+        floquet=floquet,
+    )
+    if not xs or not ys:
+        return _serial_map(cfg, x, xs, y, ys, **kwargs)
+    # Fail early and here on a bad key or value: a map of the first row's first point.
+    _serial_map(cfg, x, xs[:1], y, ys[:1], **dict(kwargs, transient=0, recorded=1, settle="fixed"))
+    size = _chunk_size(client, len(ys), chunk_size)
+    rows = [ys[j : j + size] for j in range(0, len(ys), size)]
+    futures = client.map(
+        _run_map_rows,
+        [cfg] * len(rows),
+        [x] * len(rows),
+        [xs] * len(rows),
+        [y] * len(rows),
+        rows,
+        [kwargs] * len(rows),
+        pure=False,
+    )
+    parts: List[Map] = _gather(client, futures)
+    settings = dict(parts[0].settings)
+    settings["y_values"] = ys
+    return Map(summary=Table.concat([p.summary for p in parts]), settings=settings)
+
+
+
+def _basin_row(config: Config, x: str, xs: List[float], y: str, y_value: float, kwargs: dict) -> list:
+    """One task: the fingerprints of the starts of one row of a basin grid."""
+    return _vibrotribo.basin_starts(config, x, xs, y, [y_value], **kwargs)
+
+
+def basins(
+    client: Any,
+    config: Any,
+    x: str,
+    x_from: float,
+    x_to: float,
+    y: str,
+    y_from: float,
+    y_to: float,
+    grid: tuple,
+    *,
+    cell: float = 0.05,
+    section_tolerance: float = 1e-3,
+    match_tolerance: float = 3e-3,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    floquet: bool = False,
+    settle: str = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    threads: Optional[int] = 1,
+) -> Basins:
+    """:func:`vibrotribo.basins` with the rows of its grid spread over the workers of the Dask
+    ``client``, one task per row (``threads`` threads each, default 1). The starts'
+    fingerprints come back and are classified here, in grid order, so the result equals the
+    serial :func:`vibrotribo.basins` for the same arguments. Bad input raises here, before
+    anything is submitted (a serial run of the grid's first start checks it)."""
+    from . import _count, basins as _serial_basins
+
+    cfg = _config(config)
+    nx, ny = _count(grid[0], "grid[0]", least=1), _count(grid[1], "grid[1]", least=1)
+    options = dict(cell=cell, section_tolerance=section_tolerance, match_tolerance=match_tolerance)
+    run = dict(
+        transient=transient,
+        recorded=recorded,
+        mechanics_only=mechanics_only,
+        period_tolerance=period_tolerance,
+        floquet=floquet,
+        settle=settle,
+        settle_cap=settle_cap,
+    )
+    # Checks every argument as the serial function does (one start, one period).
+    probe = _serial_basins(cfg, x, x_from, x_from, y, y_from, y_from, (1, 1), **options,
+                           **dict(run, transient=0, recorded=1, settle="fixed"), threads=1)
+    xs = _vibrotribo.grid(float(x_from), float(x_to), int(nx)).tolist()
+    ys = _vibrotribo.grid(float(y_from), float(y_to), int(ny)).tolist()
+    kwargs = dict(options, **run, threads=threads)
+    futures = client.map(
+        _basin_row,
+        [cfg] * len(ys),
+        [x] * len(ys),
+        [xs] * len(ys),
+        [y] * len(ys),
+        ys,
+        [kwargs] * len(ys),
+        pure=False,
+    )
+    rows: List[list] = _gather(client, futures)
+    raw = _vibrotribo.classify_basins(cfg, xs, ys, [f for row in rows for f in row], **options)
+    transient_default, recorded_default = _vibrotribo.DEFAULT_START_PERIODS
+    settings = dict(
+        probe.settings,
+        x_values=xs,
+        y_values=ys,
+        transient_periods=transient_default if transient is None else transient,
+        recorded_periods=recorded_default if recorded is None else recorded,
+    )
+    return Basins(Table(raw["basins"]), Table(raw["attractors"]), Table(raw["starts"]), settings)

@@ -107,22 +107,13 @@ pub struct BasinsArgs {
 }
 
 /// Transient and recorded periods of a start unless `--transient`/`--recorded` say.
-pub const DEFAULT_PERIODS: (u64, u64) = (500, 100);
+pub const DEFAULT_PERIODS: (u64, u64) = vibrotribo::attractors::DEFAULT_START_PERIODS;
 
 /// Checks that `key` is an initial condition of a chain of `masses` masses.
 fn check_key(option: &str, key: &str, masses: usize) -> Result<()> {
-    let index = ["run.initial_positions[", "run.initial_velocities["]
-        .iter()
-        .find_map(|p| key.strip_prefix(p))
-        .and_then(|rest| rest.strip_suffix(']'))
-        .and_then(|i| i.parse::<usize>().ok());
-    match index {
-        Some(i) if i < masses => Ok(()),
-        Some(i) => bail!("{option} {key}: index {i} out of range (the chain has {masses} masses, 0-based)"),
-        None => bail!(
-            "{option} {key}: basins vary initial conditions, run.initial_positions[i] or run.initial_velocities[i] (i 0-based); for parameters use `map` or `attractors`"
-        ),
-    }
+    vibrotribo::attractors::initial_condition_index(key, masses)
+        .map(|_| ())
+        .map_err(|e| anyhow!("{option} {e}"))
 }
 
 /// `starts.csv`: one row per start, the fingerprint of where it ended.
@@ -150,7 +141,7 @@ fn layout() -> Layout {
 }
 
 fn points_of(xs: &[f64], ys: &[f64]) -> Vec<(f64, f64)> {
-    ys.iter().flat_map(|&y| xs.iter().map(move |&x| (x, y))).collect()
+    vibrotribo::attractors::basin_points(xs, ys)
 }
 
 fn key_of(&(x, y): &(f64, f64)) -> String {

@@ -12,7 +12,7 @@ use vibrotribo::config::Config;
 use vibrotribo::orbits::{
     Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
 };
-use vibrotribo::study::{Harvester, PointOptions, power_on_periodic_state};
+use vibrotribo::study::PointOptions;
 use vibrotribo::sweep::{PointRunner, grid};
 use vibrotribo::{ChainParams, ChainState, Simulator};
 
@@ -65,10 +65,6 @@ pub struct ContinueArgs {
     pub mass: Option<usize>,
 }
 
-/// Repetitions of an orbit the charge solver warms up over, and averages over.
-const POWER_WARMUP: u32 = 2;
-const POWER_PERIODS: u32 = 2;
-
 /// Runs `vibrotribo continue`.
 pub fn run(args: &ContinueArgs) -> Result<()> {
     if args.period == Some(0) {
@@ -99,8 +95,12 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
     let power = if args.mechanics_only {
         None
     } else {
-        let h = Harvester::new(config.harvester().clone(), config.charge_options().clone());
-        Some(branch_powers(&result, &family, &h, &config)?)
+        Some(vibrotribo::branch::branch_powers(
+            &config,
+            &args.param,
+            &result,
+            || std::ops::ControlFlow::Continue(()),
+        ))
     };
     print_continuation(&args.param, &result);
     if let Some(dir) = &args.out {
@@ -122,38 +122,6 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The average power on every point of every branch (NaN where the charge solver failed).
-fn branch_powers(
-    result: &Continuation,
-    family: &impl Fn(f64) -> ChainParams,
-    harvester: &Harvester,
-    config: &Config,
-) -> Result<Vec<Vec<f64>>> {
-    Ok(result
-        .branches
-        .iter()
-        .map(|b| {
-            b.points
-                .iter()
-                .map(|p| {
-                    power_on_periodic_state(
-                        &family(p.parameter),
-                        &p.state,
-                        b.period,
-                        harvester,
-                        config.sim_options(),
-                        POWER_WARMUP,
-                        POWER_PERIODS,
-                    )
-                    .ok()
-                    .and_then(|e| e.power.map(|s| s.average_power_w))
-                    .unwrap_or(f64::NAN)
-                })
-                .collect()
-        })
-        .collect())
 }
 
 /// What a bifurcation is, in words, with its detail.

@@ -4,11 +4,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use vibrotribo::config::Config;
-use vibrotribo::electrical::spice::{self, SpiceOptions};
-use vibrotribo::electrical::{ChargeSolver, PwlGaps};
-use vibrotribo::study::{RunSpec, record_trajectory};
+use vibrotribo::study::{SPICE_DATA_FILE, SpiceExportError, spice_check, spice_export};
 
 use crate::output::si;
 
@@ -21,11 +19,11 @@ pub struct ExportSpiceArgs {
     #[arg(long)]
     pub from_period: Option<u64>,
     /// Periods exported (default: 2).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = vibrotribo::study::DEFAULT_SPICE_PERIODS)]
     pub periods: u64,
     /// PWL sampling interval as a fraction of the excitation period (every impact is also a
     /// breakpoint).
-    #[arg(long, default_value_t = 1.0 / 2000.0)]
+    #[arg(long, default_value_t = vibrotribo::study::DEFAULT_SPICE_DT_FRACTION)]
     pub dt_fraction: f64,
     /// Netlist file name, written in RUN_DIR.
     #[arg(long, default_value = "harvester.cir")]
@@ -53,55 +51,35 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
     let table: toml::Table =
         serde_json::from_value(settings).context("the recorded settings are not a table")?;
     let config = Config::from_table(table)?;
-    let chain = config.chain();
-    let harvester = config.harvester();
-    if !(args.dt_fraction > 0.0 && args.dt_fraction < 1.0) {
-        bail!("--dt-fraction must lie in (0, 1), got {}", args.dt_fraction);
-    }
-    let from = args.from_period.unwrap_or(config.run().transient());
-    if args.periods == 0 {
-        bail!("--periods must be at least 1");
-    }
-    let period = chain.period();
-    let (t0, t1) = (from as f64 * period, (from + args.periods) as f64 * period);
-
-    // Re-create the run's exact trajectory (the simulation is deterministic).
-    let spec = RunSpec {
-        periods: from + args.periods,
-        ..config.run_spec(true)
-    };
-    let (trajectory, _) = record_trajectory(&spec, from, &mut ())?;
-    let pwl = PwlGaps::from_trajectory(&trajectory, args.dt_fraction * period, t1)?;
-    let options = SpiceOptions::default();
-    let data_file = "vibrotribo-out.txt";
-    let deck = spice::netlist(harvester, &pwl, t1, &options, data_file)?;
+    let export =
+        spice_export(&config, args.from_period, args.periods, args.dt_fraction).map_err(|e| match e {
+            SpiceExportError::Option { option, message } => {
+                anyhow::anyhow!("--{}: {message}", option.replace('_', "-"))
+            }
+            other => other.into(),
+        })?;
     let path = args.run_dir.join(&args.name);
-    std::fs::write(&path, &deck).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::write(&path, &export.netlist).with_context(|| format!("cannot write {}", path.display()))?;
+    let (from, (t0, t1)) = (export.from_period, export.window_s);
     println!(
         "wrote {} ({} PWL points, periods {from}..{} of the run, t = {t0:.6}…{t1:.6} s shifted to start at 0)",
         path.display(),
-        pwl.times().len(),
-        from + args.periods
+        export.pwl.times().len(),
+        from + export.periods
     );
     println!(
-        "  run it with `ngspice -b {}` in {}; it writes {data_file} (time, charge in nC, energy in nJ, voltage)",
+        "  run it with `ngspice -b {}` in {}; it writes {SPICE_DATA_FILE} (time, charge in nC, energy in nJ, voltage)",
         args.name,
         args.run_dir.display()
     );
     if args.check {
-        let ours = {
-            let mut s = ChargeSolver::for_chain(harvester, chain, config.charge_options().clone())?;
-            s.run_pwl(&pwl)?;
-            s.total_energy()
-        };
-        let run = spice::run_ngspice(harvester, &pwl, t1, &options)?;
-        let theirs = run.energy_j.last().copied().unwrap_or(f64::NAN);
+        let (ours, theirs, elapsed) = spice_check(&config, &export)?;
         println!(
             "  delivered energy: vibrotribo {}, ngspice {} (relative difference {:.2e}; ngspice took {:.2} s)",
             si(ours, "J"),
             si(theirs, "J"),
             (ours - theirs) / theirs,
-            run.elapsed.as_secs_f64()
+            elapsed
         );
     }
     Ok(())

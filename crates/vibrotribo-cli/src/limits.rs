@@ -7,19 +7,19 @@
 use anyhow::{Result, bail};
 
 /// Most points of one sweep or map grid (their values are held in memory): 10⁷.
-pub const MAX_GRID_POINTS: f64 = 1e7;
+pub const MAX_GRID_POINTS: f64 = vibrotribo::study::limits::MAX_GRID_POINTS;
 
 /// Largest estimated output written without `--allow-large`: 20 GiB.
-pub const MAX_OUTPUT_BYTES: f64 = 20.0 * GIB;
+pub const MAX_OUTPUT_BYTES: f64 = vibrotribo::study::limits::MAX_OUTPUT_BYTES;
 
 /// Largest estimated memory used without `--allow-large`: 4 GiB.
-pub const MAX_MEMORY_BYTES: f64 = 4.0 * GIB;
+pub const MAX_MEMORY_BYTES: f64 = vibrotribo::study::limits::MAX_MEMORY_BYTES;
 
 /// Bytes in a GiB.
-pub const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+pub const GIB: f64 = vibrotribo::study::limits::GIB;
 
 /// Bytes of one number written to a CSV file (estimate).
-pub const CSV_NUMBER_BYTES: f64 = 22.0;
+pub const CSV_NUMBER_BYTES: f64 = vibrotribo::study::limits::CSV_NUMBER_BYTES;
 
 /// Refuses a grid of `points` points (named `what`, e.g. "--steps") above [`MAX_GRID_POINTS`];
 /// this limit holds even with `--allow-large`.

@@ -291,11 +291,11 @@ pub struct OptimizeArgs {
 }
 
 /// The paper's fit of the optimal mass ratio, R_mo = aΩ² + bΩ + c (Sect. 4.3.2).
-pub const PAPER_FIT: [f64; 3] = [11.43, -28.46, 18.03];
+pub const PAPER_FIT: [f64; 3] = vibrotribo::study::PAPER_MASS_RATIO_FIT;
 
 /// The paper's fit evaluated at Ω = `w`.
 pub fn paper_fit(w: f64) -> f64 {
-    PAPER_FIT[0] * w * w + PAPER_FIT[1] * w + PAPER_FIT[2]
+    vibrotribo::study::paper_mass_ratio_fit(w)
 }
 
 /// Draws the optima (`ws`, `rs`), the paper's fit and `fit` over `[w_from, w_to]` to `path`.
@@ -327,38 +327,16 @@ pub fn plot_optimal_mass_ratio(
 /// The maximum of `values` on the equally spaced `grid`, refined by the parabola through the
 /// best point and its neighbours (when it is interior and the parabola is concave).
 pub fn refine_maximum(grid: &[f64], values: &[f64]) -> Option<(f64, f64)> {
-    let (best, &vmax) = values
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.is_finite())
-        .max_by(|a, b| a.1.total_cmp(b.1))?;
-    if best == 0 || best + 1 >= values.len() || !values[best - 1].is_finite() || !values[best + 1].is_finite()
-    {
-        return Some((grid[best], vmax));
-    }
-    let (a, b, c) = (values[best - 1], vmax, values[best + 1]);
-    let denom = a - 2.0 * b + c;
-    if denom >= 0.0 {
-        return Some((grid[best], vmax));
-    }
-    let h = grid[best + 1] - grid[best];
-    let shift = 0.5 * (a - c) / denom;
-    Some((grid[best] + shift * h, b - 0.25 * (a - c) * shift))
+    vibrotribo::study::refine_maximum(grid, values)
 }
 
 /// The optimal mass ratio at each Ω of `omegas`: the maximum of its row of `power` (row-major,
 /// `ratios.len()` mass ratios per Ω) refined by [`refine_maximum`], as (Ω, R_mo, power there
 /// in W, whether R_mo is at an end of `ratios`). An Ω without a finite power is left out.
 pub(crate) fn optima(omegas: &[f64], ratios: &[f64], power: &[f64]) -> Vec<(f64, f64, f64, bool)> {
-    let (first, last) = (ratios[0], ratios[ratios.len() - 1]);
-    omegas
-        .iter()
-        .zip(power.chunks(ratios.len()))
-        .filter_map(|(&w, row)| {
-            let (r, p) = refine_maximum(ratios, row)?;
-            let at_edge = (r - first).abs() < 1e-12 || (r - last).abs() < 1e-12;
-            Some((w, r, p, at_edge))
-        })
+    vibrotribo::study::mass_ratio_optima(omegas, ratios, power)
+        .into_iter()
+        .map(|o| (o.omega_ratio, o.mass_ratio, o.average_power_w, o.at_edge))
         .collect()
 }
 

@@ -10,7 +10,7 @@ use vibrotribo::config::Config;
 use vibrotribo::orbits::{
     PeriodicOrbit, ShootingOptions, find_periodic_orbit, periodic_orbit_from_transient,
 };
-use vibrotribo::study::{ElectricalOutcome, Harvester, power_on_orbit};
+use vibrotribo::study::ElectricalOutcome;
 use vibrotribo::{EventKind, UniformSampler};
 
 use crate::config::ConfigArgs;
@@ -41,10 +41,6 @@ pub struct PeriodicArgs {
     pub plot: bool,
 }
 
-/// Repetitions of the orbit the charge solver warms up over, and averages over.
-const POWER_WARMUP: u32 = 2;
-const POWER_PERIODS: u32 = 4;
-
 /// Runs `vibrotribo periodic`.
 pub fn run(args: &PeriodicArgs) -> Result<()> {
     if args.period == Some(0) {
@@ -70,17 +66,10 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
         )?
     };
     // A single mass (against a stop) has no gap between masses to harvest from.
-    let power = if args.mechanics_only || config.chain().len() < 2 {
+    let power = if args.mechanics_only {
         None
     } else {
-        let h = Harvester::new(config.harvester().clone(), config.charge_options().clone());
-        Some(power_on_orbit(
-            &orbit,
-            &h,
-            config.sim_options(),
-            POWER_WARMUP,
-            POWER_PERIODS,
-        )?)
+        vibrotribo::branch::orbit_power(&config, &orbit)?
     };
     print_orbit(&orbit, power.as_ref());
     if let Some(dir) = &args.out {

@@ -312,15 +312,7 @@ fn check_size(config: &Config, spec: &RunSpec, args: &SimulateArgs) -> Result<()
     let periods = spec.periods as f64;
     let n = spec.chain.len() as f64;
     let electrical = spec.harvester.is_some();
-    // Per period: impact counts per contact, the solver's period record, and the per-period
-    // arrays of summary.json.
-    let per_period = 48.0
-        + 4.0 * n
-        + if electrical {
-            80.0 + 2.0 * limits::CSV_NUMBER_BYTES
-        } else {
-            0.0
-        };
+    let per_period = vibrotribo::study::limits::per_period_bytes(spec.chain.len(), electrical);
     limits::check_memory(
         &format!("{} periods of per-period statistics", spec.periods),
         periods * per_period,

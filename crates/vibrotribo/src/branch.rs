@@ -6,13 +6,16 @@
 //! `continue`, Python's `continue_`) calls with the same [`BranchOptions`], so that the same
 //! configuration gives the same branch, bit for bit.
 
+use std::ops::ControlFlow;
+
 use thiserror::Error;
 
 use crate::config::{Config, ConfigError};
 use crate::orbits::{
-    Continuation, ContinuationOptions, OrbitError, ShootingOptions, continue_orbit,
+    Continuation, ContinuationOptions, OrbitError, PeriodicOrbit, ShootingOptions, continue_orbit,
     periodic_orbit_from_transient,
 };
+use crate::study::{ElectricalOutcome, Harvester, StudyError, power_on_orbit, power_on_periodic_state};
 use crate::{ChainParams, ChainState};
 
 /// How a configuration's branch is started and followed.
@@ -148,4 +151,78 @@ pub fn continue_config(
         period,
         &continuation,
     )?)
+}
+
+/// Periods of the harvester simulated along an orbit of a branch before its power is
+/// averaged (the charge settles onto its periodic cycle).
+pub const BRANCH_POWER_WARMUP: u32 = 2;
+/// Periods of the orbit the power on a branch point is averaged over.
+pub const BRANCH_POWER_PERIODS: u32 = 2;
+/// Periods of the harvester simulated along a periodic orbit found by `periodic` before its
+/// power is averaged.
+pub const ORBIT_POWER_WARMUP: u32 = 2;
+/// Periods of a periodic orbit its power is averaged over.
+pub const ORBIT_POWER_PERIODS: u32 = 4;
+
+/// The harvester of `config` (its transducer, load and charge solver settings).
+fn harvester_of(config: &Config) -> Harvester {
+    Harvester::new(config.harvester().clone(), config.charge_options().clone())
+}
+
+/// The average power of `config`'s harvester on every point of every branch of `c`
+/// (continued in `key`), W: the orbit of each point run for [`BRANCH_POWER_WARMUP`] +
+/// [`BRANCH_POWER_PERIODS`] of its periods with the charge solved alongside (NaN where the
+/// charge solver failed). `each` is called after every point and may stop the computation
+/// (the powers computed so far are returned).
+pub fn branch_powers(
+    config: &Config,
+    key: &str,
+    c: &Continuation,
+    mut each: impl FnMut() -> ControlFlow<()>,
+) -> Vec<Vec<f64>> {
+    let family = config_family(config, key);
+    let harvester = harvester_of(config);
+    let mut out = Vec::with_capacity(c.branches.len());
+    for b in &c.branches {
+        let mut powers = Vec::with_capacity(b.points.len());
+        for p in &b.points {
+            powers.push(
+                power_on_periodic_state(
+                    &family(p.parameter),
+                    &p.state,
+                    b.period,
+                    &harvester,
+                    config.sim_options(),
+                    BRANCH_POWER_WARMUP,
+                    BRANCH_POWER_PERIODS,
+                )
+                .ok()
+                .and_then(|e| e.power.map(|s| s.average_power_w))
+                .unwrap_or(f64::NAN),
+            );
+            if each().is_break() {
+                out.push(powers);
+                return out;
+            }
+        }
+        out.push(powers);
+    }
+    out
+}
+
+/// The harvester of `config` run along the periodic orbit `orbit` of its chain:
+/// [`ORBIT_POWER_WARMUP`] periods of the orbit, then [`ORBIT_POWER_PERIODS`] averaged over.
+/// `None` for a single mass (no gap between masses to harvest from).
+pub fn orbit_power(config: &Config, orbit: &PeriodicOrbit) -> Result<Option<ElectricalOutcome>, StudyError> {
+    if config.chain().len() < 2 {
+        return Ok(None);
+    }
+    power_on_orbit(
+        orbit,
+        &harvester_of(config),
+        config.sim_options(),
+        ORBIT_POWER_WARMUP,
+        ORBIT_POWER_PERIODS,
+    )
+    .map(Some)
 }

@@ -4,7 +4,7 @@
 use std::ops::ControlFlow;
 
 use anyhow::{Context, Result, anyhow, bail};
-use vibrotribo::study::{PointResult, SettleMode};
+use vibrotribo::study::PointResult;
 use vibrotribo::sweep::{Delivery, PointRunner, SweepError, run_chunks};
 
 use crate::limits;
@@ -140,11 +140,5 @@ pub fn estimate_point_output(runner: &PointRunner, orbit: bool) -> f64 {
 
 /// Estimated memory of one point's run (stroboscopic samples and per-period counts).
 pub fn estimate_point_memory(runner: &PointRunner) -> f64 {
-    let o = runner.options();
-    let n = runner.masses() as f64;
-    let before = match &o.settle {
-        SettleMode::Auto(a) => a.cap_periods.max(o.transient_periods),
-        SettleMode::Fixed => o.transient_periods,
-    };
-    (before + o.recorded_periods) as f64 * (8.0 * n + 96.0)
+    vibrotribo::study::limits::point_memory_bytes(runner.options(), runner.masses())
 }

@@ -43,6 +43,7 @@
 //! known one whose set lies nearest within [`AttractorOptions::continuation_distance`]
 //! (Attractors.jl's matching by set distance).
 
+mod basins;
 mod classify;
 mod fingerprint;
 #[cfg(feature = "config")]
@@ -50,6 +51,7 @@ mod runs;
 mod starts;
 mod track;
 
+pub use basins::{BasinKeyError, DEFAULT_START_PERIODS, basin_points, initial_condition_index};
 pub use classify::{Attractor, Classification, classify};
 pub use fingerprint::{AttractorOptions, Fingerprint, SectionScale};
 #[cfg(feature = "config")]

@@ -396,6 +396,39 @@ impl Config {
         }
     }
 
+    /// The effective settings: every key of the schema with its value (the defaults filled
+    /// in where the file and the overrides leave it out: the chain, the harmonic amplitude,
+    /// the reference frequency as `omega_ratio`, the transient, the initial state, the
+    /// harvester), shaped like the file, as JSON (`null` for an optional key left absent).
+    pub fn effective(&self) -> serde_json::Value {
+        let mut doc = self.doc.clone();
+        let c = &self.chain;
+        let o = &mut doc.oscillator;
+        o.masses.get_or_insert_with(|| c.masses.clone());
+        o.stiffness
+            .get_or_insert_with(|| PerMass::Many(c.stiffness.clone()));
+        o.damping.get_or_insert_with(|| PerMass::Many(c.damping.clone()));
+        o.gaps.get_or_insert_with(|| PerMass::Many(c.gaps.clone()));
+        o.restitution.get_or_insert(c.restitution);
+        let e = &mut doc.excitation;
+        if matches!(e.kind, None | Some(ExcitationKind::Harmonic)) {
+            e.amplitude.get_or_insert(c.excitation.amplitude);
+        }
+        if e.omega_ratio.is_none() && e.frequency_hz.is_none() {
+            e.omega_ratio = Some(c.omega_ratio());
+        }
+        let r = &mut doc.run;
+        r.transient_periods.get_or_insert(self.run.transient());
+        if !r.start_relative_to_base {
+            r.initial_positions
+                .get_or_insert_with(|| self.initial.positions.clone());
+            r.initial_velocities
+                .get_or_insert_with(|| self.initial.velocities.clone());
+        }
+        doc.harvester.get_or_insert_with(|| self.harvester.clone());
+        serde_json::to_value(&doc).unwrap_or(serde_json::Value::Null)
+    }
+
     /// The TOML tree: the file with the overrides applied (what a run records as its
     /// settings).
     pub fn table(&self) -> &Table {

@@ -409,3 +409,53 @@ pub fn apply_overrides<S: AsRef<str>>(config: &mut Config, assignments: &[S]) ->
         .collect::<Result<Vec<_>, _>>()?;
     config.set_all(parsed)
 }
+
+/// The keys (of the schema and derived) closest to `key` in edit distance, best first: the
+/// "did you mean" of an unknown key (at most three, none farther than a third of its length).
+pub fn similar_keys(key: &str) -> Vec<String> {
+    let mut known = known_keys();
+    known.extend(DERIVED_KEYS.iter().map(|(k, _)| k.to_string()));
+    let limit = (key.chars().count() / 3).max(2);
+    let mut scored: Vec<(usize, String)> = known
+        .into_iter()
+        .map(|k| {
+            // The last part alone matches a key given without its section.
+            let tail = k.rsplit('.').next().unwrap_or(&k).to_string();
+            (edit_distance(key, &k).min(edit_distance(key, &tail)), k)
+        })
+        .filter(|(d, _)| *d <= limit)
+        .collect();
+    scored.sort();
+    scored.into_iter().take(3).map(|(_, k)| k).collect()
+}
+
+/// The Levenshtein distance between `a` and `b` (in characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut previous = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let substitution = previous + usize::from(ca != cb);
+            previous = row[j + 1];
+            row[j + 1] = substitution.min(row[j] + 1).min(previous + 1);
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn similar_keys_find_a_transposition_and_a_key_without_its_section() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(similar_keys("excitation.amplitdue")[0], "excitation.amplitude");
+        assert!(similar_keys("omega_ratoi").contains(&"omega_ratio".to_string()));
+        assert!(similar_keys("masses").contains(&"oscillator.masses".to_string()));
+        assert!(similar_keys("completely_unrelated_words").is_empty());
+    }
+}

@@ -40,8 +40,13 @@ pub fn log_spaced(min: f64, max: f64, n: usize) -> Vec<f64> {
         1 => vec![min],
         _ => {
             let (a, b) = (min.ln(), max.ln());
+            // The ends exactly (exp∘ln is not the identity in floating point).
             (0..n)
-                .map(|k| (a + (b - a) * k as f64 / (n - 1) as f64).exp())
+                .map(|k| match k {
+                    0 => min,
+                    k if k == n - 1 => max,
+                    k => (a + (b - a) * k as f64 / (n - 1) as f64).exp(),
+                })
                 .collect()
         }
     }

@@ -6,8 +6,10 @@
 //! the charge solver and the statistics together itself.
 
 mod chirp;
+pub mod limits;
 mod loads;
 mod lyapunov;
+mod mass_ratio;
 mod motion;
 mod observer;
 mod orbit;
@@ -18,6 +20,8 @@ mod run_motion;
 mod settings;
 mod settle;
 mod simulate;
+#[cfg(feature = "spice")]
+mod spice_export;
 
 pub use chirp::{
     ChirpError, ChirpOptions, ChirpRun, ChirpStudy, Cycle, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE,
@@ -25,6 +29,9 @@ pub use chirp::{
 };
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
+pub use mass_ratio::{
+    MassRatioOptimum, PAPER_MASS_RATIO_FIT, mass_ratio_optima, paper_mass_ratio_fit, refine_maximum,
+};
 pub use motion::{LabelSource, Motion, MotionReport, Window, classify, exponent_sign};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
@@ -40,3 +47,8 @@ pub use settle::{
     AutoSettle, DEFAULT_SETTLE_CAP, SettleEnding, SettleMode, Settled, ShotOrbit, UnknownSettleMode, settle,
 };
 pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};
+#[cfg(feature = "spice")]
+pub use spice_export::{
+    DEFAULT_SPICE_DT_FRACTION, DEFAULT_SPICE_PERIODS, SPICE_DATA_FILE, SpiceExport, SpiceExportError,
+    spice_check, spice_export,
+};
