@@ -47,6 +47,7 @@ mod branch;
 mod corrector;
 mod cross;
 mod locate;
+mod nordmark;
 mod phase;
 mod types;
 
