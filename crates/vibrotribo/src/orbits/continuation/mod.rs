@@ -44,6 +44,7 @@
 //! branches, corrector iterations, location steps and the step floor.
 
 mod branch;
+mod cascade;
 mod corrector;
 mod cross;
 mod locate;
@@ -52,6 +53,7 @@ mod phase;
 mod types;
 
 pub use branch::continue_orbit;
+pub use cascade::{cascade, feigenbaum_ratios};
 pub use types::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
     Crossing, CrossingKind, NordmarkScenario,
