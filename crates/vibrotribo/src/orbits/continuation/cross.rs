@@ -51,10 +51,15 @@ const SIDE_STEPS: [f64; 4] = [1e-6, 1e-5, 1e-4, 1e-3];
 /// Penetrations (or lifts) of the guesses moved along the gap gradient, in the length unit.
 pub(super) const PENETRATIONS: [f64; 4] = [1e-12, 1e-10, 1e-8, 1e-6];
 
-/// Most natural steps taken along the new sequence after a crossing (each twice the last).
+/// Most natural steps taken along the new sequence past a grazing of one minimum (each twice
+/// the last).
 const ONWARD_STEPS: i32 = 24;
 
-/// How far from the point the natural steps go, as a fraction of the range.
+/// Natural steps taken along the new sequence after a crossing without a square-root model
+/// of one grazing minimum (each four times the last).
+const FEW_ONWARD_STEPS: i32 = 5;
+
+/// How far from the point the natural steps past a grazing go, as a fraction of the range.
 const ONWARD_REACH: f64 = 2e-2;
 
 /// A gap minimum below this fraction of the length unit is taken as grazing.
@@ -261,33 +266,42 @@ fn crossed<F: Fn(f64) -> ChainParams>(
     (direction, kind): (f64, CrossingKind),
     (lo, hi): (f64, f64),
 ) -> Option<Bridged> {
-    // Away from the point along the new sequence by natural steps growing twofold (near a
-    // non-smooth fold the other orbit lies within the arclength corrector's reach; just past
-    // a grazing the orbit's multiplier grows like the inverse of its impact speed, and
-    // Newton's method needs the square root built in), predicted by the secant through the
-    // last two orbits, out to `ONWARD_REACH` of the range.
+    // Past a grazing of one minimum the steps start at the point and double; elsewhere (no
+    // square-root model, or several minima grazing together) they start at `after` and grow
+    // fourfold, from the last orbit.
+    let single = model.filter(|m| m.is_single());
     let keep = after.described.signature.clone();
     let p_edge = before.described.point.parameter;
-    let first = (after.described.point.parameter - p_edge).abs();
+    let p_after = after.described.point.parameter;
+    let first = (p_after - p_edge).abs();
+    let (origin, factor, steps) = match single {
+        Some(_) => (p_edge, 2f64, ONWARD_STEPS),
+        None => (p_after, 4f64, FEW_ONWARD_STEPS),
+    };
     let mut onward: Vec<StepPoint> = Vec::new();
-    for k in 1..=ONWARD_STEPS {
-        let p = p_edge + direction * first * 2f64.powi(k);
-        if p <= lo || p >= hi || (p - p_edge).abs() > ONWARD_REACH * problem.p_scale {
+    for k in 1..=steps {
+        let p = origin + direction * first * factor.powi(k);
+        if p <= lo || p >= hi || (single.is_some() && (p - p_edge).abs() > ONWARD_REACH * problem.p_scale) {
             break;
         }
         let last = onward.last().unwrap_or(&after);
-        let previous = match onward.len() {
-            0 => &before,
-            n if n >= 2 => &onward[n - 2],
-            _ => &after,
-        };
         let (z1, p1) = (problem.state(&last.ev.u), last.described.point.parameter);
-        let (z0, p0) = (problem.state(&previous.ev.u), previous.described.point.parameter);
-        let predicted = &z1 + (&z1 - &z0) * ((p - p1) / (p1 - p0));
         let s = last.described.point.arclength + (p - p1).abs() / problem.p_scale;
-        let found = orbit_keeping(problem, &predicted, p, s, &keep)
-            .or_else(|| model.and_then(|m| m.solve(problem, &predicted, p, s, &keep)))
-            .or_else(|| orbit_keeping(problem, &z1, p, s, &keep));
+        let found = match single {
+            Some(m) => {
+                let previous = match onward.len() {
+                    0 => &before,
+                    n if n >= 2 => &onward[n - 2],
+                    _ => &after,
+                };
+                let (z0, p0) = (problem.state(&previous.ev.u), previous.described.point.parameter);
+                let predicted = &z1 + (&z1 - &z0) * ((p - p1) / (p1 - p0));
+                orbit_keeping(problem, &predicted, p, s, &keep)
+                    .or_else(|| m.solve(problem, &predicted, p, s, &keep))
+                    .or_else(|| orbit_keeping(problem, &z1, p, s, &keep))
+            }
+            None => orbit_keeping(problem, &z1, p, s, &keep),
+        };
         match found {
             Some(o) => onward.push(o),
             None => break,

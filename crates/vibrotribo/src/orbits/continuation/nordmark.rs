@@ -213,6 +213,11 @@ impl SquareRootModel {
         Some(&self.z + &self.inverse * kick)
     }
 
+    /// Whether the edge grazes one gap minimum only (the case [`solve`](Self::solve) covers).
+    pub(super) fn is_single(&self) -> bool {
+        self.gaps.len() == 1
+    }
+
     /// The orbit at `p` with the event sequence `keep` that strikes the one grazing minimum,
     /// by Newton's method on `F(z) = φ(z) − z` with the square root of the normal form built
     /// in: at an iterate `z_k` whose flow strikes with speed `v_k`, so `w_k = v_k/κ = √(−h)`,
