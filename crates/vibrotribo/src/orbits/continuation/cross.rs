@@ -23,7 +23,10 @@
 //!    sequence of its starting point, so that it cannot fall onto the old orbit; on the
 //!    square-root branch it converges from the side of small penetration (the map is convex
 //!    there), which is why the guesses start shallow. The branch then goes on along the new
-//!    sequence by a few natural steps away from the point before the arclength takes over.
+//!    sequence by natural steps away from the point before the arclength takes over; past a
+//!    grazing of one gap minimum they are solved by Newton's method with the square root of
+//!    the normal form built in ([`SquareRootModel::solve`]), since there the orbit's largest
+//!    multiplier grows like the inverse of its impact speed.
 //!
 //! Feigin's rule for the square-root map (the new orbit has a multiplier that grows like the
 //! inverse of its impact speed) says which of the two happens: `det(Φ − I)` keeps its sign

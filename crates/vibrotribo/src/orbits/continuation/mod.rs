@@ -39,7 +39,9 @@
 //!
 //! Every location stops at [`ContinuationOptions::location_tolerance`] in the parameter. At
 //! a period doubling the doubled branch is started along the eigenvector of the multiplier
-//! −1 (the pitchfork of the doubled map) and followed in turn, to
+//! −1 (the pitchfork of the doubled map), made orthogonal to the parent branch's tangent so
+//! that the corrector cannot slide back along the parent, and followed in turn ([`cascade`]
+//! and [`feigenbaum_ratios`] read the cascade off the result), to
 //! [`ContinuationOptions::doubling_depth`] levels. Every loop is bounded: points per branch,
 //! branches, corrector iterations, location steps and the step floor.
 
