@@ -222,6 +222,26 @@ fn print_continuation(param: &str, result: &Continuation) {
             );
         }
     }
+    let cascade: Vec<f64> = vibrotribo::orbits::cascade(result)
+        .iter()
+        .map(|b| b.parameter)
+        .collect();
+    if cascade.len() >= 3 {
+        let ratios = vibrotribo::orbits::feigenbaum_ratios(&cascade);
+        println!(
+            "  cascade: period doublings at {param} = {}; Feigenbaum ratios {}",
+            cascade
+                .iter()
+                .map(|p| format!("{p:.10}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            ratios
+                .iter()
+                .map(|r| format!("{r:.4}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
 }
 
 fn multipliers_text(p: &BranchPoint) -> String {
@@ -363,10 +383,23 @@ fn write_files(
             "mechanics_only": args.mechanics_only,
             "branches": branches,
             "bifurcations": listed,
+            "cascade": cascade_json(result),
             "settings": config.table(),
             "vibrotribo_version": env!("CARGO_PKG_VERSION"),
         }),
     )
+}
+
+/// The cascade of period doublings from the first branch and its Feigenbaum ratios.
+fn cascade_json(result: &Continuation) -> serde_json::Value {
+    let points: Vec<f64> = vibrotribo::orbits::cascade(result)
+        .iter()
+        .map(|b| b.parameter)
+        .collect();
+    json!({
+        "period_doublings": points,
+        "feigenbaum_ratios": vibrotribo::orbits::feigenbaum_ratios(&points),
+    })
 }
 
 fn bifurcation_json(branch: usize, f: &Bifurcation) -> serde_json::Value {

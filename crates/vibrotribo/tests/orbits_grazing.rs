@@ -171,11 +171,11 @@ fn the_impact_oscillator_grazing_is_located_and_crossed() {
     assert!(after.parameter < grazing);
 }
 
-/// The same branch followed on down to Ω = 2.4: the impact speeds against the closed form,
-/// their linear vanishing at the grazing, and the (1,1) orbit's period doubling. Ignored: the
-/// branch stops at the step floor about 1e-5 past the grazing on the impacting side.
+/// The same branch followed on down towards Ω = 2.4 through the grazing (where the orbit's
+/// multiplier grows like the inverse of its impact speed): the impact speeds against the
+/// closed form, their linear vanishing at the grazing, and the (1,1) orbit's period doubling,
+/// where the branch ends (no doubled branch asked for).
 #[test]
-#[ignore = "the branch stops at the step floor just past the grazing of the impact oscillator"]
 fn the_impact_oscillator_branch_goes_on_to_its_period_doubling() {
     let grazing = closed_form_grazing();
     let io = textbook(3.6);
@@ -207,8 +207,9 @@ fn the_impact_oscillator_branch_goes_on_to_its_period_doubling() {
             .collect::<Vec<_>>(),
         main.end
     );
+    let pd_at = first(main, |k| *k == BifurcationKind::PeriodDoubling).map(|b| b.parameter);
     assert!(
-        matches!(main.end, BranchEnd::RangeEnd { parameter } if (parameter - 2.4).abs() < 1e-9),
+        matches!(main.end, BranchEnd::CascadeDepth { parameter } if Some(parameter) == pd_at),
         "{:?}",
         main.end
     );
@@ -578,5 +579,83 @@ fn check_orbit(params: &ChainParams, state: &ChainState, period: u32) {
         for g in gaps(params, &samples.positions[j * n..(j + 1) * n], *t) {
             assert!(g >= -1e-12, "gap {g:e} m at t = {t}");
         }
+    }
+}
+
+/// The stroboscopic period (1, 2, 4, … 64) the impact oscillator settles to at Ω from `state`
+/// after a long transient, by direct simulation; `None` if none repeats to 1e-9 m.
+fn brute_force_period(omega_ratio: f64, state: &ChainState) -> Option<usize> {
+    let params = oscillator(omega_ratio, GAP);
+    let mut sim = Simulator::new(&params, state, SimOptions::default()).unwrap();
+    let t = params.period();
+    sim.run_until(6000.0 * t, &mut ()).unwrap();
+    let mut x = Vec::new();
+    for k in 1..=256 {
+        sim.run_until((6000.0 + f64::from(k)) * t, &mut ()).unwrap();
+        x.push(sim.state().positions[0]);
+    }
+    [1, 2, 4, 8, 16, 32, 64]
+        .into_iter()
+        .find(|&p| (0..x.len() - p).all(|i| (x[i] - x[i + p]).abs() < 1e-9))
+}
+
+/// The impact oscillator's cascade followed from its impact-free orbit through the grazing:
+/// period 1 → 2 → 4 → 8 → 16, each doubled branch switched onto and followed. Every located
+/// doubling is where the brute-force period (direct simulation from the branch's orbit, after a
+/// long transient) doubles: on the side before it the period is that of the branch, on the
+/// side after it twice that. The Feigenbaum ratios of the located points shrink the intervals
+/// geometrically (they approach 4.669 only asymptotically).
+#[test]
+fn the_impact_oscillators_cascade_is_followed_and_each_doubling_is_where_the_brute_force_period_doubles() {
+    let io = textbook(3.6);
+    let (x, v) = io.xp(0.0);
+    let start = ChainState {
+        positions: vec![x],
+        velocities: vec![v],
+    };
+    let options = ContinuationOptions {
+        doubling_depth: 4,
+        max_points: 400,
+        ..ContinuationOptions::default()
+    };
+    let result = continue_orbit(
+        "omega_ratio",
+        |w| oscillator(w, GAP),
+        3.6,
+        2.4,
+        &start,
+        1,
+        &options,
+    )
+    .unwrap();
+    let chain = vibrotribo::orbits::cascade(&result);
+    let points: Vec<f64> = chain.iter().map(|b| b.parameter).collect();
+    let ratios = vibrotribo::orbits::feigenbaum_ratios(&points);
+    println!("cascade at {points:?}, Feigenbaum ratios {ratios:?}");
+    assert!(points.len() >= 4, "{points:?}");
+    assert!((points[0] - 2.4551988).abs() < 1e-6 && (points[1] - 2.4861677).abs() < 1e-6);
+    for r in &ratios {
+        assert!(*r > 2.0 && r.is_finite(), "ratios {ratios:?}");
+    }
+    // Brute force on each side of each located doubling, a fifth of the way to its
+    // neighbours, from the orbit at the point.
+    for (k, b) in chain.iter().enumerate() {
+        let p = b.parameter;
+        let below = if k == 0 {
+            0.2 * (points[1] - p)
+        } else {
+            0.2 * (p - points[k - 1])
+        };
+        let above = match points.get(k + 1) {
+            Some(q) => 0.2 * (q - p),
+            None => 0.2 * (p - points[k - 1]) / 4.669,
+        };
+        let period = 1usize << k;
+        let sign = (points[1] - points[0]).signum();
+        let before = brute_force_period(p - sign * below, &b.point.state);
+        let after = brute_force_period(p + sign * above, &b.point.state);
+        println!("doubling {k} at {p}: brute-force period {before:?} before, {after:?} after");
+        assert_eq!(before, Some(period), "before the doubling at {p}");
+        assert_eq!(after, Some(2 * period), "after the doubling at {p}");
     }
 }

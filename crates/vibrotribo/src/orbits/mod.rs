@@ -57,7 +57,7 @@ mod shooting;
 
 pub use continuation::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
-    Crossing, CrossingKind, NordmarkScenario, continue_orbit,
+    Crossing, CrossingKind, NordmarkScenario, cascade, continue_orbit, feigenbaum_ratios,
 };
 pub use error::{NewtonFailure, OrbitError};
 pub use floquet::floquet_multipliers;

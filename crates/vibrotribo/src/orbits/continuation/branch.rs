@@ -35,6 +35,8 @@ enum Start {
     Doubling {
         u: DVector<f64>,
         direction: DVector<f64>,
+        /// The parent branch's unit tangent there (scaled).
+        parent: DVector<f64>,
     },
 }
 
@@ -54,6 +56,8 @@ struct Doubling {
     phase: f64,
     u: DVector<f64>,
     direction: DVector<f64>,
+    /// The branch's unit tangent at the point (scaled).
+    tangent: DVector<f64>,
 }
 
 /// Pseudo-arclength continuation of the periodic orbit of period `period` near `guess` at
@@ -156,6 +160,7 @@ where
                 start: Start::Doubling {
                     u: d.u,
                     direction: d.direction,
+                    parent: d.tangent,
                 },
             });
         }
@@ -191,13 +196,24 @@ fn start<F: Fn(f64) -> ChainParams>(
                 t,
             ))
         }
-        Start::Doubling { u, direction } => {
+        Start::Doubling { u, direction, parent } => {
             // The pitchfork of the doubled map: its new branch leaves along the critical
-            // eigenvector with the parameter stationary. A step too short may fall back onto
-            // the orbit of the parent's period, one too long leave the corrector's reach:
-            // from 1/16 of the first step up to 64 times it.
+            // eigenvector with the parameter stationary. The step and the corrector's plane
+            // are taken orthogonal to the parent branch's tangent, so that the corrector
+            // cannot slide along the parent branch (which crosses a plane normal to the
+            // eigenvector alone a short way off when the doubled branch is flat). A step too
+            // short may still fall back onto the orbit of the parent's period, one too long
+            // leave the corrector's reach: from 1/16 of the first step up to 64 times it, then
+            // down to 1/1024 of it (deep in a cascade the doubled branches are small).
+            let across = direction - parent * parent.dot(direction);
+            let direction = if across.norm() > 1e-3 {
+                across.normalize()
+            } else {
+                direction.clone()
+            };
+            let direction = &direction;
             let mut last = None;
-            for k in -2..4 {
+            for k in [-2, -1, 0, 1, 2, 3, -3, -4, -5] {
                 let ds = problem.options.initial_step * 4f64.powi(k);
                 let step = Step {
                     base: u,
@@ -638,6 +654,7 @@ fn detect<F: Fn(f64) -> ChainParams>(
                             phase: problem.phase,
                             u: l.point.ev.u.clone(),
                             direction,
+                            tangent: t_base.clone(),
                         }
                     })
             } else {

@@ -164,7 +164,7 @@ impl<F: Fn(f64) -> ChainParams> Problem<'_, F> {
             })?;
             let r = ev.residual.amax();
             residuals.push(r);
-            if r <= self.options.corrector_tolerance {
+            if r <= self.options.corrector_tolerance.max(rounding_floor(&ev.jacobian)) {
                 ev.iterations = residuals.len() - 1;
                 return Ok(ev);
             }
@@ -250,6 +250,17 @@ impl<F: Fn(f64) -> ChainParams> Problem<'_, F> {
         })
     }
 }
+
+/// The smallest scaled residual the map can be evaluated to near `jacobian` (scaled, either
+/// `Φ` or `Φ − I` and its parameter column): rounding in the state is amplified by the map's
+/// largest derivative, which grows like the inverse of the impact speed just past a grazing.
+/// At most [`ROUNDING_CAP`], and below every tolerance away from grazing.
+pub(crate) fn rounding_floor(jacobian: &DMatrix<f64>) -> f64 {
+    (4.0 * f64::EPSILON * jacobian.amax()).min(ROUNDING_CAP)
+}
+
+/// The largest residual (scaled) taken as converged where the map amplifies rounding.
+const ROUNDING_CAP: f64 = 1e-10;
 
 /// A converged point with what the detection needs.
 #[derive(Debug, Clone)]

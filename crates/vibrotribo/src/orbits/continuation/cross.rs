@@ -23,21 +23,25 @@
 //!    sequence of its starting point, so that it cannot fall onto the old orbit; on the
 //!    square-root branch it converges from the side of small penetration (the map is convex
 //!    there), which is why the guesses start shallow. The branch then goes on along the new
-//!    sequence by a few natural steps away from the point before the arclength takes over.
+//!    sequence by natural steps away from the point before the arclength takes over; past a
+//!    grazing of one gap minimum they are solved by Newton's method with the square root of
+//!    the normal form built in ([`SquareRootModel::solve`]), since there the orbit's largest
+//!    multiplier grows like the inverse of its impact speed.
 //!
 //! Feigin's rule for the square-root map (the new orbit has a multiplier that grows like the
 //! inverse of its impact speed) says which of the two happens: `det(Φ − I)` keeps its sign
 //! across a persistence and changes it across a non-smooth fold; the kind recorded is the
 //! one found.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::corrector::Problem;
 use super::locate::{MAX_LOCATE, StepPoint};
+use super::nordmark::SquareRootModel;
 use super::types::CrossingKind;
 use crate::dynamics::EventKind;
 use crate::model::ChainParams;
-use crate::orbits::gaps::{gap_gradient, gap_minima, smallest_gap_minimum};
+use crate::orbits::gaps::{gap_gradient, smallest_gap_minimum};
 use crate::orbits::map::{chatter_bounces, evaluate, signature};
 use crate::orbits::shooting::newton_within;
 
@@ -48,16 +52,21 @@ const FORWARD_TRIES: i32 = 8;
 const SIDE_STEPS: [f64; 4] = [1e-6, 1e-5, 1e-4, 1e-3];
 
 /// Penetrations (or lifts) of the guesses moved along the gap gradient, in the length unit.
-const PENETRATIONS: [f64; 4] = [1e-12, 1e-10, 1e-8, 1e-6];
+pub(super) const PENETRATIONS: [f64; 4] = [1e-12, 1e-10, 1e-8, 1e-6];
 
-/// Penetration, in the length unit, at which the square-root term of the map is measured.
-const PROBE_PENETRATION: f64 = 1e-10;
+/// Most natural steps taken along the new sequence past a grazing of one minimum (each twice
+/// the last).
+const ONWARD_STEPS: i32 = 24;
 
-/// Natural steps taken along the new sequence after a crossing (each four times the last).
-const ONWARD_STEPS: i32 = 5;
+/// Natural steps taken along the new sequence after a crossing without a square-root model
+/// of one grazing minimum (each four times the last).
+const FEW_ONWARD_STEPS: i32 = 5;
+
+/// How far from the point the natural steps past a grazing go, as a fraction of the range.
+const ONWARD_REACH: f64 = 2e-2;
 
 /// A gap minimum below this fraction of the length unit is taken as grazing.
-const NEAR_GRAZING: f64 = 1e-4;
+pub(super) const NEAR_GRAZING: f64 = 1e-4;
 
 /// The change of sequence crossed.
 pub(crate) struct Crossed {
@@ -167,7 +176,14 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                         o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
                     })
                 {
-                    return crossed(problem, ok, o, precision, sigma, kind, (lo, hi));
+                    return crossed(
+                        problem,
+                        (ok, o),
+                        model.as_ref(),
+                        precision,
+                        (sigma, kind),
+                        (lo, hi),
+                    );
                 }
             }
         }
@@ -176,7 +192,7 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
 }
 
 /// The orbit at `p` with the event sequence `keep`, from `z` (Newton's method held to it).
-fn orbit_keeping<F: Fn(f64) -> ChainParams>(
+pub(super) fn orbit_keeping<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
     z: &DVector<f64>,
     p: f64,
@@ -204,7 +220,7 @@ fn orbit_keeping<F: Fn(f64) -> ChainParams>(
 }
 
 /// The event sequence of an evaluation over one period (events before `end`).
-fn sequence(events: &[crate::dynamics::Event], end: f64) -> Vec<(EventKind, usize)> {
+pub(super) fn sequence(events: &[crate::dynamics::Event], end: f64) -> Vec<(EventKind, usize)> {
     let events: Vec<_> = events.iter().filter(|ev| ev.time < end).copied().collect();
     signature(&events)
 }
@@ -247,27 +263,49 @@ fn along<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, direction: f64) ->
 
 fn crossed<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
-    before: StepPoint,
-    after: StepPoint,
+    (before, after): (StepPoint, StepPoint),
+    model: Option<&SquareRootModel>,
     precision: f64,
-    direction: f64,
-    kind: CrossingKind,
+    (direction, kind): (f64, CrossingKind),
     (lo, hi): (f64, f64),
 ) -> Option<Bridged> {
-    // Away from the point along the new sequence by natural steps growing fourfold (near a
-    // non-smooth fold the other orbit lies within the arclength corrector's reach).
+    // Past a grazing of one minimum the steps start at the point and double; elsewhere (no
+    // square-root model, or several minima grazing together) they start at `after` and grow
+    // fourfold, from the last orbit.
+    let single = model.filter(|m| m.is_single());
     let keep = after.described.signature.clone();
-    let p0 = after.described.point.parameter;
-    let first = (p0 - before.described.point.parameter).abs();
+    let p_edge = before.described.point.parameter;
+    let p_after = after.described.point.parameter;
+    let first = (p_after - p_edge).abs();
+    let (origin, factor, steps) = match single {
+        Some(_) => (p_edge, 2f64, ONWARD_STEPS),
+        None => (p_after, 4f64, FEW_ONWARD_STEPS),
+    };
     let mut onward: Vec<StepPoint> = Vec::new();
-    for k in 1..=ONWARD_STEPS {
-        let p = p0 + direction * first * 4f64.powi(k);
-        if p <= lo || p >= hi {
+    for k in 1..=steps {
+        let p = origin + direction * first * factor.powi(k);
+        if p <= lo || p >= hi || (single.is_some() && (p - p_edge).abs() > ONWARD_REACH * problem.p_scale) {
             break;
         }
         let last = onward.last().unwrap_or(&after);
-        let s = last.described.point.arclength + (p - last.described.point.parameter).abs() / problem.p_scale;
-        match orbit_keeping(problem, &problem.state(&last.ev.u), p, s, &keep) {
+        let (z1, p1) = (problem.state(&last.ev.u), last.described.point.parameter);
+        let s = last.described.point.arclength + (p - p1).abs() / problem.p_scale;
+        let found = match single {
+            Some(m) => {
+                let previous = match onward.len() {
+                    0 => &before,
+                    n if n >= 2 => &onward[n - 2],
+                    _ => &after,
+                };
+                let (z0, p0) = (problem.state(&previous.ev.u), previous.described.point.parameter);
+                let predicted = &z1 + (&z1 - &z0) * ((p - p1) / (p1 - p0));
+                orbit_keeping(problem, &predicted, p, s, &keep)
+                    .or_else(|| m.solve(problem, &predicted, p, s, &keep))
+                    .or_else(|| orbit_keeping(problem, &z1, p, s, &keep))
+            }
+            None => orbit_keeping(problem, &z1, p, s, &keep),
+        };
+        match found {
             Some(o) => onward.push(o),
             None => break,
         }
@@ -345,191 +383,4 @@ fn guesses<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, edge: &StepPoint
         }
     }
     out
-}
-
-/// The map near a grazing of the edge orbit `z*` at `p*`, approached without the impacts
-/// (Nordmark's normal form, linearised, with one term per grazing gap minimum j, several when
-/// a symmetric orbit grazes two contacts at once): `P(z, p) = z* + A(z − z*) + b Δp +
-/// Σ_j E_j √(−h_j(z, p))` over the minima the flow strikes (`h_j < 0`), with
-/// `h_j(z, p) = g_j + c_jᵀ(z − z*) + d_j Δp` the gap minimum of the smooth flow. A fixed
-/// point striking the set S has `z − z* = (I − A)⁻¹(b Δp + Σ_S E_k w_k)`, `w_k = √(−h_k)`, so
-/// `w_j² + Σ_S β_jk w_k + g_j + α_j Δp = 0` (j ∈ S) with `β_jk = c_jᵀ(I − A)⁻¹E_k` and
-/// `α_j = dg_j/dp` along the branch without the impacts. For one minimum this is Feigin's
-/// rule: for β > 0 the root w > 0 lies on the side where that branch would penetrate (a
-/// persistence), for β < 0 on its own side (a non-smooth fold).
-struct SquareRootModel {
-    z: DVector<f64>,
-    inverse: DMatrix<f64>,
-    b: DVector<f64>,
-    /// Per grazing minimum: g_j, α_j, E_j, c_j.
-    gaps: Vec<f64>,
-    alphas: Vec<f64>,
-    e: Vec<DVector<f64>>,
-    c: Vec<DVector<f64>>,
-    /// Moves of the state that change one gap minimum by a metre and leave the others.
-    units: Vec<DVector<f64>>,
-    length: f64,
-}
-
-/// Gap minima within this factor of the smallest (plus a floor) graze together.
-const TOGETHER: f64 = 10.0;
-
-impl SquareRootModel {
-    /// The model at `edge`, with `behind` (an orbit of the same sequence a little before it)
-    /// for the rates α; `None` if the edge is not a grazing without the impacts.
-    fn new<F: Fn(f64) -> ChainParams>(
-        problem: &Problem<'_, F>,
-        edge: &StepPoint,
-        behind: &StepPoint,
-    ) -> Option<Self> {
-        let p = edge.described.point.parameter;
-        let params = (problem.family)(p);
-        let opts = &problem.options.shooting;
-        let length = problem.scale.length;
-        let z = problem.state(&edge.ev.u);
-        let minima = gap_minima(&params, &z, problem.period, problem.phase, &opts.sim);
-        let smallest = minima.iter().map(|m| m.gap).fold(f64::INFINITY, f64::min);
-        if smallest.is_nan() || smallest >= NEAR_GRAZING * length {
-            return None;
-        }
-        let grazing: Vec<_> = minima
-            .into_iter()
-            .filter(|m| m.gap <= TOGETHER * smallest.max(0.0) + 1e-12 * length)
-            .take(3)
-            .collect();
-        let p_b = behind.described.point.parameter;
-        let before = gap_minima(
-            &(problem.family)(p_b),
-            &problem.state(&behind.ev.u),
-            problem.period,
-            problem.phase,
-            &opts.sim,
-        );
-        let period = params.period();
-        let mut alphas = Vec::new();
-        let mut c = Vec::new();
-        for m in &grazing {
-            // The same minimum behind: same contact, nearest in time.
-            let b = before
-                .iter()
-                .filter(|b| b.contact == m.contact && (b.time - m.time).abs() < 0.05 * period)
-                .min_by(|x, y| (x.time - m.time).abs().total_cmp(&(y.time - m.time).abs()))?;
-            alphas.push((m.gap - b.gap) / (p - p_b));
-            c.push(gap_gradient(
-                &params,
-                &z,
-                problem.phase,
-                m.contact,
-                m.time,
-                &opts.sim,
-                &opts.sensitivity,
-            )?);
-        }
-        let a = edge.ev.eval.stm.as_ref().ok()?;
-        let dim = z.len();
-        let inverse = (DMatrix::identity(dim, dim) - a).try_inverse()?;
-        let n = problem.n;
-        let s = |i: usize| problem.scale.of_component(i, n);
-        let b = DVector::from_fn(dim, |i, _| edge.ev.jacobian[(i, dim)] * s(i) / problem.p_scale);
-        // Directions that move one gap minimum by a metre and leave the others (minimum
-        // norm in the scaled units): U = D²Cᵀ(C D² Cᵀ)⁻¹.
-        let k = grazing.len();
-        let cs = DMatrix::from_fn(k, dim, |j, i| c[j][i] * s(i));
-        let gram = (&cs * cs.transpose()).try_inverse()?;
-        let units: Vec<DVector<f64>> = (0..k)
-            .map(|j| {
-                let col = cs.transpose() * gram.column(j);
-                DVector::from_fn(dim, |i, _| col[i] * s(i))
-            })
-            .collect();
-        // E_j from one evaluation of the map at a state whose flow penetrates minimum j by η
-        // and clears the others by η.
-        let eta = PROBE_PENETRATION * length;
-        let mut e = Vec::new();
-        for (j, m) in grazing.iter().enumerate() {
-            let mut dz = &units[j] * -(m.gap + eta);
-            for (l, other) in grazing.iter().enumerate() {
-                if l != j {
-                    dz += &units[l] * (eta - other.gap.min(0.0));
-                }
-            }
-            let probe = &z + &dz;
-            let image = evaluate(
-                &params,
-                &probe,
-                problem.period,
-                problem.phase,
-                &opts.sim,
-                &opts.sensitivity,
-            )
-            .ok()?;
-            let struck = image
-                .events
-                .iter()
-                .any(|ev| ev.kind == EventKind::Impact && ev.contact == m.contact);
-            if !struck {
-                return None;
-            }
-            e.push((image.image - &edge.ev.eval.image - a * dz) / eta.sqrt());
-        }
-        Some(SquareRootModel {
-            z,
-            inverse,
-            b,
-            gaps: grazing.iter().map(|m| m.gap).collect(),
-            alphas,
-            e,
-            c,
-            units,
-            length,
-        })
-    }
-
-    /// The predicted fixed points at `p* + dp` that strike a nonempty set of the grazing
-    /// minima (all together first).
-    fn guesses(&self, dp: f64) -> Vec<DVector<f64>> {
-        let k = self.gaps.len();
-        let mut sets: Vec<u32> = (1..(1u32 << k)).collect();
-        sets.sort_by_key(|s| std::cmp::Reverse(s.count_ones()));
-        let mut out = Vec::new();
-        for set in sets {
-            let Some(z) = self.strike(set, dp) else { continue };
-            // The prediction, and the same pressed a little deeper into the contacts in case
-            // its flow misses them (the penetration is second order in Δp).
-            let press: DVector<f64> = (0..k)
-                .filter(|j| set & (1 << j) != 0)
-                .fold(DVector::zeros(z.len()), |acc, j| acc - &self.units[j]);
-            out.push(z.clone());
-            for eta in PENETRATIONS {
-                out.push(&z + &press * (eta * self.length));
-            }
-        }
-        out
-    }
-
-    /// The fixed point striking the minima in `set` (a bit mask), by Newton's method on the
-    /// small system for w from its linear solution; `None` unless every w > 0.
-    fn strike(&self, set: u32, dp: f64) -> Option<DVector<f64>> {
-        let idx: Vec<usize> = (0..self.gaps.len()).filter(|j| set & (1 << j) != 0).collect();
-        let m = idx.len();
-        let beta = DMatrix::from_fn(m, m, |r, q| {
-            self.c[idx[r]].dot(&(&self.inverse * &self.e[idx[q]]))
-        });
-        let rhs = DVector::from_fn(m, |r, _| -(self.gaps[idx[r]] + self.alphas[idx[r]] * dp));
-        let mut w = beta.clone().lu().solve(&rhs)?;
-        for _ in 0..30 {
-            let f = DVector::from_fn(m, |r, _| w[r] * w[r]) + &beta * &w - &rhs;
-            let j = &beta + DMatrix::from_diagonal(&(&w * 2.0));
-            let step = j.lu().solve(&f)?;
-            w -= step;
-        }
-        if w.iter().any(|v| v.is_nan() || *v <= 0.0) {
-            return None;
-        }
-        let mut kick = &self.b * dp;
-        for (r, &j) in idx.iter().enumerate() {
-            kick += &self.e[j] * w[r];
-        }
-        Some(&self.z + &self.inverse * kick)
-    }
 }

@@ -39,18 +39,23 @@
 //!
 //! Every location stops at [`ContinuationOptions::location_tolerance`] in the parameter. At
 //! a period doubling the doubled branch is started along the eigenvector of the multiplier
-//! −1 (the pitchfork of the doubled map) and followed in turn, to
+//! −1 (the pitchfork of the doubled map), made orthogonal to the parent branch's tangent so
+//! that the corrector cannot slide back along the parent, and followed in turn ([`cascade`]
+//! and [`feigenbaum_ratios`] read the cascade off the result), to
 //! [`ContinuationOptions::doubling_depth`] levels. Every loop is bounded: points per branch,
 //! branches, corrector iterations, location steps and the step floor.
 
 mod branch;
+mod cascade;
 mod corrector;
 mod cross;
 mod locate;
+mod nordmark;
 mod phase;
 mod types;
 
 pub use branch::continue_orbit;
+pub use cascade::{cascade, feigenbaum_ratios};
 pub use types::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
     Crossing, CrossingKind, NordmarkScenario,
