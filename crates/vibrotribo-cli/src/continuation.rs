@@ -518,7 +518,7 @@ pub fn plot_branches(
         }
     }
     // Bifurcations: a marker per kind on the branch, at each section point of its orbit.
-    let mut marks: Vec<(&'static str, Shape, usize, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut marks: Vec<Marks> = Vec::new();
     for b in &result.branches {
         for f in &b.bifurcations {
             let (label, shape, colour) = marker_of(&f.kind);
@@ -608,6 +608,10 @@ fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Leg
         Legend::UpperRight
     }
 }
+
+/// The bifurcations of one kind on a picture: legend entry, marker shape, palette colour, and
+/// the points (parameter, section position).
+type Marks = (&'static str, Shape, usize, Vec<f64>, Vec<f64>);
 
 /// The legend entry, marker shape and palette colour of a bifurcation's kind.
 fn marker_of(kind: &BifurcationKind) -> (&'static str, Shape, usize) {

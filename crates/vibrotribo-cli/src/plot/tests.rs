@@ -322,7 +322,7 @@ fn titles_shrink_then_shorten_to_fit() {
     let long = "x".repeat(80);
     let (text, px) = fitted_title(&long, 80 * 11, width);
     assert_eq!(text, long, "fits at a smaller size");
-    assert!(px < TITLE_PX && px >= TITLE_MIN_PX && width(&text, px) <= 80 * 11);
+    assert!((TITLE_MIN_PX..TITLE_PX).contains(&px) && width(&text, px) <= 80 * 11);
     let (text, px) = fitted_title(&long, 300, width);
     assert_eq!(px, TITLE_MIN_PX);
     assert!(text.ends_with('…') && width(&text, px) <= 300, "{text}");
