@@ -15,7 +15,7 @@ def wait_power(page, previous=None):
         """prev => {
             const v = document.querySelector('[data-testid="power-value"]').dataset.value;
             const idle = document.querySelector('[data-testid="status"]').dataset.state === 'idle';
-            return v !== '' && idle && v !== prev;
+            return v !== '' && idle && Number(v) !== prev;
         }""",
         arg=previous,
     )
@@ -35,7 +35,7 @@ def test_changing_omega_follows_the_cli(page, artefacts):
     field = page.get_by_test_id("param-excitation.omega_ratio")
     field.fill("0.8")
     field.press("Enter")
-    after = wait_power(page, str(before))
+    after = wait_power(page, before)
     assert after == cli_power("--set", "excitation.omega_ratio=0.8")
     assert "0.8" in page.url or "omega_ratio" in page.url  # the state is in the URL
     page.screenshot(path=str(artefacts / "omega-0.8.png"), full_page=True)
@@ -61,7 +61,8 @@ def orbit_points(page):
 
 def wait_orbit_done(page):
     page.wait_for_function(
-        "() => /values in/.test(document.querySelector('[data-testid=\"orbit-progress\"]').textContent)"
+        "() => document.querySelector('[data-testid=\"orbit-diagram\"]').dataset.state === 'idle'"
+        " && /values in/.test(document.querySelector('[data-testid=\"orbit-progress\"]').textContent)"
     )
 
 
@@ -88,6 +89,7 @@ def test_orbit_diagram_zoom_and_click(page, artefacts):
         "() => Number(document.querySelector('[data-testid=\"orbit-from\"]').value) > 0.5"
     )
     wait_orbit_done(page)
+    box = over.bounding_box()
     lo = float(page.get_by_test_id("orbit-from").input_value())
     hi = float(page.get_by_test_id("orbit-to").input_value())
     assert 0.5 < lo < hi < 1.0, (lo, hi)
@@ -103,7 +105,7 @@ def test_orbit_diagram_zoom_and_click(page, artefacts):
     )
     value = page.get_by_test_id("param-excitation.omega_ratio").input_value()
     assert float(value) in xs
-    after = wait_power(page, str(before))
+    after = wait_power(page, before)
     assert after == cli_power("--set", f"excitation.omega_ratio={value}")
     page.screenshot(path=str(artefacts / "orbit-clicked.png"), full_page=True)
 
@@ -113,7 +115,7 @@ def test_exported_toml_runs_to_the_same_power(page, artefacts, tmp_path):
     field = page.get_by_test_id("param-harvester.load_resistance")
     field.fill("3e6")
     field.press("Enter")
-    power = wait_power(page, str(before))
+    power = wait_power(page, before)
     with page.expect_download() as download:
         page.get_by_test_id("export-toml").click()
     path = tmp_path / "exported.toml"

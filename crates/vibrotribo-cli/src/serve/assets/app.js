@@ -119,7 +119,7 @@ function buildParams() {
     input.dataset.testid = "param-" + k.key;
     input.dataset.key = k.key;
     input.value = state.set[k.key] ?? k.value ?? "";
-    input.placeholder = k.default ?? k.absent;
+    input.placeholder = (k.default ?? k.absent).replace(/[`"]/g, "");
     input.title = label.title;
     if (k.given || k.key in state.set) input.classList.add("given");
     if (k.choices.length) {
@@ -179,6 +179,16 @@ function setParam(key, value) {
   updateCommand();
 }
 
+// Axis labels of numbers of any size (a power of 1e-5 W is not 0).
+function tickValues(u, values) {
+  return values.map((v) => {
+    if (v == null) return "";
+    const a = Math.abs(v);
+    return a !== 0 && (a < 1e-2 || a >= 1e5) ? v.toExponential(1) : String(+v.toPrecision(4));
+  });
+}
+const AXES = [{}, { values: tickValues, size: 60 }];
+
 // ---- run view -----------------------------------------------------------------------------
 
 let runTimer = null;
@@ -221,7 +231,7 @@ function lineChart(id, title, x, columns, labels, extra) {
     series.push(extra.series);
   }
   const opts = {
-    title, width: 520, height: 220, scales: { x: { time: false } }, series,
+    title, width: 520, height: 220, scales: { x: { time: false } }, series, axes: AXES,
     legend: { show: true }, cursor: { drag: { x: true, y: false } },
   };
   const aligned = extra ? uPlot.join([data, extra.data]) : data;
@@ -266,7 +276,7 @@ function showRun(view) {
   charts.phase = new uPlot({
     title: "phase portrait of m1 after the transient", mode: 2, width: 520, height: 220,
     scales: { x: { time: false } },
-    axes: [{ label: "x1 (m)" }, { label: "v1 (m/s)" }],
+    axes: [{ label: "x1 (m)", values: tickValues }, { label: "v1 (m/s)", values: tickValues, size: 60 }],
     series: [{}, { label: "m1", stroke: COLORS[0], fill: COLORS[0], paths: uPlot.paths.points(),
       points: { show: false, size: 2, width: 0 } }],
     legend: { show: false },
@@ -317,7 +327,7 @@ function drawOrbit() {
     mode: 2, width: 1060, height: 380,
     scales: { x: { time: false, auto: !range, range: range ? [range.x0, range.x1] : undefined },
       y: { auto: !range || range.y0 == null, range: range && range.y0 != null ? [range.y0, range.y1] : undefined } },
-    axes: [{ label: param }, { label: "x at t = nT (m)" }],
+    axes: [{ label: param, values: tickValues }, { label: "x at t = nT (m)", values: tickValues, size: 60 }],
     series,
     cursor: { drag: { x: true, y: true, setScale: false } },
     hooks: { setSelect: [onOrbitSelect] },
@@ -350,8 +360,9 @@ function attachOrbitClick(el) {
     const moved = Math.hypot(e.clientX - down[0], e.clientY - down[1]);
     down = null;
     if (moved > 3 || orbitPoints.length === 0) return;
-    const left = orbitChart.cursor.left;
-    if (left == null || left < 0) return;
+    const rect = orbitChart.over.getBoundingClientRect();
+    const left = e.clientX - rect.left;
+    if (left < 0 || left > rect.width || e.clientY < rect.top || e.clientY > rect.bottom) return;
     const v = orbitChart.posToVal(left, "x");
     let best = orbitPoints[0];
     for (const p of orbitPoints) if (Math.abs(p.x - v) < Math.abs(best.x - v)) best = p;
@@ -375,6 +386,8 @@ async function computeOrbit(whole) {
     recorded: f.recorded === "" ? null : parseInt(f.recorded, 10),
   };
   const progress = document.getElementById("orbit-progress");
+  progress.textContent = "computing…";
+  document.getElementById("orbit-diagram").dataset.state = "busy";
   orbitPoints = [];
   let total = 0, last = 0;
   setBusy("orbit", "orbit diagram");
@@ -400,7 +413,10 @@ async function computeOrbit(whole) {
   } catch (e) {
     if (e.name !== "AbortError") progress.textContent = "error: " + e.message;
   } finally {
-    if (abort === orbitAbort) setBusy("orbit", null);
+    if (abort === orbitAbort) {
+      setBusy("orbit", null);
+      document.getElementById("orbit-diagram").dataset.state = "idle";
+    }
   }
 }
 
@@ -429,7 +445,7 @@ function gridView(id, colorOf) {
     view.chart = new uPlot({
       mode: 2, width: 520, height: 400,
       scales: { x: { time: false, auto: false, range: xr }, y: { auto: false, range: yr } },
-      axes: [{ label: view.xKey }, { label: view.yKey }],
+      axes: [{ label: view.xKey, values: tickValues }, { label: view.yKey, values: tickValues, size: 60 }],
       series: [{}, { label: "cells", paths: () => null, points: { show: false } }],
       legend: { show: false },
       hooks: {
@@ -477,6 +493,7 @@ async function computeGrid(view, path, formId, key, progressId, onDone) {
     recorded: f.recorded === "" ? null : parseInt(f.recorded, 10),
   };
   const progress = document.getElementById(progressId);
+  progress.textContent = "computing…";
   view.cells = [];
   view.xKey = f.x; view.yKey = f.y;
   let total = 0, last = 0;
@@ -506,6 +523,12 @@ async function computeGrid(view, path, formId, key, progressId, onDone) {
   } finally {
     if (abort === view.abort) setBusy(key, null);
   }
+}
+
+function mapLegend(view) {
+  const ps = view.cells.map((d) => d.average_power_w).filter((p) => p != null);
+  document.getElementById("map-legend").textContent = ps.length === 0 ? "no power computed"
+    : `colour: average power from ${Math.min(...ps).toExponential(3)} W (dark) to ${Math.max(...ps).toExponential(3)} W (light); grey: none`;
 }
 
 const mapView = gridView("chart-map", (c, view) => {
@@ -629,7 +652,7 @@ async function main() {
   document.getElementById("orbit-reset").addEventListener("click", () => computeOrbit(true));
   document.getElementById("map-form").addEventListener("submit", (e) => {
     e.preventDefault();
-    computeGrid(mapView, "/api/map", "map-form", "map", "map-progress");
+    computeGrid(mapView, "/api/map", "map-form", "map", "map-progress", mapLegend);
   });
   document.getElementById("basins-form").addEventListener("submit", (e) => {
     e.preventDefault();
@@ -649,7 +672,7 @@ async function main() {
   updateCommand();
   await computeRun();
   if (state.orbit) computeOrbit(false);
-  if (state.map) computeGrid(mapView, "/api/map", "map-form", "map", "map-progress");
+  if (state.map) computeGrid(mapView, "/api/map", "map-form", "map", "map-progress", mapLegend);
   if (state.basins) {
     computeGrid(basinsView, "/api/basins", "basins-form", "basins", "basins-progress", basinsLegend);
   }
