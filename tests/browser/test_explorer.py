@@ -140,3 +140,25 @@ def test_map_and_basins_paint(page, artefacts):
     assert page.locator("#chart-basins").get_attribute("data-cells") == "16"
     assert "%" in page.get_by_test_id("basins-legend").text_content()
     page.screenshot(path=str(artefacts / "map-basins.png"), full_page=True)
+
+
+def test_rapid_changes_show_the_latest_answer(page):
+    wait_power(page)
+    final = page.evaluate(
+        """async () => {
+            const f = document.querySelector('[data-testid="param-excitation.omega_ratio"]');
+            for (let k = 0; k < 60; k++) {
+                f.value = String(0.6 + 0.003 * k);
+                f.dispatchEvent(new Event('change'));
+                await new Promise(r => setTimeout(r, 3));
+            }
+            return f.value;
+        }"""
+    )
+    expected = cli_power("--set", f"excitation.omega_ratio={final}")
+    page.wait_for_function(
+        """want => document.querySelector('[data-testid="status"]').dataset.state === 'idle'
+            && Number(document.querySelector('[data-testid="power-value"]').dataset.value) === want""",
+        arg=expected,
+    )
+    assert page.get_by_test_id("param-excitation.omega_ratio").input_value() == final

@@ -3,11 +3,11 @@
 
 use std::sync::Arc;
 
+use axum::Json;
 use axum::body::Bytes;
 use axum::extract::{Path, State};
 use axum::http::{StatusCode, header};
 use axum::response::{Html, IntoResponse, Response};
-use axum::Json;
 use serde::Deserialize;
 
 use super::assets;
@@ -93,7 +93,10 @@ pub async fn toml(State(state): State<Shared>, bytes: Bytes) -> Result<Response,
     Ok((
         [
             (header::CONTENT_TYPE, "application/toml; charset=utf-8"),
-            (header::CONTENT_DISPOSITION, "attachment; filename=\"vibrotribo.toml\""),
+            (
+                header::CONTENT_DISPOSITION,
+                "attachment; filename=\"vibrotribo.toml\"",
+            ),
         ],
         text,
     )

@@ -171,7 +171,10 @@ fn axis_values(axis: &Axis) -> Result<Vec<f64>, ApiError> {
         return Err(ApiError::bad(format!("{}: steps must be at least 1", axis.param)));
     }
     if !axis.from.is_finite() || !axis.to.is_finite() {
-        return Err(ApiError::bad(format!("{}: from and to must be finite numbers", axis.param)));
+        return Err(ApiError::bad(format!(
+            "{}: from and to must be finite numbers",
+            axis.param
+        )));
     }
     limits::check_grid("steps", axis.steps as f64).map_err(|e| ApiError::bad_chain(&e))?;
     let values = grid(axis.from, axis.to, axis.steps);

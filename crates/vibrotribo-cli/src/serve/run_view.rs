@@ -156,8 +156,7 @@ pub fn run_view(base: &Config, request: &RunRequest, ticket: Ticket) -> Result<R
     let started = Instant::now();
     let mut run_motion = RunMotion::new(&spec).map_err(ApiError::bad)?;
     run_motion.options_mut().settle = SettleMode::Fixed;
-    let outcome =
-        simulate(&spec, &mut (&mut recorder, run_motion.observer())).map_err(ApiError::failed)?;
+    let outcome = simulate(&spec, &mut (&mut recorder, run_motion.observer())).map_err(ApiError::failed)?;
     if outcome.ending == Ending::Stopped {
         return Err(ApiError::superseded());
     }

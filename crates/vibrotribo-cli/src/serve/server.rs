@@ -69,7 +69,11 @@ async fn stop_signal() {
 
 /// Opens `url` in the default browser, saying so if it cannot.
 fn open_browser(url: &str) {
-    let opener = if cfg!(target_os = "macos") { "open" } else { "xdg-open" };
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else {
+        "xdg-open"
+    };
     if let Err(e) = std::process::Command::new(opener).arg(url).spawn() {
         eprintln!("vibrotribo serve: cannot open a browser ({opener}: {e}); open {url} yourself");
     }

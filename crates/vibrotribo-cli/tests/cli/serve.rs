@@ -99,9 +99,7 @@ fn simulate_summary(args: &[&str]) -> Value {
 fn column(path: &Path, name: &str) -> Vec<f64> {
     let (header, rows) = read_csv(path);
     let k = header.iter().position(|h| h == name).unwrap();
-    rows.iter()
-        .map(|r| r[k].parse().unwrap_or(f64::NAN))
-        .collect()
+    rows.iter().map(|r| r[k].parse().unwrap_or(f64::NAN)).collect()
 }
 
 #[test]
@@ -130,7 +128,10 @@ fn run_view_is_simulate_bit_for_bit() {
         for key in ["impacts", "events_total", "sticks", "periods"] {
             assert_eq!(view["summary"][key], cli[key], "{set}: {key}");
         }
-        assert_eq!(view["summary"]["motion"]["motion"], cli["motion"]["motion"], "{set}");
+        assert_eq!(
+            view["summary"]["motion"]["motion"], cli["motion"]["motion"],
+            "{set}"
+        );
         // The samples are the run's: the last one is at the run's end.
         let t = view["samples"]["t"].as_array().unwrap();
         let end = float(&cli["periods"]) * float(&cli["excitation_period_s"]);
@@ -205,7 +206,12 @@ fn orbit_diagram_and_map_are_sweep_and_map_bit_for_bit() {
         let x = float(&p["x"]);
         let k = params.iter().position(|&v| v.to_bits() == x.to_bits()).unwrap();
         let api = float(&p["average_power_w"]);
-        assert_eq!(api.to_bits(), powers[k].to_bits(), "Ω = {x}: API {api:e} W, sweep {:e} W", powers[k]);
+        assert_eq!(
+            api.to_bits(),
+            powers[k].to_bits(),
+            "Ω = {x}: API {api:e} W, sweep {:e} W",
+            powers[k]
+        );
         let cli_x1: Vec<f64> = orbit_param
             .iter()
             .zip(&orbit_x1)
@@ -270,7 +276,11 @@ fn orbit_diagram_and_map_are_sweep_and_map_bit_for_bit() {
             .unwrap_or_else(|| panic!("no map.csv row at ({x}, {y})"));
         let cli: f64 = row[cp].parse().unwrap();
         let api = float(&p["average_power_w"]);
-        assert_eq!(api.to_bits(), cli.to_bits(), "({x}, {y}): API {api:e} W, map {cli:e} W");
+        assert_eq!(
+            api.to_bits(),
+            cli.to_bits(),
+            "({x}, {y}): API {api:e} W, map {cli:e} W"
+        );
     }
 }
 
@@ -281,9 +291,21 @@ fn malformed_requests_get_400_with_the_reason() {
     let cases: Vec<(&str, String, &str)> = vec![
         ("/api/run", "{not json".into(), "malformed request"),
         ("/api/run", r#"{"sett": {}}"#.into(), "unknown field"),
-        ("/api/run", r#"{"set": {"oscillator.mass": "1"}}"#.into(), "oscillator.mass"),
-        ("/api/run", r#"{"set": {"oscillator.restitution": "1.5"}}"#.into(), "restitution"),
-        ("/api/check", r#"{"set": {"excitation.omega_ratio": "-1"}}"#.into(), "omega_ratio"),
+        (
+            "/api/run",
+            r#"{"set": {"oscillator.mass": "1"}}"#.into(),
+            "oscillator.mass",
+        ),
+        (
+            "/api/run",
+            r#"{"set": {"oscillator.restitution": "1.5"}}"#.into(),
+            "restitution",
+        ),
+        (
+            "/api/check",
+            r#"{"set": {"excitation.omega_ratio": "-1"}}"#.into(),
+            "omega_ratio",
+        ),
         ("/api/toml", r#"{"set": {"run.periods": "0"}}"#.into(), "periods"),
         (
             "/api/orbit",
@@ -305,14 +327,21 @@ fn malformed_requests_get_400_with_the_reason() {
             orbit(json!({"param": "excitation.omega_ratio", "from": 0.5, "to": 1.0, "steps": 3})),
             "x and y",
         ),
-        ("/api/orbit", r#"{"x": {"param": "excitation.omega_ratio"}}"#.into(), "missing field"),
+        (
+            "/api/orbit",
+            r#"{"x": {"param": "excitation.omega_ratio"}}"#.into(),
+            "missing field",
+        ),
     ];
     for (path, body, says) in cases {
         let (status, text) = server.request("POST", path, &body);
         assert_eq!(status, 400, "POST {path} {body}: {text}");
         let error: Value = serde_json::from_str(&text).unwrap_or_else(|_| panic!("not JSON: {text}"));
         let message = error["error"].as_str().unwrap();
-        assert!(message.contains(says), "POST {path} {body}: {message:?} lacks {says:?}");
+        assert!(
+            message.contains(says),
+            "POST {path} {body}: {message:?} lacks {says:?}"
+        );
     }
     let (status, text) = server.request("GET", "/api/nothing", "");
     assert_eq!(status, 404, "{text}");
@@ -326,10 +355,27 @@ fn page_schema_and_assets_are_served() {
     let server = Server::start(&[]);
     let (status, page) = server.request("GET", "/", "");
     assert_eq!(status, 200);
-    for id in ["power-value", "run-view", "orbit-diagram", "basins-view", "map-view", "export-toml", "status"] {
-        assert!(page.contains(&format!("data-testid=\"{id}\"")), "the page lacks {id}");
+    for id in [
+        "power-value",
+        "run-view",
+        "orbit-diagram",
+        "basins-view",
+        "map-view",
+        "export-toml",
+        "status",
+    ] {
+        assert!(
+            page.contains(&format!("data-testid=\"{id}\"")),
+            "the page lacks {id}"
+        );
     }
-    for asset in ["app.js", "app.css", "uPlot.iife.min.js", "uPlot.min.css", "uPlot.LICENSE"] {
+    for asset in [
+        "app.js",
+        "app.css",
+        "uPlot.iife.min.js",
+        "uPlot.min.css",
+        "uPlot.LICENSE",
+    ] {
         let (status, _) = server.request("GET", &format!("/assets/{asset}"), "");
         assert_eq!(status, 200, "{asset}");
     }
@@ -344,9 +390,15 @@ fn page_schema_and_assets_are_served() {
     for k in keys {
         let key = k["key"].as_str().unwrap();
         let name = key.rsplit_once('.').map_or(key, |(_, n)| n);
-        assert!(reference.contains(&format!("| `{name}` | {} |", k["unit"].as_str().unwrap())), "{key}");
+        assert!(
+            reference.contains(&format!("| `{name}` | {} |", k["unit"].as_str().unwrap())),
+            "{key}"
+        );
     }
-    let omega = keys.iter().find(|k| k["key"] == "excitation.omega_ratio").unwrap();
+    let omega = keys
+        .iter()
+        .find(|k| k["key"] == "excitation.omega_ratio")
+        .unwrap();
     let default = vibrotribo::config::Config::default().chain().omega_ratio();
     let shown: f64 = omega["value"].as_str().unwrap().parse().unwrap();
     assert!((shown - default).abs() <= 1e-9 * default, "{shown} vs {default}");
@@ -364,6 +416,12 @@ fn sigterm_stops_the_server_cleanly() {
     let exit = server.child.wait().unwrap();
     assert!(exit.success(), "exit status after SIGTERM: {exit:?}");
     let mut rest = String::new();
-    server.child.stdout.take().unwrap().read_to_string(&mut rest).unwrap();
+    server
+        .child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut rest)
+        .unwrap();
     assert!(rest.contains("stopped"), "{rest:?}");
 }

@@ -146,20 +146,29 @@ function buildParams() {
 
 // Applies a field's value: checked by the engine first (its error shown next to the field and
 // nothing run), then the run view recomputed.
+const fieldSeq = {};
+
 async function applyField(input, error, k) {
+  const seq = fieldSeq[k.key] = (fieldSeq[k.key] || 0) + 1;
   const text = input.value.trim();
   const original = k.value ?? "";
   const candidate = { ...state.set };
   if (text === "" || (text === original && !(k.key in state.set))) delete candidate[k.key];
   else candidate[k.key] = text;
   if (JSON.stringify(candidate) === JSON.stringify(state.set) && !error.textContent) return;
+  setBusy("check", "checking");
   try {
     await post("/api/check", { set: candidate });
   } catch (e) {
+    if (seq !== fieldSeq[k.key]) return;
     error.textContent = e.message;
     input.setAttribute("aria-invalid", "true");
     return;
+  } finally {
+    if (seq === fieldSeq[k.key]) setBusy("check", null);
   }
+  // A newer value of this field was entered meanwhile: it decides.
+  if (seq !== fieldSeq[k.key]) return;
   error.textContent = "";
   input.removeAttribute("aria-invalid");
   input.classList.toggle("given", k.key in candidate || k.given);
@@ -198,7 +207,8 @@ const charts = {};
 
 function scheduleRun(delay = 80) {
   clearTimeout(runTimer);
-  runTimer = setTimeout(computeRun, delay);
+  setBusy("run", "computing the run");
+  runTimer = setTimeout(() => { runTimer = null; computeRun(); }, delay);
 }
 
 async function computeRun() {
@@ -217,7 +227,7 @@ async function computeRun() {
     if (e.name === "AbortError" || e.status === 409) return;
     if (seq === runSeq) document.getElementById("run-error").textContent = e.message;
   } finally {
-    if (seq === runSeq) setBusy("run", null);
+    if (seq === runSeq && runTimer === null) setBusy("run", null);
   }
 }
 
