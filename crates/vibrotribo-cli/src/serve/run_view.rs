@@ -31,7 +31,7 @@ pub struct RunRequest {
     pub set: Overrides,
 }
 
-/// The samples of a run (every `stride`-th sample of its grid): time, s; positions x_i, m;
+/// The samples of a run (every `stride`-th sample of its grid, and its last): time, s; positions x_i, m;
 /// velocities, m/s; gaps d_k, m; base displacement y, m; load voltage V, V; and the power
 /// delivered to the load V·I, W (empty without a harvester).
 #[derive(Debug, Default, Serialize)]
@@ -83,6 +83,8 @@ pub struct RunView {
 /// Records the samples and events of a run and stops it when its ticket is stopped.
 struct Recorder {
     samples: Samples,
+    /// Index of the grid's last sample (always kept, so the samples reach the run's end).
+    last: u64,
     events: Events,
     ticket: Ticket,
 }
@@ -93,7 +95,7 @@ impl RunObserver for Recorder {
     }
 
     fn sample(&mut self, s: &Sample<'_>) {
-        if s.index % self.samples.stride != 0 {
+        if s.index % self.samples.stride != 0 && s.index != self.last {
             return;
         }
         let d = &mut self.samples;
@@ -150,6 +152,7 @@ pub fn run_view(base: &Config, request: &RunRequest, ticket: Ticket) -> Result<R
             gaps: vec![Vec::new(); n.saturating_sub(1)],
             ..Samples::default()
         },
+        last: grid - 1,
         events: Events::default(),
         ticket,
     };

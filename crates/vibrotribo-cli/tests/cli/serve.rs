@@ -389,7 +389,7 @@ fn page_schema_and_assets_are_served() {
     assert!(keys.len() > 40, "{} keys", keys.len());
     for k in keys {
         let key = k["key"].as_str().unwrap();
-        let name = key.rsplit_once('.').map_or(key, |(_, n)| n);
+        let name = key.split_once('.').map_or(key, |(_, n)| n);
         assert!(
             reference.contains(&format!("| `{name}` | {} |", k["unit"].as_str().unwrap())),
             "{key}"
