@@ -95,7 +95,7 @@ impl RunObserver for Recorder {
     }
 
     fn sample(&mut self, s: &Sample<'_>) {
-        if s.index % self.samples.stride != 0 && s.index != self.last {
+        if !s.index.is_multiple_of(self.samples.stride) && s.index != self.last {
             return;
         }
         let d = &mut self.samples;
