@@ -248,7 +248,8 @@ impl GridJob {
         if !send(&start) {
             return;
         }
-        let chunk = 2 * rayon::current_num_threads();
+        // One point per thread a chunk: the first points arrive after one point's time.
+        let chunk = rayon::current_num_threads();
         let done = run_chunks(
             &self.order,
             chunk,
