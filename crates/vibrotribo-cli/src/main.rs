@@ -73,8 +73,9 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
     Plot(PlotArgs),
-    /// A local web page to explore a configuration: parameters, the run, an orbit diagram
-    /// and a power map, computed live by the same engine (all assets built in).
+    /// A local web page to explore a configuration: parameters, the run, an orbit diagram,
+    /// a power map and basins, computed live by the same engine (all assets built in; Ctrl-C
+    /// stops).
     Serve(serve::ServeArgs),
     /// Write the configuration reference (every key, its unit, default and allowed values) as
     /// Markdown: the guide's `reference/configuration.md`.

@@ -248,35 +248,45 @@ impl GridJob {
         if !send(&start) {
             return;
         }
-        // One point per thread a chunk: the first points arrive after one point's time.
-        let chunk = rayon::current_num_threads();
-        let done = run_chunks(
-            &self.order,
-            chunk,
-            |&p| {
-                if ticket.stopped() {
-                    return Err(None);
-                }
-                self.runner.run(&self.point_keys(p), None).map_err(Some)
-            },
-            |d| match d {
-                Delivery::Point(&(i, j), r) => {
-                    let r = match r {
-                        Err(None) => return ControlFlow::Break(()),
-                        Ok(p) => Ok(p),
-                        Err(Some(e)) => Err(e),
-                    };
-                    let line = PointLine::new((i, j), (self.xs[i], self.ys.get(j).copied()), r);
-                    if !send(&Line::Point(line)) || ticket.stopped() {
-                        ControlFlow::Break(())
-                    } else {
-                        ControlFlow::Continue(())
+        // The first chunk holds one point per thread, so that the first points arrive after
+        // one point's time; the later ones are larger, so that few threads wait for the
+        // slowest point of a chunk.
+        let threads = rayon::current_num_threads();
+        let (head, tail) = self.order.split_at(threads.min(self.order.len()));
+        let mut done = 0;
+        for (k, (points, chunk)) in [(head, threads), (tail, 8 * threads)].into_iter().enumerate() {
+            // The head stopped early (superseded, client gone): the tail is not started.
+            if k == 1 && done < head.len() {
+                break;
+            }
+            done += run_chunks(
+                points,
+                chunk,
+                |&p| {
+                    if ticket.stopped() {
+                        return Err(None);
                     }
-                }
-                Delivery::Chunk(_) if ticket.stopped() => ControlFlow::Break(()),
-                Delivery::Chunk(_) => ControlFlow::Continue(()),
-            },
-        );
+                    self.runner.run(&self.point_keys(p), None).map_err(Some)
+                },
+                |d| match d {
+                    Delivery::Point(&(i, j), r) => {
+                        let r = match r {
+                            Err(None) => return ControlFlow::Break(()),
+                            Ok(p) => Ok(p),
+                            Err(Some(e)) => Err(e),
+                        };
+                        let line = PointLine::new((i, j), (self.xs[i], self.ys.get(j).copied()), r);
+                        if !send(&Line::Point(line)) || ticket.stopped() {
+                            ControlFlow::Break(())
+                        } else {
+                            ControlFlow::Continue(())
+                        }
+                    }
+                    Delivery::Chunk(_) if ticket.stopped() => ControlFlow::Break(()),
+                    Delivery::Chunk(_) => ControlFlow::Continue(()),
+                },
+            );
+        }
         let complete = done == self.order.len() && !ticket.stopped();
         send(&Line::End {
             done,

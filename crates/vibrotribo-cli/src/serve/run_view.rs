@@ -138,6 +138,9 @@ impl RunObserver for Recorder {
 /// Runs the configuration of `request` on `base` as `vibrotribo simulate` does; stops (409)
 /// when `ticket` is stopped.
 pub fn run_view(base: &Config, request: &RunRequest, ticket: Ticket) -> Result<RunView, ApiError> {
+    if ticket.stopped() {
+        return Err(ApiError::superseded());
+    }
     let config = configure(base, &request.set)?;
     let mut spec = config.sampled_run_spec(false);
     spec.breakdown_check = true;

@@ -93,6 +93,9 @@ pub fn run(args: &ServeArgs) -> Result<()> {
     };
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
+        // Computations run on blocking threads; a burst of superseded requests waits for a
+        // few threads instead of starting hundreds (each stops at once when its turn comes).
+        .max_blocking_threads(16)
         .enable_all()
         .build()
         .context("cannot start the server's runtime")?;
