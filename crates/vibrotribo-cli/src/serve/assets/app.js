@@ -224,7 +224,10 @@ async function computeRun() {
     showRun(view);
     document.getElementById("run-error").textContent = "";
   } catch (e) {
-    if (e.name === "AbortError" || e.status === 409) return;
+    if (e.name === "AbortError") return;
+    // Stopped by a request the server handled after this one (an older one, abandoned by
+    // this page): still the latest here, so ask again.
+    if (e.status === 409) { if (seq === runSeq) scheduleRun(0); return; }
     if (seq === runSeq) document.getElementById("run-error").textContent = e.message;
   } finally {
     if (seq === runSeq && runTimer === null) setBusy("run", null);
