@@ -20,6 +20,7 @@ mod plot;
 mod plots;
 mod progress;
 mod reproduce;
+mod serve;
 mod simulate;
 mod sweep;
 
@@ -72,6 +73,10 @@ enum Command {
     Reproduce(reproduce::ReproduceArgs),
     /// Draw the pictures (and per-run analyses) of a simulate, sweep or map directory.
     Plot(PlotArgs),
+    /// A local web page to explore a configuration: parameters, the run, an orbit diagram,
+    /// a power map and basins, computed live by the same engine (all assets built in; Ctrl-C
+    /// stops).
+    Serve(serve::ServeArgs),
     /// Write the configuration reference (every key, its unit, default and allowed values) as
     /// Markdown: the guide's `reference/configuration.md`.
     #[command(hide = true)]
@@ -140,6 +145,7 @@ fn run() -> anyhow::Result<()> {
         Command::Attractors(args) => attractors::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Plot(args) => plots::plot_dir(&args.dir, args.psd_mass),
+        Command::Serve(args) => serve::run(&args),
         Command::ConfigReference => {
             print!("{}", vibrotribo::config::reference_markdown());
             Ok(())

@@ -170,7 +170,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let config = args.input.load()?;
     let mut spec = config.sampled_run_spec(args.mechanics_only);
     spec.breakdown_check = true;
-    check_size(&config, &spec, args)?;
+    check_size(&config, &spec, args.out.is_some(), args.allow_large)?;
     let harvester = spec.harvester.as_ref().map(|h| &h.params);
     let mut files = match &args.out {
         Some(dir) => Some(Files::create(dir, &spec.chain, harvester)?),
@@ -306,9 +306,9 @@ fn failure_error(outcome: &RunOutcome) -> Option<anyhow::Error> {
     })
 }
 
-/// Refuses a run whose per-period statistics or files would be unreasonably large (see
-/// [`limits`]).
-fn check_size(config: &Config, spec: &RunSpec, args: &SimulateArgs) -> Result<()> {
+/// Refuses a run whose per-period statistics or (with `files`) files would be unreasonably
+/// large (see [`limits`]) unless `allow_large`.
+pub fn check_size(config: &Config, spec: &RunSpec, files: bool, allow_large: bool) -> Result<()> {
     let periods = spec.periods as f64;
     let n = spec.chain.len() as f64;
     let electrical = spec.harvester.is_some();
@@ -316,15 +316,15 @@ fn check_size(config: &Config, spec: &RunSpec, args: &SimulateArgs) -> Result<()
     limits::check_memory(
         &format!("{} periods of per-period statistics", spec.periods),
         periods * per_period,
-        args.allow_large,
+        allow_large,
     )?;
-    if args.out.is_some() {
+    if files {
         let columns = 1.0 + 2.0 * n + 1.0 + (n - 1.0) + if electrical { 6.0 } else { 0.0 };
         let rows = periods * config.run().samples_per_period as f64 + 1.0;
         limits::check_output(
             "trajectory.csv",
             rows * columns * limits::CSV_NUMBER_BYTES,
-            args.allow_large,
+            allow_large,
         )?;
     }
     Ok(())

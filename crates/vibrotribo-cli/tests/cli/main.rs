@@ -11,6 +11,7 @@ mod issue_plot_without_out;
 mod issue_simulate_output_edges;
 mod lyapunov;
 mod periodic_orbits;
+mod serve;
 mod stops;
 mod util;
 

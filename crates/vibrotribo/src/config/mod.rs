@@ -27,4 +27,6 @@ pub use error::ConfigError;
 pub use excitation::{DEFAULT_SPLINE_TOLERANCE, MAX_HARMONICS};
 pub use keys::{DERIVED_KEYS, apply_overrides, known_keys, parse_override, parse_value, similar_keys};
 pub use param::Param;
-pub use reference::{Allowed, KEY_DOCS, KeyDoc, reference_markdown, stale_entries, undocumented_keys};
+pub use reference::{
+    Allowed, KEY_DOCS, KeyDoc, default_values, reference_markdown, stale_entries, undocumented_keys,
+};

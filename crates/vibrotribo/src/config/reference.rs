@@ -206,6 +206,20 @@ fn default_of(defaults: &Json, key: &str) -> Option<String> {
     Some(toml_value.to_string())
 }
 
+/// The default of every key of the schema in the paper's default case, as TOML writes it, in
+/// the schema's order; `None` for a key absent by default (its [`KeyDoc::absent`] says what
+/// absent means).
+pub fn default_values() -> Vec<(String, Option<String>)> {
+    let defaults = serde_json::to_value(default_document()).unwrap_or(Json::Null);
+    known_keys()
+        .into_iter()
+        .map(|key| {
+            let value = default_of(&defaults, &key);
+            (key, value)
+        })
+        .collect()
+}
+
 /// Keys of the schema that [`KEY_DOCS`] lacks.
 pub fn undocumented_keys() -> Vec<String> {
     known_keys()

@@ -1,0 +1,313 @@
+//! The orbit diagram and the power map: the points of a one- or two-parameter grid run by
+//! the point runner of `vibrotribo sweep` and `vibrotribo map` (same options, same checks,
+//! same limits), streamed as newline-delimited JSON as they finish, coarse to fine.
+
+use std::convert::Infallible;
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+use axum::body::Body;
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use tokio::sync::mpsc;
+use vibrotribo::analysis::Periodicity;
+use vibrotribo::config::Config;
+use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, PointResult, SettleMode};
+use vibrotribo::sweep::{Delivery, PointRunner, SweepError, grid, run_chunks};
+
+use super::cancel::{Guard, Ticket};
+use super::error::ApiError;
+use super::request::{Overrides, configure};
+use crate::job::{RunArgs, check_all, check_distinct, estimate_point_memory};
+use crate::limits;
+
+/// One axis of a grid: the key and its values, equally spaced (as `sweep --param --from --to
+/// --steps`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Axis {
+    /// The parameter (any key `sweep --param` accepts).
+    pub param: String,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Number of values.
+    pub steps: usize,
+}
+
+/// `POST /api/orbit` (one axis) and `POST /api/map` (two axes).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridRequest {
+    /// The overrides of the server's configuration.
+    #[serde(default)]
+    pub set: Overrides,
+    /// The axis (orbit diagram), or the x axis (map).
+    pub x: Axis,
+    /// The y axis of a map.
+    #[serde(default)]
+    pub y: Option<Axis>,
+    /// Transient periods per value (default: the configuration's, as `sweep --transient`).
+    #[serde(default)]
+    pub transient: Option<u64>,
+    /// Recorded periods per value (default: the configuration's, as `sweep --recorded`).
+    #[serde(default)]
+    pub recorded: Option<u64>,
+    /// Mechanics only (as `--mechanics-only`).
+    #[serde(default)]
+    pub mechanics_only: bool,
+}
+
+/// One streamed line.
+#[derive(Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+enum Line<'a> {
+    /// First: the grid's values and the chain's size.
+    Start {
+        xs: &'a [f64],
+        ys: &'a [f64],
+        masses: usize,
+    },
+    /// A finished point.
+    Point(PointLine),
+    /// Last: how many points were delivered, whether all of them, and the time taken.
+    End {
+        done: usize,
+        complete: bool,
+        elapsed_s: f64,
+    },
+}
+
+/// A finished point: its indices and values, the stroboscopic positions of its recorded
+/// periods (`x[j·N + i]`, m), its motion (as `summary.json` states it), the average power
+/// (W) and impacts per period, or the error that stopped it.
+#[derive(Debug, Serialize)]
+struct PointLine {
+    i: usize,
+    j: usize,
+    x: f64,
+    y: Option<f64>,
+    strobe: Vec<f64>,
+    motion: Value,
+    period: Option<usize>,
+    average_power_w: Option<f64>,
+    impacts_per_period: Option<f64>,
+    error: Option<String>,
+}
+
+impl PointLine {
+    fn new((i, j): (usize, usize), (x, y): (f64, Option<f64>), r: Result<PointResult, SweepError>) -> Self {
+        match r {
+            Ok(p) => PointLine {
+                i,
+                j,
+                x,
+                y,
+                motion: vibrotribo::report::motion_json(p.motion.as_ref()),
+                period: match p.periodicity {
+                    Some(Periodicity::Periodic { period, .. }) => Some(period),
+                    _ => None,
+                },
+                average_power_w: p.average_power_w,
+                impacts_per_period: Some(p.impacts_per_period.iter().sum()),
+                strobe: p.strobe,
+                error: p.electrical_error.map(|e| e.to_string()),
+            },
+            Err(e) => PointLine {
+                i,
+                j,
+                x,
+                y,
+                strobe: Vec::new(),
+                motion: Value::Null,
+                period: None,
+                average_power_w: None,
+                impacts_per_period: None,
+                error: Some(e.to_string()),
+            },
+        }
+    }
+}
+
+/// The rank of index `k` in a coarse-to-fine order: indices divisible by a higher power of
+/// two come first.
+fn coarseness(k: usize) -> u32 {
+    if k == 0 { u32::MAX } else { k.trailing_zeros() }
+}
+
+/// A checked grid job, ready to stream.
+pub struct GridJob {
+    runner: PointRunner,
+    keys: Vec<String>,
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    /// (i, j) in the order computed: coarse to fine.
+    order: Vec<(usize, usize)>,
+}
+
+/// The point runner of `vibrotribo sweep` and `map` with their default options.
+fn runner(config: Config, request: &GridRequest) -> Result<PointRunner, ApiError> {
+    let args = RunArgs {
+        transient: request.transient,
+        recorded: request.recorded,
+        mechanics_only: request.mechanics_only,
+        period_tolerance: DEFAULT_PERIOD_TOLERANCE,
+        floquet: false,
+        settle: "auto".parse::<SettleMode>().map_err(ApiError::bad)?,
+        settle_cap: DEFAULT_SETTLE_CAP,
+        threads: None,
+        quiet: true,
+        allow_large: false,
+    };
+    args.runner(config).map_err(|e| ApiError::bad_chain(&e))
+}
+
+/// The values of `axis`, checked as `sweep` checks `--from --to --steps`.
+fn axis_values(axis: &Axis) -> Result<Vec<f64>, ApiError> {
+    if axis.steps == 0 {
+        return Err(ApiError::bad(format!("{}: steps must be at least 1", axis.param)));
+    }
+    if !axis.from.is_finite() || !axis.to.is_finite() {
+        return Err(ApiError::bad(format!(
+            "{}: from and to must be finite numbers",
+            axis.param
+        )));
+    }
+    limits::check_grid("steps", axis.steps as f64).map_err(|e| ApiError::bad_chain(&e))?;
+    let values = grid(axis.from, axis.to, axis.steps);
+    check_distinct(&format!("{} from/to/steps", axis.param), &values).map_err(|e| ApiError::bad_chain(&e))?;
+    Ok(values)
+}
+
+impl GridJob {
+    /// The job of `request` on `base`, checked as `sweep` and `map` check theirs: the grid's
+    /// size, every point's configuration, the memory of the points running at once.
+    pub fn new(base: &Config, request: &GridRequest) -> Result<Self, ApiError> {
+        let config = configure(base, &request.set)?;
+        let runner = runner(config, request)?;
+        let xs = axis_values(&request.x)?;
+        let (ys, mut keys) = (Vec::new(), vec![request.x.param.clone()]);
+        let ys = match &request.y {
+            Some(y) => {
+                keys.push(y.param.clone());
+                axis_values(y)?
+            }
+            None => ys,
+        };
+        let cells = xs.len() as f64 * ys.len().max(1) as f64;
+        limits::check_grid("the grid", cells).map_err(|e| ApiError::bad_chain(&e))?;
+        let mut order: Vec<(usize, usize)> = (0..xs.len())
+            .flat_map(|i| (0..ys.len().max(1)).map(move |j| (i, j)))
+            .collect();
+        order.sort_by_key(|&(i, j)| std::cmp::Reverse(coarseness(i).min(coarseness(j))));
+        let job = GridJob {
+            runner,
+            keys,
+            xs,
+            ys,
+            order,
+        };
+        check_all(&job.runner, &job.order, |&p| job.point_keys(p)).map_err(|e| ApiError::bad_chain(&e))?;
+        let threads = rayon::current_num_threads() as f64;
+        limits::check_memory(
+            "one point of the grid (transient + recorded periods)",
+            estimate_point_memory(&job.runner) * threads * 4.0,
+            false,
+        )
+        .map_err(|e| ApiError::bad_chain(&e))?;
+        Ok(job)
+    }
+
+    fn point_keys(&self, (i, j): (usize, usize)) -> Vec<(&str, f64)> {
+        let mut keys = vec![(self.keys[0].as_str(), self.xs[i])];
+        if let (Some(key), Some(&y)) = (self.keys.get(1), self.ys.get(j)) {
+            keys.push((key.as_str(), y));
+        }
+        keys
+    }
+
+    /// Runs the points on the rayon pool (called on a blocking thread), sending each line
+    /// to `tx`; stops when the ticket is stopped or nobody receives.
+    fn produce(&self, tx: &mpsc::Sender<String>, ticket: &Ticket) {
+        let started = Instant::now();
+        let send = |line: &Line<'_>| match serde_json::to_string(line) {
+            Ok(mut text) => {
+                text.push('\n');
+                tx.blocking_send(text).is_ok()
+            }
+            Err(_) => false,
+        };
+        let start = Line::Start {
+            xs: &self.xs,
+            ys: &self.ys,
+            masses: self.runner.masses(),
+        };
+        if !send(&start) {
+            return;
+        }
+        // The first chunk holds one point per thread, so that the first points arrive after
+        // one point's time; the later ones are larger, so that few threads wait for the
+        // slowest point of a chunk.
+        let threads = rayon::current_num_threads();
+        let (head, tail) = self.order.split_at(threads.min(self.order.len()));
+        let mut done = 0;
+        for (k, (points, chunk)) in [(head, threads), (tail, 8 * threads)].into_iter().enumerate() {
+            // The head stopped early (superseded, client gone): the tail is not started.
+            if k == 1 && done < head.len() {
+                break;
+            }
+            done += run_chunks(
+                points,
+                chunk,
+                |&p| {
+                    if ticket.stopped() {
+                        return Err(None);
+                    }
+                    self.runner.run(&self.point_keys(p), None).map_err(Some)
+                },
+                |d| match d {
+                    Delivery::Point(&(i, j), r) => {
+                        let r = match r {
+                            Err(None) => return ControlFlow::Break(()),
+                            Ok(p) => Ok(p),
+                            Err(Some(e)) => Err(e),
+                        };
+                        let line = PointLine::new((i, j), (self.xs[i], self.ys.get(j).copied()), r);
+                        if !send(&Line::Point(line)) || ticket.stopped() {
+                            ControlFlow::Break(())
+                        } else {
+                            ControlFlow::Continue(())
+                        }
+                    }
+                    Delivery::Chunk(_) if ticket.stopped() => ControlFlow::Break(()),
+                    Delivery::Chunk(_) => ControlFlow::Continue(()),
+                },
+            );
+        }
+        let complete = done == self.order.len() && !ticket.stopped();
+        send(&Line::End {
+            done,
+            complete,
+            elapsed_s: started.elapsed().as_secs_f64(),
+        });
+    }
+
+    /// The streamed answer: `application/x-ndjson`, one [`Line`] a line; the work stops when
+    /// the response is dropped (the guard goes with it) or the ticket is superseded.
+    pub fn stream(self, ticket: Ticket, guard: Guard) -> Response {
+        let (tx, rx) = mpsc::channel::<String>(256);
+        tokio::task::spawn_blocking(move || self.produce(&tx, &ticket));
+        let lines = futures_util::stream::unfold((rx, guard), |(mut rx, guard)| async move {
+            let line = rx.recv().await?;
+            Some((Ok::<_, Infallible>(line), (rx, guard)))
+        });
+        (
+            [(header::CONTENT_TYPE, "application/x-ndjson")],
+            Body::from_stream(lines),
+        )
+            .into_response()
+    }
+}
