@@ -14,6 +14,7 @@ mod lyapunov;
 mod manifest;
 mod map;
 mod merge;
+mod merit;
 mod output;
 mod periodic;
 mod plot;
