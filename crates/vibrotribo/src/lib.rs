@@ -86,6 +86,8 @@ pub mod excitation;
 pub mod lyapunov;
 pub mod merit;
 pub mod model;
+#[cfg(feature = "config")]
+pub mod optimize;
 pub mod orbits;
 mod random;
 #[cfg(feature = "config")]
