@@ -48,7 +48,9 @@ pub enum OptimizeError {
         name: String,
     },
     /// A `--constraint` argument that cannot be read.
-    #[error("--constraint {text:?}: expected breakdown_ratio<=X or max_displacement<=X (X in its unit: 1, m)")]
+    #[error(
+        "--constraint {text:?}: expected breakdown_ratio<=X or max_displacement<=X (X in its unit: 1, m)"
+    )]
     ConstraintSyntax {
         /// The argument.
         text: String,
@@ -80,7 +82,9 @@ pub enum OptimizeError {
         reason: &'static str,
     },
     /// No design of those evaluated met the constraints.
-    #[error("no design met the constraints ({constraints}) among {evaluations} evaluated; the least violated: {least}")]
+    #[error(
+        "no design met the constraints ({constraints}) among {evaluations} evaluated; the least violated: {least}"
+    )]
     Infeasible {
         /// The constraints, as given.
         constraints: String,

@@ -78,10 +78,7 @@ fn run_once(
         return Err(e.to_string());
     }
     let e = outcome.electrical.as_ref().ok_or("the chain has no harvester")?;
-    let power = e
-        .power
-        .as_ref()
-        .ok_or("no complete period after the transient")?;
+    let power = e.power.as_ref().ok_or("no complete period after the transient")?;
     let se = e.average_power_se(spec.transient_periods);
     let ratio = e.breakdown.map_or(0.0, |m| m.worst_ratio);
     Ok((power.average_power_w, se, ratio, watch.max))
@@ -110,7 +107,8 @@ pub fn evaluate(problem: &Problem, unit: &[f64]) -> Evaluation {
             let bounds = StartBox::of(chain);
             (0..problem.options.starts)
                 .map(|k| {
-                    let s = random_start(chain, &bounds, problem.options.seed, k).map_err(|e| e.to_string())?;
+                    let s =
+                        random_start(chain, &bounds, problem.options.seed, k).map_err(|e| e.to_string())?;
                     run_once(&config, Some(s))
                 })
                 .collect()

@@ -121,8 +121,18 @@ impl CostFunction for Cost<'_, '_> {
         // Nelder–Mead may step outside the cube: the design at the nearest point of the cube,
         // penalised by the distance.
         let unit: Vec<f64> = p.iter().map(|x| x.clamp(0.0, 1.0)).collect();
-        let outside = p.iter().zip(&unit).map(|(x, u)| (x - u).powi(2)).sum::<f64>().sqrt();
-        let cached = s.cache.lock().unwrap_or_else(PoisonError::into_inner).get(&unit).cloned();
+        let outside = p
+            .iter()
+            .zip(&unit)
+            .map(|(x, u)| (x - u).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let cached = s
+            .cache
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .get(&unit)
+            .cloned();
         let (e, was_cached) = match cached {
             Some(e) => (e, true),
             None => {
@@ -192,7 +202,14 @@ pub fn optimize(
 ) -> Result<OptimizeResult, OptimizeError> {
     problem.validate()?;
     let eval = |u: &[f64]| evaluate(problem, u);
-    let result = optimize_with(problem.variables.len(), &problem.options, &eval, cache, on_eval, stop)?;
+    let result = optimize_with(
+        problem.variables.len(),
+        &problem.options,
+        &eval,
+        cache,
+        on_eval,
+        stop,
+    )?;
     if !result.best.feasible() {
         let b = &result.best;
         return Err(OptimizeError::Infeasible {
@@ -238,7 +255,9 @@ pub fn optimize_with(
         best: Arc::new(Mutex::new(None)),
     };
     let history = Arc::new(Mutex::new(Vec::new()));
-    let stopped = |e: argmin::core::Error| OptimizeError::Stopped { reason: e.to_string() };
+    let stopped = |e: argmin::core::Error| OptimizeError::Stopped {
+        reason: e.to_string(),
+    };
     let swarm = ParticleSwarm::new((vec![0.0; dim], vec![1.0; dim]), options.particles)
         .with_rng_generator(rand::rngs::StdRng::seed_from_u64(options.seed));
     Executor::new(Cost(&shared), swarm)
@@ -266,7 +285,11 @@ pub fn optimize_with(
         for k in 0..dim {
             let mut p = start.clone();
             // Step inwards, so that every vertex lies in the cube.
-            p[k] = if p[k] + 0.05 <= 1.0 { p[k] + 0.05 } else { p[k] - 0.05 };
+            p[k] = if p[k] + 0.05 <= 1.0 {
+                p[k] + 0.05
+            } else {
+                p[k] - 0.05
+            };
             simplex.push(p);
         }
         let local = NelderMead::new(simplex);
