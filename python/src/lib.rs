@@ -11,6 +11,7 @@ mod convert;
 mod interrupt;
 mod loads;
 mod lyapunov;
+mod optimize;
 mod orbits;
 mod simulate;
 mod sweep;
@@ -45,6 +46,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(orbits::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::continue_, m)?)?;
     m.add_function(wrap_pyfunction!(lyapunov::lyapunov, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize::optimize, m)?)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;
     m.add_function(wrap_pyfunction!(log_spaced, m)?)?;
     m.add("OrbitNotFound", m.py().get_type::<orbits::OrbitNotFound>())?;

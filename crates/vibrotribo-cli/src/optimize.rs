@@ -259,10 +259,32 @@ pub fn run(args: &OptimizeArgs) -> Result<()> {
     };
     write_json(&dir.join("optimize.json"), &serde_json::to_value(&manifest)?)?;
     let design = problem.design(&result.best_unit)?;
-    let toml = toml::to_string(design.table()).context("cannot write the best design as TOML")?;
+    let mut table = design.table().clone();
+    anchor_record(&mut table, args.input.config.as_deref())?;
+    let toml = toml::to_string(&table).context("cannot write the best design as TOML")?;
     write_atomic(&dir.join("best.toml"), toml.as_bytes())?;
     plot_convergence(dir, &result.history, objective)?;
     print_result(&problem, &manifest, dir);
+    Ok(())
+}
+
+/// Makes a record file named relative to the configuration file (`excitation.file`) absolute,
+/// so that best.toml runs from wherever it is.
+fn anchor_record(table: &mut toml::Table, config: Option<&Path>) -> Result<()> {
+    let (Some(config), Some(excitation)) =
+        (config, table.get_mut("excitation").and_then(|v| v.as_table_mut()))
+    else {
+        return Ok(());
+    };
+    if let Some(toml::Value::String(file)) = excitation.get_mut("file") {
+        let path = Path::new(file.as_str());
+        if path.is_relative() {
+            let dir = config.parent().unwrap_or(Path::new("."));
+            let absolute = std::path::absolute(dir.join(path))
+                .with_context(|| format!("cannot resolve the record file {}", path.display()))?;
+            *file = absolute.display().to_string();
+        }
+    }
     Ok(())
 }
 

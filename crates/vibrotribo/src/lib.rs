@@ -46,6 +46,9 @@
 //! - **Figures of merit.** [`merit`] has the triboelectric figures of merit of a run: the
 //!   cycle for maximised energy output (CMEO), `FOM_S`, the breakdown-limited maximum and the
 //!   run's own energy per cycle against them.
+//! - **Design.** [`optimize`] maximises average power, expected power over random starts or
+//!   power per mass over any numeric configuration keys, under air-breakdown and
+//!   displacement constraints (argmin's particle swarm, then Nelder–Mead).
 //!
 //! The engine alone, ten periods of the paper's default case:
 //!

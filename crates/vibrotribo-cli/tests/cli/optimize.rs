@@ -61,26 +61,26 @@ fn load_optimum_of_the_default_case() {
 #[test]
 fn resume_after_interruption_gives_the_uninterrupted_result() {
     let dir = tempdir();
-    let run = |out: &std::path::Path, extra: &[&str]| {
-        let mut args = LOAD.to_vec();
-        args.extend([
-            "--local-iterations",
-            "6",
-            "--seed",
-            "5",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        args.extend(extra);
-        args.extend(["--set", "run.periods=60", "--set", "run.transient_periods=40"]);
+    let run = |out: &std::path::Path, extra: &[&str]| -> Vec<String> {
+        let mut args: Vec<String> = LOAD.iter().map(|s| s.to_string()).collect();
+        for a in ["--local-iterations", "6", "--seed", "5", "--out"] {
+            args.push(a.into());
+        }
+        args.push(out.to_str().unwrap().into());
+        args.extend(extra.iter().map(|s| s.to_string()));
+        for a in ["--set", "run.periods=60", "--set", "run.transient_periods=40"] {
+            args.push(a.into());
+        }
         args
     };
+    let strs = |v: &[String]| -> Vec<String> { v.to_vec() };
+    let call = |v: Vec<String>| vibrotribo(&v.iter().map(String::as_str).collect::<Vec<_>>());
     let whole = dir.path().join("whole");
-    let o = vibrotribo(&run(&whole, &[]));
+    let o = call(run(&whole, &[]));
     assert!(o.status.success(), "{}", stderr(&o));
     let cut = dir.path().join("cut");
     let mut child = Command::new(env!("CARGO_BIN_EXE_vibrotribo"))
-        .args(run(&cut, &[]))
+        .args(strs(&run(&cut, &[])))
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -104,7 +104,7 @@ fn resume_after_interruption_gives_the_uninterrupted_result() {
     assert!(interrupted, "the search ended before it could be interrupted");
     assert_eq!(status.code(), Some(130), "exit status after SIGINT");
     assert!(!cut.join("optimize.json").exists());
-    let o = vibrotribo(&run(&cut, &["--resume"]));
+    let o = call(run(&cut, &["--resume"]));
     assert!(o.status.success(), "{}", stderr(&o));
     let (a, b) = (
         json(&whole.join("optimize.json")),
@@ -114,7 +114,7 @@ fn resume_after_interruption_gives_the_uninterrupted_result() {
     assert_eq!(a["objective"], b["objective"]);
     assert_eq!(a["history"], b["history"]);
     // Starting over in a directory that holds a search is refused.
-    let o = vibrotribo(&run(&cut, &[]));
+    let o = call(run(&cut, &[]));
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--resume"), "{}", stderr(&o));
 }
