@@ -37,7 +37,6 @@ fn voc_c(h: &HarvesterParams, d1: f64, d2: f64) -> (f64, f64) {
         (TransducerMode::Freestanding, VocModel::Paper) => {
             (2.0 * sigma * d2 / EPS0, EPS0 * s / (d0 + d1 + d2))
         }
-        _ => unreachable!(),
     }
 }
 

@@ -147,7 +147,7 @@ impl MeritWatch {
     /// its range after a fall below ¼ (a Schmitt trigger), counted between the first and the
     /// last rise on the sample grid; `None` with fewer than two rises.
     fn cycles_per_period(&self) -> Option<f64> {
-        if !self.counted || !(self.period > 0.0) {
+        if !self.counted || self.period.is_nan() || self.period <= 0.0 {
             return None;
         }
         let (lo, hi) = self
@@ -156,7 +156,7 @@ impl MeritWatch {
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &q| {
                 (a.min(q), b.max(q))
             });
-        if !(hi > lo) {
+        if hi.is_nan() || lo.is_nan() || hi <= lo {
             return None;
         }
         let (low, high) = (lo + 0.25 * (hi - lo), hi - 0.25 * (hi - lo));
