@@ -15,6 +15,7 @@ mod limits;
 mod loads;
 mod lyapunov;
 mod mass_ratio;
+mod optimize;
 mod orbits;
 mod simulate;
 mod spice;
@@ -63,6 +64,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("MAX_GRID_POINTS", vibrotribo::study::limits::MAX_GRID_POINTS)?;
     m.add("MAX_MEMORY_BYTES", vibrotribo::study::limits::MAX_MEMORY_BYTES)?;
+    m.add_function(wrap_pyfunction!(optimize::optimize, m)?)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;
     m.add_function(wrap_pyfunction!(log_spaced, m)?)?;
     m.add("OrbitNotFound", m.py().get_type::<orbits::OrbitNotFound>())?;

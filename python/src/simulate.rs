@@ -80,7 +80,20 @@ pub fn simulate<'py>(
             }
             SettleMode::Fixed => None,
         };
-        let outcome = run(&spec, &mut (&mut recording, (&mut signals, motion.observer())));
+        // The figures of merit, as the command line's summary.json reports them.
+        let mut merit = spec.harvester.as_ref().map(|h| {
+            let period = spec.chain.period();
+            vibrotribo::merit::MeritWatch::new(
+                &h.params,
+                &spec.chain.gaps,
+                spec.transient_periods as f64 * period,
+                period,
+            )
+        });
+        let outcome = run(
+            &spec,
+            &mut ((&mut recording, &mut merit), (&mut signals, motion.observer())),
+        );
         // The motion after the transient, as the command line's summary.json reports it (a
         // base motion that is not periodic has no period to classify against).
         let report = outcome.as_ref().ok().and_then(|o| {
@@ -92,9 +105,10 @@ pub fn simulate<'py>(
             recording,
             started.elapsed().as_secs_f64(),
             signals,
-            report,
+            (report, merit),
         ))
     })?;
+    let (report, merit) = report;
     signals.result()?;
     let outcome = outcome.map_err(|e| PyValueError::new_err(e.to_string()))?;
     let n = spec.chain.len();
@@ -134,6 +148,14 @@ pub fn simulate<'py>(
         summary["settle_cap_periods"] = a.cap_periods.into();
     }
     summary["motion"] = motion_json(report.as_ref());
+    if let Some(w) = &merit {
+        let energy = outcome
+            .electrical
+            .as_ref()
+            .and_then(|e| e.power.as_ref())
+            .map(|p| p.energy_per_period_j);
+        vibrotribo::report::insert_merit(&mut summary, w.finish(energy).as_ref());
+    }
     out.set_item("summary", json_to_py(py, &summary)?)?;
     out.set_item("error", failure_text(&outcome))?;
     Ok(out)

@@ -101,6 +101,12 @@ PARITY = {
         "--match-tolerance": "match_tolerance", "--continuation-distance": "continuation_distance",
         **RUN,
     }),
+    "optimize": (vt.optimize, {
+        "<CONFIG>": "config", "--vary": "vary", "--objective": "objective",
+        "--constraint": "constraint", "--starts": "starts", "--seed": "seed",
+        "--particles": "particles", "--swarm-iterations": "swarm_iterations",
+        "--local-iterations": "local_iterations", "--out": None, "--resume": None, "-q": None,
+    }),
     "lyapunov": (vt.lyapunov, {
         "<CONFIG>": "config", "--periods": "periods", "--transient": "transient", "--seed": "seed",
         "--batches": "batches", "--out": None, "--plot": None, "-q": None,
@@ -114,6 +120,8 @@ CLI_ONLY = {
     "plot": "draws the pictures of an output directory; in Python plot the result arrays",
     "reproduce": "recomputes the paper's whole study into REPORT.md; its pieces are the Python "
     "functions (sweep, map, optimize_mass_ratio, load_sweep, continue_)",
+    "serve": "serves the interactive explorer to a browser; in a notebook call the functions "
+    "(simulate, sweep, map, basins) and plot their arrays",
     "help": HELP,
 }
 

@@ -72,6 +72,7 @@ __all__ = [
     "Basins",
     "attractors",
     "Attractors",
+    "optimize",
     "optimize_mass_ratio",
     "MassRatioOptimum",
     "export_spice",
@@ -554,6 +555,42 @@ def attractors(
         allow_large=allow_large,
     )
     return Attractors._from(raw)
+
+
+def optimize(
+    config: ConfigLike = None,
+    vary: Iterable[str] = (),
+    *,
+    objective: Literal["average_power", "expected_power", "power_per_mass"] = "average_power",
+    constraint: Iterable[str] = (),
+    starts: int = 4,
+    seed: int = 0,
+    particles: int = 8,
+    swarm_iterations: int = 6,
+    local_iterations: int = 30,
+) -> dict:
+    """A design optimised over configuration keys, as ``vibrotribo optimize``: ``vary`` as
+    ``["KEY=LO..HI", …]`` (a key spanning two decades or more is searched on a log scale),
+    ``objective`` to maximise, ``constraint`` as ``["breakdown_ratio<=0.9",
+    "max_displacement<=0.05", …]``; a seeded particle swarm then Nelder–Mead (argmin).
+    Returns a dict with ``best`` (key → value), ``objective`` (W, or W/kg for
+    ``power_per_mass``), its ``objective_standard_error``, ``breakdown_ratio``,
+    ``max_displacement_m``, ``evaluations``, ``history`` and ``best_config`` (the best
+    design as TOML, which ``vibrotribo simulate`` runs to the same power)."""
+    vary = [str(v) for v in vary]
+    if not vary:
+        raise ValueError("vary: give at least one KEY=LO..HI")
+    return _vibrotribo.optimize(
+        _config(config),
+        vary,
+        objective=objective,
+        constraints=[str(c) for c in constraint],
+        starts=_count(starts, "starts", least=1),
+        seed=_count(seed, "seed"),
+        particles=_count(particles, "particles", least=1),
+        swarm_iterations=_count(swarm_iterations, "swarm_iterations"),
+        local_iterations=_count(local_iterations, "local_iterations"),
+    )
 
 
 def optimize_mass_ratio(

@@ -250,6 +250,18 @@ def attractors(
 ) -> Dict[str, Any]:
     """The attractor census: the columns of attractors.csv and expected_power.csv."""
 
+def optimize(
+    config: Any,
+    vary: List[str],
+    *,
+    objective: str = ...,
+    constraints: Optional[List[str]] = ...,
+    starts: int = ...,
+    seed: int = ...,
+    particles: int = ...,
+    swarm_iterations: int = ...,
+    local_iterations: int = ...,
+) -> Dict[str, Any]: ...
 def optimize_mass_ratio(
     config: Any,
     *,

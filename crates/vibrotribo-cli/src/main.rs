@@ -14,6 +14,8 @@ mod lyapunov;
 mod manifest;
 mod map;
 mod merge;
+mod merit;
+mod optimize;
 mod output;
 mod periodic;
 mod plot;
@@ -60,6 +62,9 @@ enum Command {
     Map(map::MapArgs),
     /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
     OptimizeMassRatio(map::OptimizeArgs),
+    /// Optimise a design over several keys (particle swarm, then Nelder–Mead) for average or
+    /// expected power or power per mass, under breakdown and displacement constraints.
+    Optimize(optimize::OptimizeArgs),
     /// Basins of attraction over two initial conditions: the attractors, their basin
     /// fractions, periods, impacts and power (starts run 500 transient and 100 recorded
     /// periods unless --transient/--recorded say).
@@ -140,6 +145,7 @@ fn run() -> anyhow::Result<()> {
         Command::Chirp(args) => chirp::run(&args),
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),
+        Command::Optimize(args) => optimize::run(&args),
         Command::Lyapunov(args) => lyapunov::run(&args),
         Command::Basins(args) => basins::run(&args),
         Command::Attractors(args) => attractors::run(&args),

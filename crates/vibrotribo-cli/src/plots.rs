@@ -286,6 +286,7 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         .as_f64()
         .context("summary.json: excitation_period_s")?;
     let transient = summary["transient_periods"].as_u64().unwrap_or(0) as f64 * period;
+    crate::merit::plot_vq(dir, &summary, transient)?;
     let (h, rows) = read_csv(&dir.join("trajectory.csv"))?;
     let t = numbers(&rows, 0);
     let masses = h

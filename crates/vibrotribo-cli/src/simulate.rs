@@ -8,6 +8,7 @@ use anyhow::Result;
 use serde_json::json;
 use vibrotribo::config::Config;
 use vibrotribo::electrical::{HarvesterParams, Load, LoadKind, TransducerMode};
+use vibrotribo::merit::MeritWatch;
 use vibrotribo::study::{
     Ending, Motion, MotionReport, RunMotion, RunObserver, RunOutcome, RunSpec, Sample, SettleMode, settle,
     simulate,
@@ -204,8 +205,18 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut watch = Watch {
         progress: Progress::new(spec.periods, "periods", args.quiet),
     };
+    // The figures of merit, written beside the files.
+    let mut merit = match (&files, &spec.harvester) {
+        (Some(_), Some(h)) => Some(MeritWatch::new(
+            &h.params,
+            &spec.chain.gaps,
+            spec.transient_periods as f64 * spec.chain.period(),
+            spec.chain.period(),
+        )),
+        _ => None,
+    };
     let outcome = match files.as_mut() {
-        Some(f) => simulate(&spec, &mut (f, (&mut watch, run_motion.observer())))?,
+        Some(f) => simulate(&spec, &mut ((f, &mut merit), (&mut watch, run_motion.observer())))?,
         None => simulate(&spec, &mut (&mut watch, run_motion.observer()))?,
     };
     watch.progress.finish();
@@ -214,6 +225,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .then(|| run_motion.finish(&spec, &outcome.final_state, settled.as_ref()));
     let elapsed = started.elapsed().as_secs_f64();
     let failure = failure_error(&outcome);
+    let energy = outcome
+        .electrical
+        .as_ref()
+        .and_then(|e| e.power.as_ref())
+        .map(|p| p.energy_per_period_j);
+    let merit_report = merit.as_ref().and_then(|w| w.finish(energy));
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
         let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
@@ -222,12 +239,19 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             summary["settle_cap_periods"] = json!(a.cap_periods);
         }
         summary["motion"] = vibrotribo::report::motion_json(motion.as_ref());
+        if let Some(w) = &merit {
+            vibrotribo::report::insert_merit(&mut summary, merit_report.as_ref());
+            crate::merit::write_boundary(dir, w.boundary())?;
+        }
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
             crate::plots::analyze_run(dir, None)?;
         }
     }
     print_summary(&spec, &outcome, elapsed, args.out.as_deref());
+    if let Some(m) = &merit_report {
+        print_merit(m);
+    }
     let base = vibrotribo::report::base_motion_lines(&config, &spec);
     if !base.is_empty() {
         println!("  base motion:");
@@ -257,6 +281,19 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .into());
     }
     Ok(())
+}
+
+/// One line of the figures of merit ([`vibrotribo::merit`]).
+fn print_merit(m: &vibrotribo::merit::MeritReport) {
+    let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("n/a".to_string(), f);
+    println!(
+        "  figures of merit: CMEO {} per cycle, FOM_S {}, breakdown-limited {}, the run's cycle {} ({} of the CMEO)",
+        si(m.cmeo_energy_per_cycle_j, "J"),
+        opt(m.fom_s, &|f| format!("{f:.4}")),
+        opt(m.breakdown_limited_energy_per_cycle_j, &|e| si(e, "J")),
+        opt(m.energy_per_cycle_j, &|e| si(e, "J")),
+        opt(m.energy_fraction_of_cmeo, &|f| format!("{:.2} %", 100.0 * f)),
+    );
 }
 
 fn print_motion(m: &MotionReport) {

@@ -43,6 +43,12 @@
 //!   through impacts, sticking and chatter, with a batch-means error bar. [`attractors`]
 //!   finds the attractors that starts end on (by their stroboscopic sets), their basin
 //!   fractions and powers, and follows them across a parameter.
+//! - **Figures of merit.** [`merit`] has the triboelectric figures of merit of a run: the
+//!   cycle for maximised energy output (CMEO), `FOM_S`, the breakdown-limited maximum and the
+//!   run's own energy per cycle against them.
+//! - **Design.** [`optimize`] maximises average power, expected power over random starts or
+//!   power per mass over any numeric configuration keys, under air-breakdown and
+//!   displacement constraints (argmin's particle swarm, then Nelder–Mead).
 //!
 //! The engine alone, ten periods of the paper's default case:
 //!
@@ -81,7 +87,10 @@ pub mod electrical;
 mod error;
 pub mod excitation;
 pub mod lyapunov;
+pub mod merit;
 pub mod model;
+#[cfg(feature = "config")]
+pub mod optimize;
 pub mod orbits;
 mod random;
 #[cfg(feature = "config")]

@@ -128,6 +128,36 @@ pub fn run_summary(
     out
 }
 
+/// Adds a run's triboelectric figures of merit ([`crate::merit`]) to its `summary`: the keys
+/// `cmeo_energy_per_cycle_j` (J), `fom_s` (dimensionless), `breakdown_limited_energy_per_cycle_j`
+/// (J), `energy_per_cycle_j` (J, the run's own), `energy_fraction_of_cmeo` (dimensionless) and
+/// `merit` (the whole [`MeritReport`](crate::merit::MeritReport): the stroke, the cycles per
+/// period, the CMEO cycle's corners in the V–Q plane); all `null` without a harvester or with
+/// fewer than two states after the transient.
+pub fn insert_merit(summary: &mut serde_json::Value, merit: Option<&crate::merit::MeritReport>) {
+    let Some(obj) = summary.as_object_mut() else {
+        return;
+    };
+    obj.insert(
+        "cmeo_energy_per_cycle_j".into(),
+        json!(merit.map(|m| m.cmeo_energy_per_cycle_j)),
+    );
+    obj.insert("fom_s".into(), json!(merit.and_then(|m| m.fom_s)));
+    obj.insert(
+        "breakdown_limited_energy_per_cycle_j".into(),
+        json!(merit.and_then(|m| m.breakdown_limited_energy_per_cycle_j)),
+    );
+    obj.insert(
+        "energy_per_cycle_j".into(),
+        json!(merit.and_then(|m| m.energy_per_cycle_j)),
+    );
+    obj.insert(
+        "energy_fraction_of_cmeo".into(),
+        json!(merit.and_then(|m| m.energy_fraction_of_cmeo)),
+    );
+    obj.insert("merit".into(), json!(merit));
+}
+
 /// Student's t quantile t(0.975) with 9 degrees of freedom: the 95 % interval of a mean of
 /// 10 batch means is ± this × their standard error.
 const T_975_9: f64 = 2.262_157_162_8;

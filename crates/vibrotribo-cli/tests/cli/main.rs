@@ -10,6 +10,7 @@ mod issue_motion_classified;
 mod issue_plot_without_out;
 mod issue_simulate_output_edges;
 mod lyapunov;
+mod optimize;
 mod periodic_orbits;
 mod serve;
 mod stops;

@@ -19,6 +19,7 @@
 //! Every function validates its input and returns an [`AnalysisError`] instead of panicking
 //! on empty, too short or non-finite data.
 
+mod bandwidth;
 mod fit;
 mod period;
 mod poincare;
@@ -26,6 +27,7 @@ mod settle;
 mod spectrum;
 mod stats;
 
+pub use bandwidth::{Bandwidth, envelope, half_power_bandwidth};
 pub use fit::{QuadraticFit, fit_quadratic};
 pub use period::{PeriodOptions, Periodicity, detect_period};
 pub use poincare::{ImpactPoint, ImpactSection, StroboscopicOptions, StroboscopicSection};

@@ -142,7 +142,7 @@ pub fn gap_voltages(params: &HarvesterParams, q: f64, d1: f64, d2: f64) -> [f64;
 
 /// The constants of [`gap_voltages`], computed once.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct GapField {
+pub(crate) struct GapField {
     mode: TransducerMode,
     voc_model: VocModel,
     /// σS, C.
@@ -154,7 +154,7 @@ struct GapField {
 }
 
 impl GapField {
-    fn new(params: &HarvesterParams) -> Self {
+    pub(crate) fn new(params: &HarvesterParams) -> Self {
         let s = params.area;
         GapField {
             mode: params.mode,
@@ -168,7 +168,7 @@ impl GapField {
     /// The charges whose fields cross the gaps, C (`ε₀S ×` the field; the second 0 in
     /// contact-separation mode): the gap voltages are these times `dₖ/(ε₀S)`.
     #[inline]
-    fn charges(&self, q: f64, d1: f64, d2: f64) -> [f64; 2] {
+    pub(crate) fn charges(&self, q: f64, d1: f64, d2: f64) -> [f64; 2] {
         let sigma_s = self.sigma_s;
         match self.mode {
             TransducerMode::Freestanding => {
