@@ -150,7 +150,7 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
             "cell": options.cell,
             "continuation_distance": options.continuation_distance,
         },
-        "mechanics_only": args.run.mechanics_only,
+        "mechanics_only": starts.point_runner().mechanics_only(),
         "settings": starts.point_runner().base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),
     });

@@ -267,7 +267,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
             "cell": options.cell,
         },
         "section_scale": {"masses": masses, "length_m": scale.length, "speed_m_s": scale.speed},
-        "mechanics_only": args.run.mechanics_only,
+        "mechanics_only": starts.point_runner().mechanics_only(),
         "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
         "settings": starts.point_runner().base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),

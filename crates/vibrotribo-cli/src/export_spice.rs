@@ -6,10 +6,12 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use vibrotribo::config::Config;
+use vibrotribo::coupling::Coupling;
 use vibrotribo::electrical::spice::{self, SpiceOptions};
 use vibrotribo::electrical::{ChargeSolver, PwlGaps};
 use vibrotribo::study::{RunSpec, record_trajectory};
 
+use crate::limits;
 use crate::output::si;
 
 /// Options of `vibrotribo export-spice`.
@@ -17,7 +19,9 @@ use crate::output::si;
 pub struct ExportSpiceArgs {
     /// A directory written by `vibrotribo simulate --out`.
     pub run_dir: PathBuf,
-    /// First excitation period exported (default: the first after the transient).
+    /// First excitation period exported (default: the first after the transient, or the
+    /// last --periods of a run too short for that). The periods exported must lie within
+    /// the run.
     #[arg(long)]
     pub from_period: Option<u64>,
     /// Periods exported (default: 2).
@@ -27,12 +31,31 @@ pub struct ExportSpiceArgs {
     /// breakpoint).
     #[arg(long, default_value_t = 1.0 / 2000.0)]
     pub dt_fraction: f64,
-    /// Netlist file name, written in RUN_DIR.
+    /// Netlist file name, written in RUN_DIR (a plain file name: no directory part).
     #[arg(long, default_value = "harvester.cir")]
     pub name: String,
     /// Also run ngspice on the netlist and compare its delivered energy with vibrotribo's.
     #[arg(long)]
     pub check: bool,
+    /// Allow a netlist above the size limits (see the guide's "Limits and safety").
+    #[arg(long)]
+    pub allow_large: bool,
+}
+
+/// Refuses a netlist name that is not a plain file name (a directory part, `..`), so that
+/// the netlist stays inside the run's directory.
+fn check_name(name: &str) -> Result<()> {
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\'])
+        && std::path::Path::new(name).file_name() == Some(std::ffi::OsStr::new(name));
+    if !plain {
+        bail!(
+            "--name must be a plain file name, written inside RUN_DIR (no `/`, `\\` or `..`); got {name:?}"
+        );
+    }
+    Ok(())
 }
 
 /// Runs `vibrotribo export-spice`.
@@ -52,16 +75,49 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
         .with_context(|| format!("{} has no `settings`", summary_path.display()))?;
     let table: toml::Table =
         serde_json::from_value(settings).context("the recorded settings are not a table")?;
+    check_name(&args.name)?;
     let config = Config::from_table(table)?;
     let chain = config.chain();
     let harvester = config.harvester();
+    if chain.len() < 2 {
+        bail!(
+            "{} is a run of one mass, which has no harvester (the harvester sits between two masses): \
+             there is nothing to export",
+            args.run_dir.display()
+        );
+    }
+    if harvester.coupling == Coupling::TwoWay {
+        bail!(
+            "{} is a two-way run (harvester.coupling = \"two_way\"): its gaps depend on the charges, \
+             and export-spice drives the netlist with the mechanics alone; export a one-way run",
+            args.run_dir.display()
+        );
+    }
     if !(args.dt_fraction > 0.0 && args.dt_fraction < 1.0) {
         bail!("--dt-fraction must lie in (0, 1), got {}", args.dt_fraction);
     }
-    let from = args.from_period.unwrap_or(config.run().transient());
     if args.periods == 0 {
         bail!("--periods must be at least 1");
     }
+    let run_periods = config.run().periods;
+    let from = args.from_period.unwrap_or_else(|| {
+        config
+            .run()
+            .transient()
+            .min(run_periods.saturating_sub(args.periods))
+    });
+    if from.checked_add(args.periods).is_none_or(|end| end > run_periods) {
+        bail!(
+            "--from-period {from} with --periods {} ends past the run, which has {run_periods} periods",
+            args.periods
+        );
+    }
+    let points = PwlGaps::estimated_points(args.periods as f64, args.dt_fraction);
+    limits::check_memory(
+        "the netlist's PWL waveforms (--periods / --dt-fraction)",
+        PwlGaps::estimated_bytes(points, chain.len() - 1),
+        args.allow_large,
+    )?;
     let period = chain.period();
     let (t0, t1) = (from as f64 * period, (from + args.periods) as f64 * period);
 

@@ -9,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 use serde_json::json;
 use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
+use vibrotribo::config::Param;
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
@@ -113,6 +114,15 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
+    let (px, py) = (Param::new(&base, &args.x)?, Param::new(&base, &args.y)?);
+    if px.overlaps(&py) {
+        bail!(
+            "--x {} and --y {} set the same quantity: a map needs two different parameters \
+             (for one parameter use `vibrotribo sweep`)",
+            args.x,
+            args.y
+        );
+    }
     let runner = args.run.runner(base)?;
     let (xs, ys) = (
         grid(args.x_from, args.x_to, args.x_steps),
@@ -161,7 +171,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         transient_periods: o.transient_periods,
         recorded_periods: o.recorded_periods,
         period_tolerance: o.period_tolerance,
-        mechanics_only: args.run.mechanics_only,
+        mechanics_only: runner.mechanics_only(),
         shard: args.shard.map(|s| ShardRecord {
             index: s.index,
             count: s.count,

@@ -50,7 +50,8 @@ impl CsvFile {
         self.rows
     }
 
-    /// Writes one row of already-formatted fields.
+    /// Writes one row of already-formatted fields. A number that is not finite (NaN, ±inf:
+    /// a figure undefined for this row) is written as an empty field.
     pub fn row<I, S>(&mut self, fields: I) -> Result<()>
     where
         I: IntoIterator<Item = S>,
@@ -62,7 +63,11 @@ impl CsvFile {
             if i > 0 {
                 self.line.push(',');
             }
+            let start = self.line.len();
             let _ = write!(self.line, "{f}");
+            if matches!(&self.line[start..], "NaN" | "inf" | "-inf") {
+                self.line.truncate(start);
+            }
         }
         self.line.push('\n');
         self.rows += 1;
@@ -178,7 +183,7 @@ pub fn numbers(rows: &[Vec<String>], idx: usize) -> Vec<f64> {
 /// `value` with an SI prefix and `unit`, 4 significant digits (`12.92 µW`).
 pub fn si(value: f64, unit: &str) -> String {
     if !value.is_finite() {
-        return format!("{value} {unit}");
+        return format!("undefined ({unit})");
     }
     if value == 0.0 {
         return format!("0 {unit}");

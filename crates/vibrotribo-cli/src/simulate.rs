@@ -214,6 +214,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .then(|| run_motion.finish(&spec, &outcome.final_state, settled.as_ref()));
     let elapsed = started.elapsed().as_secs_f64();
     let failure = failure_error(&outcome);
+    // The pictures' result, reported after the summary: a figure that fails loses no run.
+    let mut plotted = Ok(());
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
         let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
@@ -224,7 +226,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         summary["motion"] = vibrotribo::report::motion_json(motion.as_ref());
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
-            crate::plots::analyze_run(dir, None)?;
+            plotted = crate::plots::analyze_run(dir, None);
         }
     }
     print_summary(&spec, &outcome, elapsed, args.out.as_deref());
@@ -238,6 +240,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let Some(m) = &motion {
         print_motion(m);
     }
+    plotted?;
     if let Some(e) = failure {
         return Err(e);
     }

@@ -101,7 +101,10 @@ impl RunArgs {
             settle: self.settle.with_cap(self.settle_cap),
         };
         let options = request.options(&base, defaults)?;
-        Ok(PointRunner::new(base, options, self.mechanics_only))
+        // A single mass (against a stop) has no gap between masses to harvest from: its
+        // points are mechanics only, as `simulate` runs it.
+        let mechanics_only = self.mechanics_only || base.chain().len() < 2;
+        Ok(PointRunner::new(base, options, mechanics_only))
     }
 }
 

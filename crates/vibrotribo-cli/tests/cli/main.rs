@@ -5,6 +5,7 @@ mod basins;
 mod chirp;
 mod composition;
 mod excitation;
+mod hostile;
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_motion_classified;
 mod issue_plot_without_out;
