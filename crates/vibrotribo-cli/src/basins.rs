@@ -279,7 +279,10 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
             let (o, done) = GridOutput::resume(dir, layout(), settings, &keys, keys.len())?;
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, layout(), settings)?), 0),
+        Some(dir) => (
+            Some(GridOutput::create(dir, layout(), settings, args.run.force)?),
+            0,
+        ),
     };
     let started = Instant::now();
     let mut fingerprints = Vec::new();

@@ -19,7 +19,7 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{Axis, Kind, MapManifest, SettleRecord, ShardRecord, base_motion_of, to_value};
-use crate::output::{CsvFile, create_dir, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
 use vibrotribo::sweep::{Cell, PointColumns, grid};
@@ -188,7 +188,15 @@ pub fn run(args: &MapArgs) -> Result<()> {
             let (o, done) = GridOutput::resume(dir, map_layout(columns), settings, &keys, keys.len())?;
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, map_layout(columns), settings)?), 0),
+        Some(dir) => (
+            Some(GridOutput::create(
+                dir,
+                map_layout(columns),
+                settings,
+                args.run.force,
+            )?),
+            0,
+        ),
     };
     let started = Instant::now();
     let (xk, yk) = (args.x.as_str(), args.y.as_str());
@@ -401,6 +409,8 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     let mut index = 0;
     let mut grid_csv = match &args.out {
         Some(dir) => {
+            // It writes no manifest of its own: any command's manifest is another job's.
+            check_out_dir(dir, "", args.run.force, |_| false)?;
             create_dir(dir)?;
             Some(CsvFile::create(
                 &dir.join("power_grid.csv"),
@@ -447,8 +457,18 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         },
     )?;
     if done < points.len() {
+        let kept = match (grid_csv.as_mut(), &args.out) {
+            (Some(csv), Some(dir)) => {
+                csv.flush()?;
+                format!(
+                    "{} holds the {done} points finished; no optimum or fit was written",
+                    dir.join("power_grid.csv").display()
+                )
+            }
+            _ => "nothing was written".to_string(),
+        };
         return Err(Interrupted {
-            what: format!("after {done} of {} points; nothing was written", points.len()),
+            what: format!("after {done} of {} points; {kept}", points.len()),
         }
         .into());
     }

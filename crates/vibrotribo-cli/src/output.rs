@@ -114,6 +114,49 @@ pub fn read_json(path: &Path) -> Result<serde_json::Value> {
     serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
 }
 
+/// The manifests by which a directory is known to hold a command's results.
+pub const MANIFESTS: [&str; 10] = [
+    "summary.json",
+    "sweep.json",
+    "map.json",
+    "basins.json",
+    "attractors.json",
+    "chirp.json",
+    "continue.json",
+    "load_sweep.json",
+    "lyapunov.json",
+    "periodic.json",
+];
+
+/// Refuses to write a job's results into `dir` when it holds another job's: a manifest
+/// other than `manifest`, or `manifest` itself with other settings (`same` false), unless
+/// `force` (files of the same name are then replaced, the others left as they are).
+pub fn check_out_dir(
+    dir: &Path,
+    manifest: &str,
+    force: bool,
+    same: impl Fn(&serde_json::Value) -> bool,
+) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    for name in MANIFESTS {
+        let path = dir.join(name);
+        if !path.exists() {
+            continue;
+        }
+        let other = name != manifest || read_json(&path).map_or(true, |old| !same(&old));
+        if other {
+            anyhow::bail!(
+                "{} holds the results of another job ({name}); write into a new directory, continue \
+                 that job with --resume, or pass --force to write over it",
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Creates `dir` (and parents) for output.
 pub fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))

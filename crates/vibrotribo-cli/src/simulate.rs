@@ -16,7 +16,7 @@ use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::output::{CsvFile, create_dir, numbered, si, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si, write_json};
 use crate::progress::{Interrupted, Progress, Watch};
 
 /// Options of `vibrotribo simulate`.
@@ -40,6 +40,10 @@ pub struct SimulateArgs {
     /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
     #[arg(long)]
     pub allow_large: bool,
+    /// Write into an --out directory that holds another job's results (files of the same
+    /// name are replaced).
+    #[arg(long)]
+    pub force: bool,
     /// `fixed`: the run as configured, from the initial state. `auto`: first settle (as
     /// `sweep --settle auto` does, mechanics only, at most --settle-cap periods), then the
     /// configured run from the settled state (the files start there; summary.json's
@@ -171,6 +175,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut spec = config.sampled_run_spec(args.mechanics_only);
     spec.breakdown_check = true;
     check_size(&config, &spec, args)?;
+    if let Some(dir) = &args.out {
+        let settings = json!(config.table());
+        check_out_dir(dir, "summary.json", args.force, |old| {
+            old.get("settings") == Some(&settings)
+        })?;
+    }
     let harvester = spec.harvester.as_ref().map(|h| &h.params);
     let mut files = match &args.out {
         Some(dir) => Some(Files::create(dir, &spec.chain, harvester)?),

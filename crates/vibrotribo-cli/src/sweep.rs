@@ -253,7 +253,12 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             (Some(o), done)
         }
         Some(dir) => (
-            Some(GridOutput::create(dir, sweep_layout(masses, columns), settings)?),
+            Some(GridOutput::create(
+                dir,
+                sweep_layout(masses, columns),
+                settings,
+                args.run.force,
+            )?),
             0,
         ),
     };

@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use serde_json::{Value, json};
 
-use crate::output::{CsvFile, create_dir, read_json, write_atomic, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, read_json, write_atomic, write_json};
 
 /// Manifest keys that describe the progress of a directory rather than its settings.
 const PROGRESS_KEYS: [&str; 3] = ["complete", "done", "rows"];
@@ -103,7 +103,11 @@ fn settings_of(manifest: &Value) -> Value {
 impl GridOutput {
     /// Starts a fresh job in `dir`: the manifest `settings` marked incomplete, then empty
     /// CSV files with their headers.
-    pub fn create(dir: &Path, layout: Layout, settings: Value) -> Result<Self> {
+    /// A directory that holds another job's results is refused unless `force`.
+    pub fn create(dir: &Path, layout: Layout, settings: Value, force: bool) -> Result<Self> {
+        check_out_dir(dir, layout.manifest, force, |old| {
+            settings_of(old) == settings_of(&settings) && old.get("shard") == settings.get("shard")
+        })?;
         create_dir(dir)?;
         let mut out = GridOutput {
             dir: dir.to_path_buf(),
@@ -144,7 +148,7 @@ impl GridOutput {
         if a != b || old.get("shard") != settings.get("shard") {
             bail!(
                 "--resume: {} holds a different job (its {} has other settings); \
-                 resume with the same configuration and options, or start afresh without --resume",
+                 resume with the same configuration and options, or start afresh with --force",
                 dir.display(),
                 layout.manifest
             );

@@ -261,25 +261,87 @@ impl Rng {
     }
 }
 
-const COMMANDS: [&str; 15] = [
-    "simulate",
-    "load-sweep",
-    "export-spice",
-    "periodic",
-    "continue",
-    "sweep",
-    "merge",
-    "chirp",
-    "map",
-    "optimize-mass-ratio",
-    "basins",
-    "attractors",
-    "lyapunov",
-    "plot",
-    "bogus",
-];
+/// A command line of each subcommand that runs as given (short runs), to which random
+/// options and values are added.
+fn base_case(command: usize, run: &str) -> Vec<&str> {
+    let mut args: Vec<&str> = match command {
+        0 => vec!["simulate"],
+        1 => vec!["load-sweep", "--steps", "3"],
+        2 => vec!["export-spice", run],
+        3 => vec!["periodic"],
+        4 => vec![
+            "continue",
+            "--param",
+            "omega_ratio",
+            "--from",
+            "0.75",
+            "--to",
+            "0.8",
+            "--max-points",
+            "5",
+        ],
+        5 => vec![
+            "sweep",
+            "--param",
+            "omega_ratio",
+            "--from",
+            "0.7",
+            "--to",
+            "0.8",
+            "--steps",
+            "2",
+        ],
+        6 => vec!["merge", "--out", "merged", run],
+        7 => vec!["chirp", "--from", "0.7", "--to", "0.8", "--duration", "2"],
+        8 => vec![
+            "map",
+            "--x",
+            "omega_ratio",
+            "--x-from",
+            "0.7",
+            "--x-to",
+            "0.8",
+            "--x-steps",
+            "2",
+            "--y",
+            "mass_ratio",
+            "--y-from",
+            "2",
+            "--y-to",
+            "3",
+            "--y-steps",
+            "2",
+        ],
+        9 => vec!["optimize-mass-ratio", "--omega-steps", "2", "--rm-steps", "2"],
+        10 => vec![
+            "basins", "--x", "x1", "--x-from", "-0.01", "--x-to", "0.01", "--y", "v1", "--y-from", "-0.1",
+            "--y-to", "0.1", "--grid", "2x2",
+        ],
+        11 => vec![
+            "attractors",
+            "--param",
+            "omega_ratio",
+            "--from",
+            "0.7",
+            "--to",
+            "0.8",
+            "--steps",
+            "2",
+            "--samples",
+            "2",
+        ],
+        12 => vec!["lyapunov", "--periods", "20", "--transient", "5"],
+        13 => vec!["plot", run],
+        _ => vec!["bogus"],
+    };
+    if matches!(command, 5 | 8 | 9 | 10 | 11) {
+        args.extend_from_slice(&["--transient", "5", "--recorded", "5", "--settle", "fixed"]);
+    }
+    args
+}
 
-const OPTIONS: [&str; 30] = [
+/// Options of the subcommands, each taken with a random value where it takes one.
+const OPTIONS: [&str; 34] = [
     "--steps",
     "--from",
     "--to",
@@ -301,6 +363,9 @@ const OPTIONS: [&str; 30] = [
     "--threads",
     "--shard",
     "--mass",
+    "--period",
+    "--max-points",
+    "--duration",
     "--out",
     "--resume",
     "--force",
@@ -310,15 +375,28 @@ const OPTIONS: [&str; 30] = [
     "-q",
     "--check",
     "--settle",
+    "--omega-steps",
 ];
 
-const VALUES: [&str; 24] = [
+const FLAGS: [&str; 8] = [
+    "--resume",
+    "--force",
+    "--allow-large",
+    "--mechanics-only",
+    "--plot",
+    "-q",
+    "--check",
+    "--out",
+];
+
+const VALUES: [&str; 26] = [
     "0",
     "1",
     "2",
     "3",
     "-1",
     "0.5",
+    "0.75",
     "1e300",
     "-1e300",
     "1e-300",
@@ -336,6 +414,7 @@ const VALUES: [&str; 24] = [
     "0/0",
     "../../escape",
     "auto",
+    "fixed",
     "excitation.amplitude",
 ];
 
@@ -357,7 +436,7 @@ const SETTINGS: [&str; 24] = [
     "excitation.omega_ratio=1e9",
     "excitation.amplitude=nan",
     "excitation.harmonics[0].amplitude=1",
-    "harvester.coupling=two_way",
+    "harvester.coupling=\"two_way\"",
     "harvester.storage_initial_voltage=1e9",
     "harvester.load=\"rectifier\"",
     "mass_ratio=3",
@@ -366,10 +445,12 @@ const SETTINGS: [&str; 24] = [
     "excitation.kind=\"random\"",
 ];
 
-/// A random command line; `dir` is a scratch directory for its output.
-fn random_case(rng: &mut Rng, dir: &Path) -> Vec<String> {
-    let mut args = vec![rng.pick(&COMMANDS).to_string()];
-    if rng.chance(50) {
+/// A random command line: a subcommand's runnable base, perhaps a configuration, random
+/// options and values and `--set` overrides. `run` is a finished `simulate` run, `dir` a
+/// scratch directory for its output.
+fn random_case(rng: &mut Rng, run: &str, dir: &Path) -> Vec<String> {
+    let mut args = strings(&base_case(rng.below(15), run));
+    if rng.chance(40) {
         let configs = [
             "default.toml",
             "impact_oscillator.toml",
@@ -378,30 +459,32 @@ fn random_case(rng: &mut Rng, dir: &Path) -> Vec<String> {
         ];
         args.push(config_file(rng.pick(&configs)).display().to_string());
     }
-    if args[0] == "export-spice" || args[0] == "plot" || args[0] == "merge" {
-        args.push(dir.join("run").display().to_string());
-    }
+    let command = args[0].clone();
     // Keep most runs short, so that a case is about its input, not its length.
-    if rng.chance(80) {
+    if rng.chance(80) && !matches!(command.as_str(), "export-spice" | "merge" | "plot") {
         args.extend(strings(&[
             "--set",
-            "run.periods=4",
+            "run.periods=8",
             "--set",
-            "run.transient_periods=2",
+            "run.transient_periods=4",
         ]));
     }
-    for _ in 0..rng.below(4) {
+    for _ in 0..rng.below(3) {
         let option = rng.pick(&OPTIONS);
         args.push(option.to_string());
-        match option {
-            "--out" => args.push(dir.join("out").display().to_string()),
-            "--resume" | "--force" | "--allow-large" | "--mechanics-only" | "--plot" | "-q" | "--check" => {}
-            _ => args.push(rng.pick(&VALUES).to_string()),
+        if option == "--out" {
+            args.push(dir.join("out").display().to_string());
+        } else if !FLAGS.contains(&option) {
+            args.push(rng.pick(&VALUES).to_string());
         }
     }
-    for _ in 0..rng.below(3) {
-        args.push("--set".into());
-        args.push(rng.pick(&SETTINGS).to_string());
+    if !matches!(command.as_str(), "export-spice" | "merge" | "plot") {
+        for _ in 0..rng.below(3) {
+            if rng.chance(50) {
+                args.push("--set".into());
+                args.push(rng.pick(&SETTINGS).to_string());
+            }
+        }
     }
     args
 }
@@ -415,11 +498,29 @@ fn hostile(seed: u64, count: usize) {
         let e = run_case(&args, scratch.path(), None);
         tally.add(&args, &e);
     }
+    // A finished run for export-spice, merge and plot to read.
+    let run = scratch.path().join("run");
+    let made = run_case(
+        &strings(&[
+            "simulate",
+            "-q",
+            "--out",
+            run.to_str().unwrap(),
+            "--set",
+            "run.periods=8",
+            "--set",
+            "run.transient_periods=4",
+        ]),
+        scratch.path(),
+        None,
+    );
+    assert_eq!(made.status, Some(0), "{}", made.stderr);
+    let run = run.display().to_string();
     let mut rng = Rng(seed);
     for i in 0..count {
         let dir: PathBuf = scratch.path().join(format!("case{i}"));
         std::fs::create_dir_all(&dir).unwrap();
-        let args = random_case(&mut rng, &dir);
+        let args = random_case(&mut rng, &run, &dir);
         let signal = rng.chance(25).then(|| {
             let sig = [SIGINT, SIGTERM, SIGKILL][rng.below(3)];
             (Duration::from_millis(rng.below(1500) as u64), sig)
