@@ -148,6 +148,15 @@ struct Tally {
 impl Tally {
     fn add(&mut self, args: &[String], e: &Ending) {
         self.cases += 1;
+        if std::env::var_os("HOSTILE_VERBOSE").is_some() {
+            let last = e.stderr.lines().last().unwrap_or("");
+            eprintln!(
+                "{:?} {:?} vibrotribo {}\n    {last}",
+                e.status,
+                e.sent,
+                args.join(" ")
+            );
+        }
         match fault(e) {
             Some(f) => self
                 .faults
@@ -196,10 +205,18 @@ fn known_cases(out: &Path) -> Vec<Vec<String>> {
             "map",
             "--x",
             "omega_ratio",
-            "--y",
-            "omega_ratio",
+            "--x-from",
+            "0.7",
+            "--x-to",
+            "0.8",
             "--x-steps",
             "2",
+            "--y",
+            "omega_ratio",
+            "--y-from",
+            "0.7",
+            "--y-to",
+            "0.8",
             "--y-steps",
             "2",
         ],
@@ -207,10 +224,18 @@ fn known_cases(out: &Path) -> Vec<Vec<String>> {
             "map",
             "--x",
             "omega_ratio",
-            "--y",
-            "frequency_hz",
+            "--x-from",
+            "0.7",
+            "--x-to",
+            "0.8",
             "--x-steps",
             "2",
+            "--y",
+            "frequency_hz",
+            "--y-from",
+            "0.7",
+            "--y-to",
+            "0.8",
             "--y-steps",
             "2",
         ],
@@ -224,13 +249,15 @@ fn known_cases(out: &Path) -> Vec<Vec<String>> {
         }
     }
     let mut cases: Vec<Vec<String>> = cases.into_iter().map(|c| strings(&c)).collect();
+    cases.push(strings(&["simulate", &io, "--out", &d("io"), "--plot", "-q"]));
     cases.push(strings(&[
-        "simulate",
-        &io,
+        "load-sweep",
+        "--steps",
+        "2",
+        "--vq-points",
+        "1000000000",
         "--out",
-        &d("io"),
-        "--plot",
-        "-q",
+        &d("ls"),
         "--set",
         "run.periods=6",
     ]));
@@ -450,7 +477,8 @@ const SETTINGS: [&str; 24] = [
 /// scratch directory for its output.
 fn random_case(rng: &mut Rng, run: &str, dir: &Path) -> Vec<String> {
     let mut args = strings(&base_case(rng.below(15), run));
-    if rng.chance(40) {
+    let reads_a_run = matches!(args[0].as_str(), "export-spice" | "merge" | "plot");
+    if rng.chance(40) && !reads_a_run {
         let configs = [
             "default.toml",
             "impact_oscillator.toml",
@@ -459,15 +487,18 @@ fn random_case(rng: &mut Rng, run: &str, dir: &Path) -> Vec<String> {
         ];
         args.push(config_file(rng.pick(&configs)).display().to_string());
     }
-    let command = args[0].clone();
     // Keep most runs short, so that a case is about its input, not its length.
-    if rng.chance(80) && !matches!(command.as_str(), "export-spice" | "merge" | "plot") {
+    if rng.chance(80) && !reads_a_run {
         args.extend(strings(&[
             "--set",
             "run.periods=8",
             "--set",
             "run.transient_periods=4",
         ]));
+    }
+    // Half the cases as runnable as their base, the others with hostile additions.
+    if rng.chance(50) {
+        return args;
     }
     for _ in 0..rng.below(3) {
         let option = rng.pick(&OPTIONS);
@@ -478,7 +509,7 @@ fn random_case(rng: &mut Rng, run: &str, dir: &Path) -> Vec<String> {
             args.push(rng.pick(&VALUES).to_string());
         }
     }
-    if !matches!(command.as_str(), "export-spice" | "merge" | "plot") {
+    if !reads_a_run {
         for _ in 0..rng.below(3) {
             if rng.chance(50) {
                 args.push("--set".into());
