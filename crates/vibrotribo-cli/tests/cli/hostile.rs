@@ -123,7 +123,7 @@ fn fault(e: &Ending) -> Option<String> {
         return Some(format!("killed by signal {sig}, none of ours"));
     }
     match e.status {
-        Some(0 | 1 | 2) => {}
+        Some(0..=2) => {}
         Some(130) if e.sent == Some(SIGINT) => {}
         Some(143) if e.sent == Some(SIGTERM) => {}
         Some(c) => return Some(format!("exit status {c}")),
@@ -238,6 +238,21 @@ fn known_cases(out: &Path) -> Vec<Vec<String>> {
             "0.8",
             "--y-steps",
             "2",
+        ],
+        vec![
+            "optimize-mass-ratio",
+            "--omega-steps",
+            "2",
+            "--rm-steps",
+            "2",
+            "--transient",
+            "5",
+            "--recorded",
+            "5",
+            "--settle",
+            "fixed",
+            "--set",
+            "oscillator.masses=[1e300,0.1,0.1]",
         ],
         vec!["export-spice", "/nonexistent/run"],
         vec!["plot", "/nonexistent/dir"],

@@ -93,8 +93,8 @@ impl GapPolynomial {
             1.0
         };
         let coefficients = wanted * TYPICAL_TERMS * n_masses.saturating_sub(1).max(1) as f64;
-        // Written so that a NaN estimate is refused too.
-        if !(coefficients <= MAX_COEFFICIENTS) {
+        // A NaN estimate (a rate that is not finite) is refused too.
+        if coefficients.is_nan() || coefficients > MAX_COEFFICIENTS {
             return Err(TooFine {
                 t_start: flow.t_start,
                 t_end: flow.t_end,
