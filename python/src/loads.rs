@@ -19,7 +19,8 @@ fn json<T: serde::Serialize>(py: Python<'_>, v: &T) -> PyResult<Py<PyAny>> {
 
 /// Runs a load sweep (see the Python `vibrotribo.load_sweep`).
 #[pyfunction]
-#[pyo3(signature = (config, *, resistances = None, low = 1e3, high = 1e13, steps = 41, vq_points = Some(400)))]
+#[pyo3(signature = (config, *, resistances = None, low = 1e3, high = 1e13, steps = 41, vq_points = Some(400), allow_large = false))]
+#[allow(clippy::too_many_arguments)]
 pub fn load_sweep<'py>(
     py: Python<'py>,
     config: &Bound<'py, PyAny>,
@@ -28,6 +29,7 @@ pub fn load_sweep<'py>(
     high: f64,
     steps: usize,
     vq_points: Option<usize>,
+    allow_large: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config_of(config)?;
     let resistances = match resistances {
@@ -49,11 +51,17 @@ pub fn load_sweep<'py>(
             "resistances must be positive, got {r}"
         )));
     }
+    crate::limits::check_grid("resistances", resistances.len() as f64)?;
     let spec = config.run_spec(false);
     let options = LoadStudyOptions {
         resistances,
         vq_points,
     };
+    crate::limits::check_memory(
+        "the V–Q curve (vq_points)",
+        options.estimated_bytes(),
+        allow_large,
+    )?;
     let (study, signals) = py.detach(|| {
         let mut signals = Signals::new();
         (load_study(&spec, &options, &mut signals), signals)

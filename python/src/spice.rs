@@ -5,6 +5,7 @@
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use vibrotribo::electrical::PwlGaps;
 use vibrotribo::study::{
     DEFAULT_SPICE_DT_FRACTION, DEFAULT_SPICE_PERIODS, SPICE_DATA_FILE, SpiceExportError, spice_check,
     spice_export,
@@ -15,14 +16,18 @@ use crate::convert::{array1, array2};
 
 fn export_error(e: SpiceExportError) -> PyErr {
     match e {
-        SpiceExportError::Option { .. } | SpiceExportError::Param(_) => PyValueError::new_err(e.to_string()),
+        SpiceExportError::Option { .. }
+        | SpiceExportError::Param(_)
+        | SpiceExportError::OneMass
+        | SpiceExportError::TwoWay => PyValueError::new_err(e.to_string()),
         other => PyRuntimeError::new_err(other.to_string()),
     }
 }
 
 /// The netlist of a configuration's run (see the Python `vibrotribo.export_spice`).
 #[pyfunction]
-#[pyo3(signature = (config, *, from_period = None, periods = DEFAULT_SPICE_PERIODS, dt_fraction = DEFAULT_SPICE_DT_FRACTION, check = false))]
+#[pyo3(signature = (config, *, from_period = None, periods = DEFAULT_SPICE_PERIODS, dt_fraction = DEFAULT_SPICE_DT_FRACTION, check = false, allow_large = false))]
+#[allow(clippy::too_many_arguments)]
 pub fn export_spice<'py>(
     py: Python<'py>,
     config: &Bound<'py, PyAny>,
@@ -30,8 +35,19 @@ pub fn export_spice<'py>(
     periods: u64,
     dt_fraction: f64,
     check: bool,
+    allow_large: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config_of(config)?;
+    // The PWL waveforms' size, checked before they are built (as `export-spice` does).
+    if dt_fraction > 0.0 && dt_fraction < 1.0 {
+        let points = PwlGaps::estimated_points(periods as f64, dt_fraction);
+        let gaps = config.chain().len().saturating_sub(1).max(1);
+        crate::limits::check_memory(
+            "the netlist's PWL waveforms (periods / dt_fraction)",
+            PwlGaps::estimated_bytes(points, gaps),
+            allow_large,
+        )?;
+    }
     let export = py
         .detach(|| spice_export(&config, from_period, periods, dt_fraction))
         .map_err(export_error)?;

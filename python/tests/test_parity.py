@@ -38,7 +38,7 @@ RUN = {
     "--allow-large": "allow_large",
     "-q": None,
 }
-COMMON = {"--set": None, "-h": None, "--help": None}
+COMMON = {"--set": None, "-h": None, "--help": None, "--force": None}
 
 # command → (Python function, {option: parameter or None (CLI only)}).
 PARITY = {
@@ -49,10 +49,12 @@ PARITY = {
     "load-sweep": (vt.load_sweep, {
         "<CONFIG>": "config", "--from": "low", "--to": "high", "--steps": "steps",
         "--vq-points": "vq_points", "--out": None, "--plot": None, "-q": None,
+        "--allow-large": "allow_large",
     }),
     "export-spice": (vt.export_spice, {
         "<RUN_DIR>": "config", "--from-period": "from_period", "--periods": "periods",
         "--dt-fraction": "dt_fraction", "--name": None, "--check": "check",
+        "--allow-large": "allow_large",
     }),
     "periodic": (vt.periodic, {
         "<CONFIG>": "config", "--period": "period", "--transient": "transient",
@@ -126,7 +128,8 @@ CLI_ONLY = {
 }
 
 # Why a mapped option is None, by option.
-REASONS = {"--out": FILES, "--plot": PLOT, "-q": QUIET, "--shard": SHARD, "--resume": RESUME,
+REASONS = {"--force": "CLI only: writes over another job's files; a Python result is held in memory",
+           "--out": FILES, "--plot": PLOT, "-q": QUIET, "--shard": SHARD, "--resume": RESUME,
            "--name": "CLI only: the netlist's file name; SpiceExport.write(path) writes it anywhere",
            "--diagram-steps": PLOT, "--mass": PLOT,
            "--mechanics-only": "refused by the command (the optimum maximises power)"}

@@ -278,6 +278,7 @@ def load_sweep(
     high: float = 1e13,
     steps: int = 41,
     vq_points: Optional[int] = 400,
+    allow_large: bool = False,
 ) -> LoadSweep:
     """Average power against the load resistance: the configuration's mechanics simulated
     once (``run.periods``), the charge of its harvester with a resistor of each resistance
@@ -294,6 +295,7 @@ def load_sweep(
         high=high,
         steps=_count(steps, "steps", least=1),
         vq_points=_count(vq_points, "vq_points"),
+        allow_large=allow_large,
     )
     return LoadSweep._from(raw)
 
@@ -643,6 +645,7 @@ def export_spice(
     periods: int = 2,
     dt_fraction: float = 0.0005,
     check: bool = False,
+    allow_large: bool = False,
 ) -> SpiceExport:
     """An ngspice netlist of the harvester of a run (a :class:`Simulation` or its
     configuration), driven by the run's gap waveforms over ``periods`` excitation periods
@@ -657,6 +660,7 @@ def export_spice(
         periods=_count(periods, "periods", least=1),
         dt_fraction=float(dt_fraction),
         check=check,
+        allow_large=allow_large,
     )
     return SpiceExport(**{k: (tuple(v) if k == "window_s" else v) for k, v in raw.items()})
 

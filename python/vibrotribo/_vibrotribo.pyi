@@ -137,6 +137,7 @@ def load_sweep(
     high: float = 1e13,
     steps: int = 41,
     vq_points: Optional[int] = 400,
+    allow_large: bool = ...,
 ) -> Dict[str, Any]:
     """A load sweep: the columns of load_sweep.csv and vq_cycle.csv, the optimum."""
 
@@ -289,6 +290,7 @@ def export_spice(
     periods: int = 2,
     dt_fraction: float = 0.0005,
     check: bool = False,
+    allow_large: bool = ...,
 ) -> Dict[str, Any]:
     """The ngspice netlist of a run and its gap waveforms."""
 

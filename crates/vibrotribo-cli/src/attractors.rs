@@ -16,7 +16,9 @@ use vibrotribo::sweep::grid;
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
 use crate::job::{RunArgs, check_all, check_distinct, set_threads};
-use crate::output::{CsvFile, create_dir, csv_text, numbered, read_csv, read_json, si, write_json};
+use crate::output::{
+    CsvFile, check_out_dir, create_dir, csv_text, numbered, read_csv, read_json, si, write_json,
+};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};
 
@@ -150,14 +152,18 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
             "cell": options.cell,
             "continuation_distance": options.continuation_distance,
         },
-        "mechanics_only": args.run.mechanics_only,
+        "mechanics_only": starts.point_runner().mechanics_only(),
         "settings": starts.point_runner().base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),
     });
     let mut files = match &args.out {
         Some(dir) => {
+            let ours = with_progress(&settings, false, 0);
+            check_out_dir(dir, "attractors.json", args.run.force, |old| {
+                with_progress(old, false, 0) == ours
+            })?;
             create_dir(dir)?;
-            write_json(&dir.join("attractors.json"), &with_progress(&settings, false, 0))?;
+            write_json(&dir.join("attractors.json"), &ours)?;
             let mut cols: Vec<String> = ATTRACTOR_COLUMNS.map(String::from).to_vec();
             cols.extend(numbered("x", masses, "_m"));
             cols.extend(numbered("v", masses, "_m_s"));

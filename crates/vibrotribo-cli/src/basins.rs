@@ -258,7 +258,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
             "cell": options.cell,
         },
         "section_scale": {"masses": masses, "length_m": scale.length, "speed_m_s": scale.speed},
-        "mechanics_only": args.run.mechanics_only,
+        "mechanics_only": starts.point_runner().mechanics_only(),
         "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
         "settings": starts.point_runner().base().table(),
         "vibrotribo_version": env!("CARGO_PKG_VERSION"),
@@ -270,7 +270,10 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
             let (o, done) = GridOutput::resume(dir, layout(), settings, &keys, keys.len())?;
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, layout(), settings)?), 0),
+        Some(dir) => (
+            Some(GridOutput::create(dir, layout(), settings, args.run.force)?),
+            0,
+        ),
     };
     let started = Instant::now();
     let mut fingerprints = Vec::new();

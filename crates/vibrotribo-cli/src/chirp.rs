@@ -203,7 +203,17 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
                 j.size_m,
                 100.0 * j.relative
             ),
-            None => println!("  {:>4}: {} cycles", r.direction.as_str(), r.cycles.len()),
+            None if r.cycles.len() < 2 * options.jump_window => println!(
+                "  {:>4}: {} cycles; no jump located: that needs at least 2 × --jump-window = {} cycles",
+                r.direction.as_str(),
+                r.cycles.len(),
+                2 * options.jump_window
+            ),
+            None => println!(
+                "  {:>4}: {} cycles; no jump located",
+                r.direction.as_str(),
+                r.cycles.len()
+            ),
         }
     }
     if let [up, down] = runs

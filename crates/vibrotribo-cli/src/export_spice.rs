@@ -4,10 +4,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use vibrotribo::config::Config;
+use vibrotribo::electrical::PwlGaps;
 use vibrotribo::study::{SPICE_DATA_FILE, SpiceExportError, spice_check, spice_export};
 
+use crate::limits;
 use crate::output::si;
 
 /// Options of `vibrotribo export-spice`.
@@ -15,7 +17,9 @@ use crate::output::si;
 pub struct ExportSpiceArgs {
     /// A directory written by `vibrotribo simulate --out`.
     pub run_dir: PathBuf,
-    /// First excitation period exported (default: the first after the transient).
+    /// First excitation period exported (default: the first after the transient, or the
+    /// last --periods of a run too short for that). The periods exported must lie within
+    /// the run.
     #[arg(long)]
     pub from_period: Option<u64>,
     /// Periods exported (default: 2).
@@ -25,12 +29,31 @@ pub struct ExportSpiceArgs {
     /// breakpoint).
     #[arg(long, default_value_t = vibrotribo::study::DEFAULT_SPICE_DT_FRACTION)]
     pub dt_fraction: f64,
-    /// Netlist file name, written in RUN_DIR.
+    /// Netlist file name, written in RUN_DIR (a plain file name: no directory part).
     #[arg(long, default_value = "harvester.cir")]
     pub name: String,
     /// Also run ngspice on the netlist and compare its delivered energy with vibrotribo's.
     #[arg(long)]
     pub check: bool,
+    /// Allow a netlist above the size limits (see the guide's "Limits and safety").
+    #[arg(long)]
+    pub allow_large: bool,
+}
+
+/// Refuses a netlist name that is not a plain file name (a directory part, `..`), so that
+/// the netlist stays inside the run's directory.
+fn check_name(name: &str) -> Result<()> {
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\'])
+        && std::path::Path::new(name).file_name() == Some(std::ffi::OsStr::new(name));
+    if !plain {
+        bail!(
+            "--name must be a plain file name, written inside RUN_DIR (no `/`, `\\` or `..`); got {name:?}"
+        );
+    }
+    Ok(())
 }
 
 /// Runs `vibrotribo export-spice`.
@@ -50,11 +73,24 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
         .with_context(|| format!("{} has no `settings`", summary_path.display()))?;
     let table: toml::Table =
         serde_json::from_value(settings).context("the recorded settings are not a table")?;
+    check_name(&args.name)?;
     let config = Config::from_table(table)?;
+    // The PWL waveforms' size, checked before they are built.
+    if args.dt_fraction > 0.0 && args.dt_fraction < 1.0 {
+        let points = PwlGaps::estimated_points(args.periods as f64, args.dt_fraction);
+        limits::check_memory(
+            "the netlist's PWL waveforms (--periods / --dt-fraction)",
+            PwlGaps::estimated_bytes(points, config.chain().len().saturating_sub(1).max(1)),
+            args.allow_large,
+        )?;
+    }
     let export =
         spice_export(&config, args.from_period, args.periods, args.dt_fraction).map_err(|e| match e {
             SpiceExportError::Option { option, message } => {
                 anyhow::anyhow!("--{}: {message}", option.replace('_', "-"))
+            }
+            other @ (SpiceExportError::OneMass | SpiceExportError::TwoWay) => {
+                anyhow::anyhow!("{}: {other}", args.run_dir.display())
             }
             other => other.into(),
         })?;

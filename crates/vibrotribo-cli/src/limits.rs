@@ -53,7 +53,7 @@ pub fn check_memory(what: &str, bytes: f64, allow: bool) -> Result<()> {
     if bytes > MAX_MEMORY_BYTES && !allow {
         bail!(
             "{what} would need about {:.1} GiB of memory (limit {:.0} GiB without --allow-large); \
-             run fewer periods, or pass --allow-large",
+             ask for less (fewer periods or points), or pass --allow-large",
             bytes / GIB,
             MAX_MEMORY_BYTES / GIB
         );

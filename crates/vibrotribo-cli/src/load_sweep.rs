@@ -9,6 +9,7 @@ use vibrotribo::electrical::{HarvesterParams, Load, log_spaced};
 use vibrotribo::study::{LoadStudyOptions, load_study};
 
 use crate::config::ConfigArgs;
+use crate::limits;
 use crate::output::{CsvFile, create_dir, si, write_json};
 use crate::plot::{self, both};
 use crate::progress::{Interrupted, Progress, Watch};
@@ -39,6 +40,9 @@ pub struct LoadSweepArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Allow a job above the size limits (see the guide's "Limits and safety").
+    #[arg(long)]
+    pub allow_large: bool,
 }
 
 /// Runs `vibrotribo load-sweep`.
@@ -53,6 +57,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
     if args.steps == 0 {
         bail!("--steps must be at least 1");
     }
+    limits::check_grid("--steps", args.steps as f64)?;
     let config = args.input.load()?;
     let spec = config.run_spec(false);
 
@@ -65,6 +70,11 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         resistances: log_spaced(args.from, args.to, args.steps),
         vq_points: args.out.is_some().then_some(args.vq_points),
     };
+    limits::check_memory(
+        "the V–Q cycles (--vq-points)",
+        options.estimated_bytes(),
+        args.allow_large,
+    )?;
     let study = load_study(&spec, &options, &mut watch)?;
     watch.progress.finish();
     let Some(study) = study else {

@@ -1,6 +1,11 @@
 //! The `vibrotribo` command-line program: argument parsing, configuration files, output
 //! files and plots. All physics lives in the `vibrotribo` library.
 
+// First, so that its `print!` and `println!` (which survive a closed pipe or a full disk)
+// replace the standard ones in every module below.
+#[macro_use]
+mod stdout;
+
 mod attractors;
 mod basins;
 mod chirp;
@@ -163,6 +168,7 @@ fn main() -> ExitCode {
     let result = run();
     // The pictures drawn, also when the command stopped on the way.
     plot::drawn::report();
+    let result = result.and(stdout::finish());
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => match e.downcast_ref::<progress::Interrupted>() {

@@ -9,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 use serde_json::json;
 use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
+use vibrotribo::config::Param;
 
 use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
@@ -18,7 +19,7 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{Axis, Kind, MapManifest, SettleRecord, ShardRecord, base_motion_of, to_value};
-use crate::output::{CsvFile, create_dir, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
 use vibrotribo::sweep::{Cell, PointColumns, grid};
@@ -113,6 +114,15 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load()?;
+    let (px, py) = (Param::new(&base, &args.x)?, Param::new(&base, &args.y)?);
+    if px.overlaps(&py) {
+        bail!(
+            "--x {} and --y {} set the same quantity: a map needs two different parameters \
+             (for one parameter use `vibrotribo sweep`)",
+            args.x,
+            args.y
+        );
+    }
     let runner = args.run.runner(base)?;
     let (xs, ys) = (
         grid(args.x_from, args.x_to, args.x_steps),
@@ -161,7 +171,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         transient_periods: o.transient_periods,
         recorded_periods: o.recorded_periods,
         period_tolerance: o.period_tolerance,
-        mechanics_only: args.run.mechanics_only,
+        mechanics_only: runner.mechanics_only(),
         shard: args.shard.map(|s| ShardRecord {
             index: s.index,
             count: s.count,
@@ -178,7 +188,15 @@ pub fn run(args: &MapArgs) -> Result<()> {
             let (o, done) = GridOutput::resume(dir, map_layout(columns), settings, &keys, keys.len())?;
             (Some(o), done)
         }
-        Some(dir) => (Some(GridOutput::create(dir, map_layout(columns), settings)?), 0),
+        Some(dir) => (
+            Some(GridOutput::create(
+                dir,
+                map_layout(columns),
+                settings,
+                args.run.force,
+            )?),
+            0,
+        ),
     };
     let started = Instant::now();
     let (xk, yk) = (args.x.as_str(), args.y.as_str());
@@ -369,6 +387,8 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     let mut index = 0;
     let mut grid_csv = match &args.out {
         Some(dir) => {
+            // It writes no manifest of its own: any command's manifest is another job's.
+            check_out_dir(dir, "", args.run.force, |_| false)?;
             create_dir(dir)?;
             Some(CsvFile::create(
                 &dir.join("power_grid.csv"),
@@ -415,8 +435,18 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         },
     )?;
     if done < points.len() {
+        let kept = match (grid_csv.as_mut(), &args.out) {
+            (Some(csv), Some(dir)) => {
+                csv.flush()?;
+                format!(
+                    "{} holds the {done} points finished; no optimum or fit was written",
+                    dir.join("power_grid.csv").display()
+                )
+            }
+            _ => "nothing was written".to_string(),
+        };
         return Err(Interrupted {
-            what: format!("after {done} of {} points; nothing was written", points.len()),
+            what: format!("after {done} of {} points; {kept}", points.len()),
         }
         .into());
     }

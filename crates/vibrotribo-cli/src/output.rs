@@ -50,7 +50,8 @@ impl CsvFile {
         self.rows
     }
 
-    /// Writes one row of already-formatted fields.
+    /// Writes one row of already-formatted fields. A number that is not finite (NaN, ±inf:
+    /// a figure undefined for this row) is written as an empty field.
     pub fn row<I, S>(&mut self, fields: I) -> Result<()>
     where
         I: IntoIterator<Item = S>,
@@ -62,7 +63,11 @@ impl CsvFile {
             if i > 0 {
                 self.line.push(',');
             }
+            let start = self.line.len();
             let _ = write!(self.line, "{f}");
+            if matches!(&self.line[start..], "NaN" | "inf" | "-inf") {
+                self.line.truncate(start);
+            }
         }
         self.line.push('\n');
         self.rows += 1;
@@ -107,6 +112,49 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 pub fn read_json(path: &Path) -> Result<serde_json::Value> {
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     serde_json::from_str(&text).with_context(|| format!("{} is not valid JSON", path.display()))
+}
+
+/// The manifests by which a directory is known to hold a command's results.
+pub const MANIFESTS: [&str; 10] = [
+    "summary.json",
+    "sweep.json",
+    "map.json",
+    "basins.json",
+    "attractors.json",
+    "chirp.json",
+    "continue.json",
+    "load_sweep.json",
+    "lyapunov.json",
+    "periodic.json",
+];
+
+/// Refuses to write a job's results into `dir` when it holds another job's: a manifest
+/// other than `manifest`, or `manifest` itself with other settings (`same` false), unless
+/// `force` (files of the same name are then replaced, the others left as they are).
+pub fn check_out_dir(
+    dir: &Path,
+    manifest: &str,
+    force: bool,
+    same: impl Fn(&serde_json::Value) -> bool,
+) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    for name in MANIFESTS {
+        let path = dir.join(name);
+        if !path.exists() {
+            continue;
+        }
+        let other = name != manifest || read_json(&path).map_or(true, |old| !same(&old));
+        if other {
+            anyhow::bail!(
+                "{} holds the results of another job ({name}); write into a new directory, continue \
+                 that job with --resume, or pass --force to write over it",
+                dir.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Creates `dir` (and parents) for output.
@@ -178,7 +226,7 @@ pub fn numbers(rows: &[Vec<String>], idx: usize) -> Vec<f64> {
 /// `value` with an SI prefix and `unit`, 4 significant digits (`12.92 µW`).
 pub fn si(value: f64, unit: &str) -> String {
     if !value.is_finite() {
-        return format!("{value} {unit}");
+        return format!("undefined ({unit})");
     }
     if value == 0.0 {
         return format!("0 {unit}");

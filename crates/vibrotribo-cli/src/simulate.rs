@@ -17,7 +17,7 @@ use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::output::{CsvFile, create_dir, numbered, si, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si, write_json};
 use crate::progress::{Interrupted, Progress, Watch};
 
 /// Options of `vibrotribo simulate`.
@@ -41,6 +41,10 @@ pub struct SimulateArgs {
     /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
     #[arg(long)]
     pub allow_large: bool,
+    /// Write into an --out directory that holds another job's results (files of the same
+    /// name are replaced).
+    #[arg(long)]
+    pub force: bool,
     /// `fixed`: the run as configured, from the initial state. `auto`: first settle (as
     /// `sweep --settle auto` does, mechanics only, at most --settle-cap periods), then the
     /// configured run from the settled state (the files start there; summary.json's
@@ -172,6 +176,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut spec = config.sampled_run_spec(args.mechanics_only);
     spec.breakdown_check = true;
     check_size(&config, &spec, args.out.is_some(), args.allow_large)?;
+    if let Some(dir) = &args.out {
+        let settings = json!(config.table());
+        check_out_dir(dir, "summary.json", args.force, |old| {
+            old.get("settings") == Some(&settings)
+        })?;
+    }
     let harvester = spec.harvester.as_ref().map(|h| &h.params);
     let mut files = match &args.out {
         Some(dir) => Some(Files::create(dir, &spec.chain, harvester)?),
@@ -231,6 +241,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .and_then(|e| e.power.as_ref())
         .map(|p| p.energy_per_period_j);
     let merit_report = merit.as_ref().and_then(|w| w.finish(energy));
+    // The pictures' result, reported after the summary: a figure that fails loses no run.
+    let mut plotted = Ok(());
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
         let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
@@ -245,7 +257,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
         write_json(&dir.join("summary.json"), &summary)?;
         if args.plot {
-            crate::plots::analyze_run(dir, None)?;
+            plotted = crate::plots::analyze_run(dir, None);
         }
     }
     print_summary(&spec, &outcome, elapsed, args.out.as_deref());
@@ -262,6 +274,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let Some(m) = &motion {
         print_motion(m);
     }
+    plotted?;
     if let Some(e) = failure {
         return Err(e);
     }

@@ -147,7 +147,7 @@ fn manifest(
         max_period_detected: o.period_options().max_period,
         grazing_ratio: o.grazing_ratio,
         electrical_warmup_periods: o.electrical_warmup_periods,
-        mechanics_only: args.run.mechanics_only,
+        mechanics_only: runner.mechanics_only(),
         shard: shard.map(|s| ShardRecord {
             index: s.index,
             count: s.count,
@@ -253,7 +253,12 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             (Some(o), done)
         }
         Some(dir) => (
-            Some(GridOutput::create(dir, sweep_layout(masses, columns), settings)?),
+            Some(GridOutput::create(
+                dir,
+                sweep_layout(masses, columns),
+                settings,
+                args.run.force,
+            )?),
             0,
         ),
     };

@@ -44,10 +44,12 @@ impl std::str::FromStr for Shard {
 /// Settings shared by sweeps and maps.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// Transient periods per value (default: the configuration's run.transient_periods).
+    /// Transient periods per value (sweep, map: default the configuration's
+    /// run.transient_periods; basins, attractors: default 500 per start).
     #[arg(long)]
     pub transient: Option<u64>,
-    /// Recorded periods per value (default: run.periods − run.transient_periods).
+    /// Recorded periods per value (sweep, map: default run.periods − run.transient_periods;
+    /// basins, attractors: default 100 per start).
     #[arg(long)]
     pub recorded: Option<u64>,
     /// Mechanics only: no harvester, average_power_w left empty (faster).
@@ -79,6 +81,10 @@ pub struct RunArgs {
     /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
     #[arg(long)]
     pub allow_large: bool,
+    /// Write into an --out directory that holds another job's results (files of the same
+    /// name are replaced).
+    #[arg(long)]
+    pub force: bool,
 }
 
 impl RunArgs {
@@ -101,7 +107,10 @@ impl RunArgs {
             settle: self.settle.with_cap(self.settle_cap),
         };
         let options = request.options(&base, defaults)?;
-        Ok(PointRunner::new(base, options, self.mechanics_only))
+        // A single mass (against a stop) has no gap between masses to harvest from: its
+        // points are mechanics only, as `simulate` runs it.
+        let mechanics_only = self.mechanics_only || base.chain().len() < 2;
+        Ok(PointRunner::new(base, options, mechanics_only))
     }
 }
 

@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use serde_json::{Value, json};
 
-use crate::output::{CsvFile, create_dir, read_json, write_atomic, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, read_json, write_atomic, write_json};
 
 /// Manifest keys that describe the progress of a directory rather than its settings.
 const PROGRESS_KEYS: [&str; 3] = ["complete", "done", "rows"];
@@ -103,7 +103,11 @@ fn settings_of(manifest: &Value) -> Value {
 impl GridOutput {
     /// Starts a fresh job in `dir`: the manifest `settings` marked incomplete, then empty
     /// CSV files with their headers.
-    pub fn create(dir: &Path, layout: Layout, settings: Value) -> Result<Self> {
+    /// A directory that holds another job's results is refused unless `force`.
+    pub fn create(dir: &Path, layout: Layout, settings: Value, force: bool) -> Result<Self> {
+        check_out_dir(dir, layout.manifest, force, |old| {
+            settings_of(old) == settings_of(&settings) && old.get("shard") == settings.get("shard")
+        })?;
         create_dir(dir)?;
         let mut out = GridOutput {
             dir: dir.to_path_buf(),
@@ -144,10 +148,15 @@ impl GridOutput {
         if a != b || old.get("shard") != settings.get("shard") {
             bail!(
                 "--resume: {} holds a different job (its {} has other settings); \
-                 resume with the same configuration and options, or start afresh without --resume",
+                 resume with the same configuration and options, or start afresh with --force",
                 dir.display(),
                 layout.manifest
             );
+        }
+        // A finished job's files must hold what its manifest counts; an unfinished one's
+        // data files must all be there once a point is done.
+        if old["complete"] == json!(true) {
+            check_rows(dir, &layout, &old).context("--resume")?;
         }
         // The finished points: whole index rows, in grid order.
         let index_spec = &layout.files[layout.index_file];
@@ -166,6 +175,16 @@ impl GridOutput {
                     done + 2
                 ),
             }
+        }
+        if done > 0
+            && let Some(spec) = layout.files.iter().find(|spec| !dir.join(spec.name).exists())
+        {
+            bail!(
+                "--resume: {} lacks {}, which holds rows of the {done} points finished: \
+                 run the job again (without --resume)",
+                dir.display(),
+                spec.name
+            );
         }
         let done = done.min(keep_at_most);
         let finished: HashSet<&str> = keys[..done].iter().map(String::as_str).collect();
@@ -311,6 +330,36 @@ fn read_resumable(spec: &CsvSpec, path: &Path) -> Result<String> {
     Ok(text)
 }
 
+/// Checks that every file of the finished job in `dir` holds, whole, the rows its manifest
+/// `m` counts: an error naming the file if one was deleted, cut or changed since.
+fn check_rows(dir: &Path, layout: &Layout, m: &Value) -> Result<()> {
+    for spec in &layout.files {
+        let expected = m["rows"][spec.name].as_u64().ok_or_else(|| {
+            anyhow!(
+                "{}: {} does not count the rows of {}",
+                dir.display(),
+                layout.manifest,
+                spec.name
+            )
+        })?;
+        let text = read_text(&dir.join(spec.name))?;
+        check_header(spec, &text, dir)?;
+        let (_, lines) = whole_lines(&text);
+        let whole = text.ends_with('\n');
+        if lines.len() as u64 != expected || !whole {
+            bail!(
+                "{}: {} holds {} rows, its {} says {expected}: the job's files were changed or cut \
+                 since it finished; run it again (without --resume)",
+                dir.display(),
+                spec.name,
+                lines.len(),
+                layout.manifest
+            );
+        }
+    }
+    Ok(())
+}
+
 fn check_header(spec: &CsvSpec, text: &str, dir: &Path) -> Result<()> {
     let header = text.lines().next().unwrap_or("");
     if header != spec.columns.join(",") {
@@ -353,29 +402,7 @@ where
             bail!("{}: bad `shard` in {}", dir.display(), layout.manifest);
         };
         seen.push((index, count, dir));
-        for spec in &layout.files {
-            let expected = m["rows"][spec.name].as_u64().ok_or_else(|| {
-                anyhow!(
-                    "{}: {} does not count the rows of {}",
-                    dir.display(),
-                    layout.manifest,
-                    spec.name
-                )
-            })?;
-            let text = read_text(&dir.join(spec.name))?;
-            check_header(spec, &text, dir)?;
-            let (_, lines) = whole_lines(&text);
-            let whole = text.ends_with('\n');
-            if lines.len() as u64 != expected || !whole {
-                bail!(
-                    "{}: {} holds {} rows, its {} says {expected}: the shard's files were changed or cut; rerun it",
-                    dir.display(),
-                    spec.name,
-                    lines.len(),
-                    layout.manifest
-                );
-            }
-        }
+        check_rows(dir, layout, &m)?;
         let s = settings_of(&m);
         match &settings {
             None => settings = Some(s),
@@ -389,7 +416,17 @@ where
     indices.sort_unstable();
     indices.dedup();
     if seen.iter().any(|s| s.1 != count) || indices.len() != seen.len() || indices.len() as u64 != count {
-        bail!("need each of the {count} shards exactly once, got indices {indices:?}");
+        let given: Vec<String> = seen.iter().map(|s| format!("{}/{}", s.0, s.1)).collect();
+        let missing: Vec<u64> = (0..count).filter(|i| !indices.contains(i)).collect();
+        let twice: Vec<u64> = indices
+            .iter()
+            .copied()
+            .filter(|i| seen.iter().filter(|s| s.0 == *i).count() > 1)
+            .collect();
+        bail!(
+            "need each of the {count} shards exactly once; given {} (missing {missing:?}, given twice {twice:?})",
+            given.join(", ")
+        );
     }
     let keys = keys_of(&settings)?;
     let tmp = out.with_file_name(format!(

@@ -6,12 +6,25 @@ use super::heat::draw_heat_map;
 use super::style::{
     LABEL_PX, PALETTE, TICK_PX, ensure_font, err, finite_bounds, font, tick_label, titled, widen,
 };
-use anyhow::{Context, Result, anyhow, ensure};
+use anyhow::{Context, Result, ensure};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use std::ops::Range;
 use std::path::Path;
+
+/// A figure with nothing to draw (no finite data on an axis): [`both`](super::both)
+/// skips it with a note instead of failing the command.
+#[derive(Debug)]
+pub struct NothingToDraw(pub String);
+
+impl std::fmt::Display for NothingToDraw {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "nothing to draw ({})", self.0)
+    }
+}
+
+impl std::error::Error for NothingToDraw {}
 
 /// What an x–y chart draws: lines, then points on top.
 pub(super) struct Layers<'s, 'a> {
@@ -106,15 +119,15 @@ pub(super) fn axis_range(
     }
     match scale {
         Scale::Linear => {
-            let (lo, hi) =
-                finite_bounds(data).ok_or_else(|| anyhow!("no finite data to plot on the {axis} axis"))?;
+            let (lo, hi) = finite_bounds(data)
+                .ok_or_else(|| NothingToDraw(format!("no finite data on the {axis} axis")))?;
             let (lo, hi) = widen(lo, hi);
             let m = 0.03 * (hi - lo);
             Ok(lo - m..hi + m)
         }
         Scale::Log => {
             let (lo, hi) = finite_bounds(data.filter(|v| *v > 0.0))
-                .ok_or_else(|| anyhow!("no positive data to plot on the logarithmic {axis} axis"))?;
+                .ok_or_else(|| NothingToDraw(format!("no positive data on the logarithmic {axis} axis")))?;
             let (lo, hi) = if hi > lo { (lo, hi) } else { (lo / 2.0, hi * 2.0) };
             let m = (hi / lo).powf(0.03);
             Ok(lo / m..hi * m)
@@ -139,7 +152,9 @@ pub(super) fn xy_chart<'f, 's, 'a>(
     figure: &'f Figure,
     layers: Layers<'s, 'a>,
 ) -> Result<XyChart<'f, 's, 'a>> {
-    ensure!(layers.all().next().is_some(), "nothing to plot: no series given");
+    if layers.all().next().is_none() {
+        return Err(NothingToDraw("no series given".into()).into());
+    }
     for (i, s) in layers.all().enumerate() {
         check_series(s, i)?;
     }

@@ -112,6 +112,7 @@ impl Ctx {
             threads: None,
             quiet: true,
             allow_large: false,
+            force: true,
         }
     }
 }

@@ -161,6 +161,7 @@ fn runner(config: Config, request: &GridRequest) -> Result<PointRunner, ApiError
         threads: None,
         quiet: true,
         allow_large: false,
+        force: false,
     };
     args.runner(config).map_err(|e| ApiError::bad_chain(&e))
 }

@@ -3,16 +3,24 @@
 
 mod basins;
 mod chirp;
+mod closed_pipe_and_full_disk;
 mod composition;
 mod excitation;
+mod export_spice_stays_in_its_run;
+mod grid_jobs_on_one_mass;
+mod hostile;
 mod issue_grid_jobs_stop_resume_and_merge;
 mod issue_motion_classified;
 mod issue_plot_without_out;
 mod issue_simulate_output_edges;
 mod lyapunov;
+mod map_one_parameter_twice;
 mod optimize;
 mod periodic_orbits;
+mod plot_skips_empty_figures;
+mod resume_checks_files;
 mod serve;
+mod sizes_refused_before_allocation;
 mod stops;
 mod util;
 

@@ -115,6 +115,20 @@ impl Param {
         })
     }
 
+    /// Whether `self` and `other` set the same quantity (one key under two names, Ω as a
+    /// ratio and as a frequency, the mass ratio with m1 or m2 fixed), so that setting one
+    /// overwrites the other.
+    pub fn overlaps(&self, other: &Param) -> bool {
+        use Scalar::{FrequencyHz, OmegaRatio};
+        use Target::{MassRatio, MassRatioM2Fixed};
+        match (self.target, other.target) {
+            (Target::Tree, Target::Tree) => self.key == other.key,
+            (Target::Scalar(OmegaRatio | FrequencyHz), Target::Scalar(OmegaRatio | FrequencyHz)) => true,
+            (MassRatio | MassRatioM2Fixed, MassRatio | MassRatioM2Fixed) => true,
+            (a, b) => a == b,
+        }
+    }
+
     /// The key, as given.
     pub fn key(&self) -> &str {
         &self.key

@@ -29,4 +29,4 @@ pub use observer::{
 pub(crate) use oscillator::Forcing;
 pub use oscillator::Oscillator;
 pub use simulator::{ContactStatus, RunEnd, Simulator, initial_state};
-pub(crate) use taylor::GapPolynomial;
+pub(crate) use taylor::{GapPolynomial, MAX_COEFFICIENTS};

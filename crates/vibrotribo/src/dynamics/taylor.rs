@@ -25,6 +25,28 @@ const MAX_SPLIT: usize = 1 << 16;
 /// Truncation tolerance relative to the size of a cluster's motion.
 const TRUNCATION: f64 = 0.25 * f64::EPSILON;
 
+/// Most coefficients one piece's expansion may hold (sub-pieces × terms × gaps, taking 20
+/// terms a sub-piece): 2²⁶, 512 MiB.
+pub(crate) const MAX_COEFFICIENTS: f64 = (1u64 << 26) as f64;
+
+/// Terms of a typical expansion (`Λr ≤ SUBPIECE_RATE`), for the size estimate.
+const TYPICAL_TERMS: f64 = 20.0;
+
+/// A piece of flow whose expansion would exceed [`MAX_COEFFICIENTS`]: the chain's rate
+/// bound Λ (a damping or a stiffness-to-mass ratio far beyond the excitation's) asks for
+/// more sub-pieces than memory allows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TooFine {
+    /// Start of the piece, s.
+    pub t_start: f64,
+    /// End of the piece, s.
+    pub t_end: f64,
+    /// The rate bound Λ, 1/s.
+    pub rate: f64,
+    /// The sub-pieces it would need.
+    pub sub_pieces: f64,
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 struct SubPiece {
     /// Start of the sub-piece, s.
@@ -55,29 +77,42 @@ pub(crate) struct GapPolynomial {
 }
 
 impl GapPolynomial {
-    /// Expands the gaps of `flow` over `[flow.t_start, flow.t_end]`.
-    pub(crate) fn build(&mut self, flow: &Flow<'_>) {
+    /// Expands the gaps of `flow` over `[flow.t_start, flow.t_end]`; an error, before
+    /// anything is allocated, if the expansion would hold more than [`MAX_COEFFICIENTS`].
+    pub(crate) fn build(&mut self, flow: &Flow<'_>) -> Result<(), TooFine> {
         let n_masses = flow.len();
         let clusters = flow.clusters();
-        self.n_gaps = n_masses.saturating_sub(1);
-        self.jets.resize(clusters.len() * MAX_TERMS, 0.0);
-        self.jet_terms.resize(clusters.len(), 0);
-        self.positions.resize(n_masses, 0.0);
         let rate = clusters
             .iter()
             .map(|c| c.oscillator.rate_bound())
             .fold(0.0, f64::max);
         let length = (flow.t_end - flow.t_start).max(0.0);
-        let mut count = if rate > 0.0 {
-            ((length * rate / (2.0 * SUBPIECE_RATE)).ceil() as usize).max(1)
+        let wanted = if rate > 0.0 {
+            (length * rate / (2.0 * SUBPIECE_RATE)).ceil().max(1.0)
         } else {
-            1
+            1.0
         };
+        let coefficients = wanted * TYPICAL_TERMS * n_masses.saturating_sub(1).max(1) as f64;
+        // A NaN estimate (a rate that is not finite) is refused too.
+        if coefficients.is_nan() || coefficients > MAX_COEFFICIENTS {
+            return Err(TooFine {
+                t_start: flow.t_start,
+                t_end: flow.t_end,
+                rate,
+                sub_pieces: wanted,
+            });
+        }
+        self.n_gaps = n_masses.saturating_sub(1);
+        self.jets.resize(clusters.len() * MAX_TERMS, 0.0);
+        self.jet_terms.resize(clusters.len(), 0);
+        self.positions.resize(n_masses, 0.0);
+        let mut count = wanted as usize;
         // Λr ≤ SUBPIECE_RATE needs about 20 terms; split further in the unlikely case
         // that MAX_TERMS do not reach the tolerance (a bound is only ever loose).
         while !self.try_build(flow, count) && count < MAX_SPLIT {
             count *= 2;
         }
+        Ok(())
     }
 
     /// Expands `flow` on `count` equal sub-pieces; false if some expansion did not reach
@@ -303,7 +338,7 @@ mod tests {
             let (mut g1, mut r1, mut g2, mut r2) = ([0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
             for seg in traj.segments() {
                 let flow = traj.flow_at(seg.t_start).unwrap();
-                poly.build(&flow);
+                poly.build(&flow).unwrap();
                 let times: Vec<f64> = (0..=40)
                     .map(|i| seg.t_start + (seg.t_end - seg.t_start) * i as f64 / 40.0)
                     .collect();
@@ -368,7 +403,7 @@ mod tests {
         let (mut g1, mut r1, mut g2, mut r2) = ([0.0; 2], [0.0; 2], [0.0; 2], [0.0; 2]);
         for seg in traj.segments() {
             let flow = traj.flow_at(seg.t_start).unwrap();
-            poly.build(&flow);
+            poly.build(&flow).unwrap();
             let scale = seg
                 .clusters
                 .iter()

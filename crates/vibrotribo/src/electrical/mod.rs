@@ -122,4 +122,25 @@ pub enum ElectricalError {
     /// A trajectory to replay holds no flow.
     #[error("the trajectory holds no flow to replay")]
     EmptyTrajectory,
+    /// The gaps of a piece of flow change too fast for the charge solver's expansion: the
+    /// chain's rate bound Λ (its damping rate 2α plus its natural frequency, 1/s) over the
+    /// piece asks for more sub-pieces than memory allows. Refused before any allocation.
+    #[error(
+        "the charge solver cannot follow the gaps from t = {t_start:.6e} s to {t_end:.6e} s: the chain's rate \
+         {rate:.3e} 1/s (damping rate plus natural frequency) needs {sub_pieces:.3e} sub-pieces, more than \
+         its expansion of {limit:.3e} coefficients allows; such heavily damped or stiff chains are beyond it \
+         (run --mechanics-only)"
+    )]
+    TooFine {
+        /// Start of the piece, s.
+        t_start: f64,
+        /// End of the piece, s.
+        t_end: f64,
+        /// The rate bound Λ, 1/s.
+        rate: f64,
+        /// The sub-pieces it would need.
+        sub_pieces: f64,
+        /// The most coefficients allowed.
+        limit: f64,
+    },
 }

@@ -119,6 +119,19 @@ impl PwlGaps {
         Ok(PwlGaps { times, values, n })
     }
 
+    /// Points of [`from_trajectory`](Self::from_trajectory) over `periods` excitation periods
+    /// sampled every `dt_fraction` of a period, segment boundaries aside (an estimate, to
+    /// refuse a mistyped size before anything is allocated).
+    pub fn estimated_points(periods: f64, dt_fraction: f64) -> f64 {
+        periods / dt_fraction + 1.0
+    }
+
+    /// Bytes held while building `points` points of `gaps` gaps (the candidate times, the
+    /// kept times, the values), an estimate.
+    pub fn estimated_bytes(points: f64, gaps: usize) -> f64 {
+        points * (2.0 + gaps as f64) * std::mem::size_of::<f64>() as f64
+    }
+
     /// Samples a recorded trajectory from its start to `t_end`, s, every `dt` seconds, adding
     /// every segment boundary (impact kinks); points closer than `dt/1000` to the previous one
     /// are dropped.

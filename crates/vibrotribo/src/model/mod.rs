@@ -63,6 +63,9 @@ impl Default for Excitation {
     }
 }
 
+/// Largest ratio of the heaviest to the lightest mass of a chain: 10¹².
+pub const MAX_MASS_SPREAD: f64 = 1e12;
+
 /// Physical parameters of an N-mass vibro-impact chain.
 ///
 /// [`Default`] is the paper's default case (Sect. 4.1, configuration (1), m₂ = 120 g,
@@ -149,7 +152,8 @@ impl ChainParams {
         self.masses.is_empty()
     }
 
-    /// Checks every parameter; returns the first problem found, naming the parameter by its
+    /// Checks every parameter (masses within a factor [`MAX_MASS_SPREAD`] of each other);
+    /// returns the first problem found, naming the parameter by its
     /// field (`masses[1]`, `excitation.amplitude`, `excitation.omega_ratio`, …).
     pub fn validate(&self) -> Result<(), ParamError> {
         let n = self.masses.len();
@@ -161,6 +165,19 @@ impl ChainParams {
         check_len("gaps", &self.gaps, n - 1)?;
         for (i, &m) in self.masses.iter().enumerate() {
             check_positive(&format!("masses[{i}]"), m)?;
+        }
+        // Beyond this spread the impact law loses the light mass's momentum to rounding
+        // (masses of 1e300 and 0.1 kg interpenetrate by centimetres).
+        let (lightest, heaviest) = self
+            .masses
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &m| (lo.min(m), hi.max(m)));
+        if heaviest / lightest > MAX_MASS_SPREAD {
+            return Err(ParamError::Invalid {
+                name: "masses".into(),
+                value: heaviest / lightest,
+                reason: "the heaviest mass is more than 1e12 times the lightest (beyond what the impact law resolves in double precision)",
+            });
         }
         for (i, &k) in self.stiffness.iter().enumerate() {
             check_positive(&format!("stiffness[{i}]"), k)?;

@@ -536,7 +536,8 @@ impl RunObserver for Condenser {
                     let drain = r
                         .storage_load_resistance
                         .map_or(0.0, |rs| 0.5 * (before * before + now * now) / rs * dt);
-                    0.5 * r.storage_capacitance * (now * now - before * before) + drain
+                    // ½C(V1² − V0²) as a product: no cancellation at a large storage voltage.
+                    0.5 * r.storage_capacitance * (now - before) * (now + before) + drain
                 }
                 Load::Open | Load::Short => 0.0,
             };

@@ -25,6 +25,15 @@ pub struct LoadStudyOptions {
     pub vq_points: Option<usize>,
 }
 
+impl LoadStudyOptions {
+    /// Bytes the study's V–Q cycles hold (two cycles of `vq_points + 1` samples of eight
+    /// quantities), an estimate to refuse a mistyped size before anything is allocated.
+    pub fn estimated_bytes(&self) -> f64 {
+        let points = self.vq_points.map_or(0.0, |p| p as f64 + 1.0);
+        2.0 * points * 8.0 * std::mem::size_of::<f64>() as f64
+    }
+}
+
 /// The V–Q cycle of one load over the last simulated period.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VqCycle {

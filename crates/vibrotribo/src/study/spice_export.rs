@@ -7,6 +7,7 @@
 use thiserror::Error;
 
 use crate::config::Config;
+use crate::coupling::Coupling;
 use crate::electrical::spice::{self, SpiceError, SpiceOptions};
 use crate::electrical::{ChargeSolver, ElectricalError, PwlGaps};
 use crate::error::ParamError;
@@ -33,6 +34,18 @@ pub enum SpiceExportError {
         /// Why.
         message: String,
     },
+    /// A run of one mass: the harvester sits between two masses, so there is nothing to
+    /// export.
+    #[error(
+        "a run of one mass has no harvester (the harvester sits between two masses): there is nothing to export"
+    )]
+    OneMass,
+    /// A two-way coupled run: its gaps depend on the charges, while the netlist is driven by
+    /// the mechanics alone.
+    #[error(
+        "a two-way run (harvester.coupling = \"two_way\"): its gaps depend on the charges, and the netlist is driven by the mechanics alone; export a one-way run"
+    )]
+    TwoWay,
     /// Re-running the mechanics failed.
     #[error(transparent)]
     Study(#[from] StudyError),
@@ -65,8 +78,8 @@ pub struct SpiceExport {
 }
 
 /// The netlist of `config`'s harvester over `periods` excitation periods from `from_period`
-/// (default: the first after the transient), the gaps sampled every `dt_fraction` of a
-/// period.
+/// (default: the first after the transient, or as late as the run allows), the gaps sampled
+/// every `dt_fraction` of a period. Refused for a run of one mass and for a two-way run.
 pub fn spice_export(
     config: &Config,
     from_period: Option<u64>,
@@ -83,10 +96,25 @@ pub fn spice_export(
     if periods == 0 {
         return Err(option("periods", "must be at least 1".into()));
     }
-    let from = from_period.unwrap_or(config.run().transient());
+    if config.chain().len() < 2 {
+        return Err(SpiceExportError::OneMass);
+    }
+    if config.harvester().coupling == Coupling::TwoWay {
+        return Err(SpiceExportError::TwoWay);
+    }
+    // By default the first period after the transient, or as late as the run allows.
+    let run_periods = config.run().periods;
+    let from =
+        from_period.unwrap_or_else(|| config.run().transient().min(run_periods.saturating_sub(periods)));
     let end = from
         .checked_add(periods)
-        .ok_or_else(|| option("from_period", format!("{from} + {periods} periods is too large")))?;
+        .filter(|&end| end <= run_periods)
+        .ok_or_else(|| {
+            option(
+                "from_period",
+                format!("{from} with {periods} periods ends past the run, which has {run_periods} periods"),
+            )
+        })?;
     let period = config.chain().period();
     let (t0, t1) = (from as f64 * period, end as f64 * period);
     let spec = RunSpec {

@@ -276,8 +276,16 @@ impl ChargeSolver {
     /// Advances over a piece of the simulator's flow, through its Taylor expansion.
     pub(super) fn advance_flow(&mut self, flow: &Flow<'_>) -> Result<(), ElectricalError> {
         let mut poly = std::mem::take(&mut self.poly);
-        poly.build(flow);
-        let result = self.advance(flow.t_start, flow.t_end, &poly);
+        let result = match poly.build(flow) {
+            Ok(()) => self.advance(flow.t_start, flow.t_end, &poly),
+            Err(e) => Err(ElectricalError::TooFine {
+                t_start: e.t_start,
+                t_end: e.t_end,
+                rate: e.rate,
+                sub_pieces: e.sub_pieces,
+                limit: crate::dynamics::MAX_COEFFICIENTS,
+            }),
+        };
         self.poly = poly;
         result
     }
