@@ -99,7 +99,7 @@ pub fn cmeo_contact_separation(params: &HarvesterParams, x_min: f64, x_max: f64)
 /// freestanding law, `[0, 2σS)` for the paper's, `[0, σS)` in contact-separation mode).
 const BINS: usize = 1024;
 
-/// The states a run visits, kept in [`BINS`] bins of their short-circuit charge: per bin the
+/// The states a run visits, kept in 1024 bins of their short-circuit charge: per bin the
 /// state of the largest `1/C` and those of the smallest and largest `Q_sc` (the candidates of
 /// a cycle's switching states: for a given `Q_sc` a larger `1/C` gives more energy), and the
 /// charges no state of the bin breaks down at (the intersection of their intervals).
