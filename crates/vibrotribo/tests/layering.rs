@@ -11,8 +11,8 @@
 //! 2. analyses of a trajectory, the observers a run carries: `analysis`, `orbits`, `lyapunov`;
 //! 3. runs and studies: `config` (the edge that reads a configuration into a run), `study`,
 //!    `sweep` (a study runs the engine with the observers of layer 2 and earns its labels from
-//!    them);
-//! 4. studies of studies: `attractors`, `branch`;
+//!    them), `merit` (the figures of merit, a run observer);
+//! 4. studies of studies: `attractors`, `branch`, `optimize`;
 //! 5. output: `report`.
 //!
 //! Only code counts: paths in comments and doc links do not.
@@ -34,8 +34,8 @@ const LAYERS: &[&[&str]] = &[
         "coupling",
     ],
     &["analysis", "orbits", "lyapunov"],
-    &["config", "study", "sweep"],
-    &["attractors", "branch"],
+    &["config", "study", "sweep", "merit"],
+    &["attractors", "branch", "optimize"],
     &["report"],
 ];
 
