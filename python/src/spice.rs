@@ -5,10 +5,9 @@
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use vibrotribo::electrical::PwlGaps;
 use vibrotribo::study::{
     DEFAULT_SPICE_DT_FRACTION, DEFAULT_SPICE_PERIODS, SPICE_DATA_FILE, SpiceExportError, spice_check,
-    spice_export,
+    spice_export, spice_export_bytes,
 };
 
 use crate::config::config_of;
@@ -39,12 +38,10 @@ pub fn export_spice<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config_of(config)?;
     // The PWL waveforms' size, checked before they are built (as `export-spice` does).
-    if dt_fraction > 0.0 && dt_fraction < 1.0 {
-        let points = PwlGaps::estimated_points(periods as f64, dt_fraction);
-        let gaps = config.chain().len().saturating_sub(1).max(1);
+    if let Some(bytes) = spice_export_bytes(&config, periods, dt_fraction) {
         crate::limits::check_memory(
             "the netlist's PWL waveforms (periods / dt_fraction)",
-            PwlGaps::estimated_bytes(points, gaps),
+            bytes,
             allow_large,
         )?;
     }

@@ -6,8 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use vibrotribo::config::Config;
-use vibrotribo::electrical::PwlGaps;
-use vibrotribo::study::{SPICE_DATA_FILE, SpiceExportError, spice_check, spice_export};
+use vibrotribo::study::{SPICE_DATA_FILE, SpiceExportError, spice_check, spice_export, spice_export_bytes};
 
 use crate::limits;
 use crate::output::si;
@@ -76,11 +75,10 @@ pub fn run(args: &ExportSpiceArgs) -> Result<()> {
     check_name(&args.name)?;
     let config = Config::from_table(table)?;
     // The PWL waveforms' size, checked before they are built.
-    if args.dt_fraction > 0.0 && args.dt_fraction < 1.0 {
-        let points = PwlGaps::estimated_points(args.periods as f64, args.dt_fraction);
+    if let Some(bytes) = spice_export_bytes(&config, args.periods, args.dt_fraction) {
         limits::check_memory(
             "the netlist's PWL waveforms (--periods / --dt-fraction)",
-            PwlGaps::estimated_bytes(points, config.chain().len().saturating_sub(1).max(1)),
+            bytes,
             args.allow_large,
         )?;
     }

@@ -5,9 +5,7 @@
 //! catch a mistyped `1e11`, not to budget a job to the byte.
 
 use anyhow::{Result, bail};
-
-/// Most points of one sweep or map grid (their values are held in memory): 10⁷.
-pub const MAX_GRID_POINTS: f64 = vibrotribo::study::limits::MAX_GRID_POINTS;
+use vibrotribo::study::limits::{self, SizeError};
 
 /// Largest estimated output written without `--allow-large`: 20 GiB.
 pub const MAX_OUTPUT_BYTES: f64 = vibrotribo::study::limits::MAX_OUTPUT_BYTES;
@@ -21,14 +19,11 @@ pub const GIB: f64 = vibrotribo::study::limits::GIB;
 /// Bytes of one number written to a CSV file (estimate).
 pub const CSV_NUMBER_BYTES: f64 = vibrotribo::study::limits::CSV_NUMBER_BYTES;
 
-/// Refuses a grid of `points` points (named `what`, e.g. "--steps") above [`MAX_GRID_POINTS`];
+/// Refuses a grid of `points` points (named `what`, e.g. "--steps") above [`limits::MAX_GRID_POINTS`] (10⁷);
 /// this limit holds even with `--allow-large`.
 pub fn check_grid(what: &str, points: f64) -> Result<()> {
-    if points > MAX_GRID_POINTS {
-        bail!(
-            "{what} asks for {points:.3e} grid points, more than the limit of {MAX_GRID_POINTS:.0e}; \
-             split the job into several (e.g. --shard) or use a coarser grid"
-        );
+    if let Err(e) = limits::check_grid(what, points) {
+        bail!("{e}; split the job into several (e.g. --shard) or use a coarser grid");
     }
     Ok(())
 }
@@ -48,17 +43,18 @@ pub fn check_output(what: &str, bytes: f64, allow: bool) -> Result<()> {
 }
 
 /// Refuses an estimated `bytes` of memory (for `what`) above [`MAX_MEMORY_BYTES`] unless
-/// `allow`.
+/// `allow` (the library's check, in the command line's words).
 pub fn check_memory(what: &str, bytes: f64, allow: bool) -> Result<()> {
-    if bytes > MAX_MEMORY_BYTES && !allow {
-        bail!(
+    match limits::check_memory(what, bytes, allow) {
+        Ok(()) => Ok(()),
+        Err(SizeError::Memory { what, bytes }) => bail!(
             "{what} would need about {:.1} GiB of memory (limit {:.0} GiB without --allow-large); \
              ask for less (fewer periods or points), or pass --allow-large",
             bytes / GIB,
             MAX_MEMORY_BYTES / GIB
-        );
+        ),
+        Err(other) => bail!("{other}"),
     }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -50,5 +50,5 @@ pub use simulate::{ElectricalOutcome, Ending, RunOutcome, StudyError, simulate};
 #[cfg(feature = "spice")]
 pub use spice_export::{
     DEFAULT_SPICE_DT_FRACTION, DEFAULT_SPICE_PERIODS, SPICE_DATA_FILE, SpiceExport, SpiceExportError,
-    spice_check, spice_export,
+    spice_check, spice_export, spice_export_bytes,
 };

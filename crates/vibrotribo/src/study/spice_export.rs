@@ -140,6 +140,16 @@ pub fn spice_export(
     })
 }
 
+/// Bytes the gap waveforms of an export of `periods` periods sampled every `dt_fraction` of a
+/// period would hold (an estimate, for the size limits), before they are built; `None` when
+/// `dt_fraction` is outside (0, 1), which [`spice_export`] refuses by name.
+pub fn spice_export_bytes(config: &Config, periods: u64, dt_fraction: f64) -> Option<f64> {
+    (dt_fraction > 0.0 && dt_fraction < 1.0).then(|| {
+        let points = PwlGaps::estimated_points(periods as f64, dt_fraction);
+        PwlGaps::estimated_bytes(points, config.chain().len().saturating_sub(1).max(1))
+    })
+}
+
 /// The energy delivered over an export's window by vibrotribo's charge solver and by
 /// ngspice on its netlist, J (and the wall time of ngspice, s).
 pub fn spice_check(config: &Config, export: &SpiceExport) -> Result<(f64, f64, f64), SpiceExportError> {
