@@ -16,6 +16,7 @@ use toml::Value;
 
 use super::observer::{RunObserver, Sample};
 use super::settings::Sampling;
+use super::point::PointError;
 use super::simulate::{RunOutcome, StudyError, simulate};
 use crate::config::{Config, ConfigError};
 use crate::dynamics::{Event, EventKind, StateView};
@@ -99,12 +100,12 @@ pub enum ChirpError {
     #[error(transparent)]
     Study(#[from] StudyError),
     /// Settling at the start frequency failed.
-    #[error("settling the harmonic motion at Ω = {omega_ratio} (the chirp's start): {message}")]
+    #[error("settling the harmonic motion at Ω = {omega_ratio} (the chirp's start): {source}")]
     Settle {
         /// The start Ω.
         omega_ratio: f64,
         /// Why.
-        message: String,
+        source: Box<PointError>,
     },
 }
 
@@ -381,10 +382,7 @@ pub fn chirp_config(
 /// The steady state of `config`'s harmonic motion at Ω = `omega_ratio`, at a period's end
 /// (mechanics only; [`settle`](super::settle) with the defaults of a sweep point).
 fn settled_state(config: &Config, omega_ratio: f64) -> Result<crate::model::ChainState, ChirpError> {
-    let fail = |message: String| ChirpError::Settle { omega_ratio, message };
-    let harmonic = config
-        .with("omega_ratio", Value::Float(omega_ratio))
-        .map_err(|e| fail(e.to_string()))?;
+    let harmonic = config.with("omega_ratio", Value::Float(omega_ratio))?;
     let s = super::settle::settle(
         harmonic.chain(),
         harmonic.initial_state(),
@@ -392,7 +390,10 @@ fn settled_state(config: &Config, omega_ratio: f64) -> Result<crate::model::Chai
         &super::point::PointOptions::default(),
         &super::settle::AutoSettle::default(),
     )
-    .map_err(|e| fail(e.to_string()))?;
+    .map_err(|e| ChirpError::Settle {
+        omega_ratio,
+        source: Box::new(e),
+    })?;
     Ok(s.state)
 }
 
