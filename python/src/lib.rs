@@ -17,6 +17,7 @@ mod lyapunov;
 mod mass_ratio;
 mod optimize;
 mod orbits;
+mod curve;
 mod simulate;
 mod spice;
 mod sweep;
@@ -50,6 +51,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loads::load_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::continue_, m)?)?;
+    m.add_function(wrap_pyfunction!(curve::curve, m)?)?;
     m.add_function(wrap_pyfunction!(lyapunov::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(chirp::chirp, m)?)?;
     m.add_function(wrap_pyfunction!(attractors::basins, m)?)?;
