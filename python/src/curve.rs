@@ -32,7 +32,9 @@ fn error(e: CurveConfigError) -> PyErr {
 fn points_to_py<'py>(py: Python<'py>, points: &[CurvePoint], n: usize) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let column = |f: &dyn Fn(&CurvePoint) -> f64| array1(py, points.iter().map(f).collect());
-    let flat = |f: &dyn Fn(&CurvePoint) -> &[f64]| -> Vec<f64> { points.iter().flat_map(|p| f(p).to_vec()).collect() };
+    let flat = |f: &dyn Fn(&CurvePoint) -> &[f64]| -> Vec<f64> {
+        points.iter().flat_map(|p| f(p).to_vec()).collect()
+    };
     d.set_item("parameter", column(&|p| p.parameter))?;
     d.set_item("parameter2", column(&|p| p.parameter2))?;
     d.set_item("x", array2(py, flat(&|p| &p.state.positions), n)?)?;
@@ -119,7 +121,9 @@ pub fn curve<'py>(
             "near, from2 and to2 must be finite, from2 and to2 different (got {near}, {from2}, {to2})"
         )));
     }
-    let kind: CurveKind = kind.parse().map_err(|e: CurveError| PyValueError::new_err(e.to_string()))?;
+    let kind: CurveKind = kind
+        .parse()
+        .map_err(|e: CurveError| PyValueError::new_err(e.to_string()))?;
     let base = config_of(config)?;
     base.check_uncoupled("curve").map_err(config_error)?;
     base.check_periodic("continuation of bifurcation curves")
@@ -148,8 +152,8 @@ pub fn curve<'py>(
     let n = base.chain().len();
     let out = PyDict::new(py);
     out.set_item("kind", r.curve.kind.name())?;
-    out.set_item("param", &r.key)?;
-    out.set_item("param2", &r.key2)?;
+    out.set_item("param", r.key.as_str())?;
+    out.set_item("param2", r.key2.as_str())?;
     out.set_item("period", r.curve.period)?;
     out.set_item("contact", r.curve.contact.map(|k| k + 1))?;
     out.set_item("located", r.located.parameter)?;
@@ -176,7 +180,12 @@ pub fn curve<'py>(
         e.set_item("parameter", p.point.parameter)?;
         e.set_item("parameter2", p.point.parameter2)?;
         e.set_item("precision", p.precision)?;
-        let m: Vec<Complex64> = p.point.multipliers.iter().map(|c| Complex64::new(c.re, c.im)).collect();
+        let m: Vec<Complex64> = p
+            .point
+            .multipliers
+            .iter()
+            .map(|c| Complex64::new(c.re, c.im))
+            .collect();
         e.set_item("multipliers", PyArray1::from_vec(py, m))?;
         codim2.append(e)?;
     }

@@ -156,7 +156,8 @@ pub fn run(args: &CurveArgs) -> Result<()> {
         },
     };
     let result = curve_config(&config, &request, &options)?;
-    let power = (!args.mechanics_only).then(|| curve_powers(&config, &result.key, &result.key2, &result.curve));
+    let power =
+        (!args.mechanics_only).then(|| curve_powers(&config, &result.key, &result.key2, &result.curve));
     print_curve(&result);
     create_dir(&args.out)?;
     write_files(&args.out, &config, args, &result, power.as_deref())?;
@@ -176,11 +177,15 @@ fn end_text(end: &CurveEnd) -> String {
             parameter2,
             reason,
         } => format!("no continuation past ({parameter}, {parameter2}): {reason}"),
-        CurveEnd::SequenceChange => "the orbit's event sequence changes (see the codimension-two points)".into(),
+        CurveEnd::SequenceChange => {
+            "the orbit's event sequence changes (see the codimension-two points)".into()
+        }
         CurveEnd::Degenerate {
             parameter,
             parameter2,
-        } => format!("the condition no longer applies past ({parameter}, {parameter2}): no critical multiplier or gap minimum left"),
+        } => format!(
+            "the condition no longer applies past ({parameter}, {parameter2}): no critical multiplier or gap minimum left"
+        ),
         other => format!("{other:?}"),
     }
 }

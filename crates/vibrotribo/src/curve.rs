@@ -7,15 +7,15 @@
 
 use thiserror::Error;
 
+use crate::ChainParams;
 use crate::branch::{BRANCH_POWER_PERIODS, BRANCH_POWER_WARMUP, BranchError, BranchOptions, continue_config};
-use crate::study::{Harvester, power_on_periodic_state};
 use crate::config::{Config, ConfigError};
 use crate::orbits::curve::{Curve, CurveError, CurveKind, CurveOptions, CurveStart, continue_curve};
 use crate::orbits::{
     Bifurcation, BifurcationKind, ContinuationOptions, OrbitError, ShootingOptions,
     periodic_orbit_from_transient,
 };
-use crate::ChainParams;
+use crate::study::{Harvester, power_on_periodic_state};
 
 /// What curve to compute.
 #[derive(Debug, Clone, PartialEq)]

@@ -22,10 +22,17 @@ const R: f64 = 0.8;
 const GAP_KEY: &str = "oscillator.stops.upper.gap";
 
 fn config(omega_ratio: f64, gap: f64) -> Config {
+    config_from(omega_ratio, gap, (0.0, 0.0))
+}
+
+/// The impact oscillator starting from `(x, v)` at t = 0.
+fn config_from(omega_ratio: f64, gap: f64, start: (f64, f64)) -> Config {
     let text = format!(
         "[oscillator]\nmasses = [{M}]\nstiffness = {K}\ndamping = {C}\n\n\
          [oscillator.stops.upper]\ngap = {gap}\nrestitution = {R}\nframe = \"fixed\"\n\n\
-         [excitation]\namplitude = {A}\nomega_ratio = {omega_ratio}\n"
+         [excitation]\namplitude = {A}\nomega_ratio = {omega_ratio}\n\n\
+         [run]\ninitial_positions = [{:e}]\ninitial_velocities = [{:e}]\n",
+        start.0, start.1
     );
     Config::from_toml_str(&text).expect("the test's configuration is valid")
 }
@@ -155,11 +162,19 @@ fn period_doubling_curve_matches_the_closed_form() {
         result.located.parameter,
         curve.points.len(),
         curve.end,
-        curve.codim2.iter().map(|p| (p.kind, p.point.parameter, p.point.parameter2)).collect::<Vec<_>>()
+        curve
+            .codim2
+            .iter()
+            .map(|p| (p.kind, p.point.parameter, p.point.parameter2))
+            .collect::<Vec<_>>()
     );
     assert!(curve.points.len() >= 3, "only {} points", curve.points.len());
     let last = curve.points.last().expect("points");
-    assert!(last.parameter2 > 0.0012, "the curve stops at gap {}", last.parameter2);
+    assert!(
+        last.parameter2 > 0.0012,
+        "the curve stops at gap {}",
+        last.parameter2
+    );
     let stride = (curve.points.len() / 4).max(1);
     for p in curve.points.iter().step_by(stride).chain([last]) {
         let c = config(p.parameter, p.parameter2);
@@ -172,8 +187,16 @@ fn period_doubling_curve_matches_the_closed_form() {
         assert!(lambda < 1e-8, "no multiplier at −1 at {p:?}");
         let speed = impact_speed(&c, p, curve.period);
         let want = closed_form_doubling(p.parameter2, p.parameter - 0.01, p.parameter + 0.01, speed)
-            .unwrap_or_else(|| panic!("no closed-form doubling near Ω = {} at gap {}", p.parameter, p.parameter2));
-        println!("gap {:.6}: Ω = {:.12}, closed form {want:.12}", p.parameter2, p.parameter);
+            .unwrap_or_else(|| {
+                panic!(
+                    "no closed-form doubling near Ω = {} at gap {}",
+                    p.parameter, p.parameter2
+                )
+            });
+        println!(
+            "gap {:.6}: Ω = {:.12}, closed form {want:.12}",
+            p.parameter2, p.parameter
+        );
         assert!(
             (p.parameter - want).abs() < 1e-6,
             "doubling at gap {}: Ω = {} vs closed form {want}",
@@ -196,20 +219,28 @@ fn grazing_curve_is_where_the_steady_amplitude_equals_the_gap() {
     let request = CurveRequest {
         kind: CurveKind::Grazing,
         key: "omega_ratio".into(),
-        near: 3.3,
+        near: 3.4,
         key2: GAP_KEY.into(),
         from2: 0.001,
         to2: 0.002,
         period: Some(1),
     };
-    let result = curve_config(&config(3.3, 0.001), &request, &options(60)).expect("the curve is computed");
+    // Started on the closed-form steady motion at Ω = 3.4 (amplitude 0.95 mm, clear of the
+    // stop at 1 mm), which the transient keeps.
+    let start = textbook(3.4, 0.001).xp(0.0);
+    let base = config_from(3.4, 0.001, start);
+    let result = curve_config(&base, &request, &options(80)).expect("the curve is computed");
     let curve = &result.curve;
     println!(
         "located at Ω = {}, {} points, end {:?}, codim2 {:?}",
         result.located.parameter,
         curve.points.len(),
         curve.end,
-        curve.codim2.iter().map(|p| (p.kind, p.point.parameter, p.point.parameter2)).collect::<Vec<_>>()
+        curve
+            .codim2
+            .iter()
+            .map(|p| (p.kind, p.point.parameter, p.point.parameter2))
+            .collect::<Vec<_>>()
     );
     assert_eq!(curve.contact, Some(1), "the upper stop is contact 2 of one mass");
     assert!(curve.points.len() >= 5, "only {} points", curve.points.len());

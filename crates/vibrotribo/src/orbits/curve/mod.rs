@@ -111,11 +111,23 @@ pub fn continue_curve<F: Fn(f64, f64) -> ChainParams>(
     let scale = Scale::of(&params0);
     let z0 = DVector::from_iterator(
         2 * params0.len(),
-        start.state.positions.iter().chain(&start.state.velocities).copied(),
+        start
+            .state
+            .positions
+            .iter()
+            .chain(&start.state.velocities)
+            .copied(),
     );
     let sim = &options.shooting.sim;
-    let first = evaluate(&params0, &z0, start.period, 0.0, sim, &options.shooting.sensitivity)
-        .map_err(|_| no_start(kind, start.period, system::Failure::simulation()))?;
+    let first = evaluate(
+        &params0,
+        &z0,
+        start.period,
+        0.0,
+        sim,
+        &options.shooting.sensitivity,
+    )
+    .map_err(|_| no_start(kind, start.period, system::Failure::simulation()))?;
     let impacts_at_contact = first
         .events
         .iter()
@@ -140,8 +152,13 @@ pub fn continue_curve<F: Fn(f64, f64) -> ChainParams>(
         p_scale: [0.1 * start.parameter.abs().max(1e-12), (to2 - from2).abs()],
         options,
     };
-    let z_theta = carry(&system.params(&system.point(&z0, start.parameter, from2)), &z0, theta, sim)
-        .ok_or_else(|| no_start(kind, start.period, system::Failure::simulation()))?;
+    let z_theta = carry(
+        &system.params(&system.point(&z0, start.parameter, from2)),
+        &z0,
+        theta,
+        sim,
+    )
+    .ok_or_else(|| no_start(kind, start.period, system::Failure::simulation()))?;
     let u0 = system.point(&z_theta, start.parameter, from2);
     let d = system.dim();
     let fix2 = DVector::from_fn(d + 2, |i, _| if i == d + 1 { 1.0 } else { 0.0 });
@@ -163,15 +180,15 @@ fn no_start(kind: CurveKind, period: u32, f: system::Failure) -> CurveError {
 
 /// The middle of the longest stretch without events of an orbit of `duration` s, s.
 fn quiet_phase(events: &[Event], duration: f64) -> f64 {
-    let mut times: Vec<f64> = events
-        .iter()
-        .map(|e| e.time.rem_euclid(duration))
-        .collect();
+    let mut times: Vec<f64> = events.iter().map(|e| e.time.rem_euclid(duration)).collect();
     if times.is_empty() {
         return 0.0;
     }
     times.sort_by(f64::total_cmp);
-    let mut best = (times[0] + duration - times[times.len() - 1], times[times.len() - 1]);
+    let mut best = (
+        times[0] + duration - times[times.len() - 1],
+        times[times.len() - 1],
+    );
     for w in times.windows(2) {
         if w[1] - w[0] > best.0 {
             best = (w[1] - w[0], w[0]);
@@ -181,7 +198,12 @@ fn quiet_phase(events: &[Event], duration: f64) -> f64 {
 }
 
 /// The state at t = `theta` of the flow from `z` at t = 0.
-fn carry(params: &ChainParams, z: &DVector<f64>, theta: f64, sim: &crate::SimOptions) -> Option<DVector<f64>> {
+fn carry(
+    params: &ChainParams,
+    z: &DVector<f64>,
+    theta: f64,
+    sim: &crate::SimOptions,
+) -> Option<DVector<f64>> {
     let mut s = Simulator::new_at(params, 0.0, &state_from_vector(z.as_slice()), sim.clone()).ok()?;
     s.run_until(theta, &mut ()).ok()?;
     Some(state_vector(&s.state()))
@@ -195,9 +217,15 @@ struct Step<'s> {
 }
 
 impl Step<'_> {
-    fn at<F: Fn(f64, f64) -> ChainParams>(&self, system: &System<'_, F>, theta: f64) -> Result<Eval, system::Failure> {
+    fn at<F: Fn(f64, f64) -> ChainParams>(
+        &self,
+        system: &System<'_, F>,
+        theta: f64,
+    ) -> Result<Eval, system::Failure> {
         let pred = self.base + self.tangent * (theta * self.ds);
-        system.correct(&pred, self.tangent, self.tangent.dot(&pred)).map(|r| r.0)
+        system
+            .correct(&pred, self.tangent, self.tangent.dot(&pred))
+            .map(|r| r.0)
     }
 }
 
@@ -392,7 +420,11 @@ fn follow<F: Fn(f64, f64) -> ChainParams>(
     curve
 }
 
-fn step_floor<F: Fn(f64, f64) -> ChainParams>(system: &System<'_, F>, at: &Eval, f: system::Failure) -> CurveEnd {
+fn step_floor<F: Fn(f64, f64) -> ChainParams>(
+    system: &System<'_, F>,
+    at: &Eval,
+    f: system::Failure,
+) -> CurveEnd {
     let (parameter, parameter2) = system.parameters(&at.u);
     if f.degenerate {
         CurveEnd::Degenerate {

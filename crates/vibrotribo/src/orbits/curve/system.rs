@@ -204,9 +204,7 @@ impl<F: Fn(f64, f64) -> ChainParams> System<'_, F> {
         let gap = (self.kind == CurveKind::Grazing)
             .then(|| self.gap(&params, &z))
             .flatten();
-        let condition = self
-            .condition(&multipliers, gap)
-            .ok_or_else(degenerate)?;
+        let condition = self.condition(&multipliers, gap).ok_or_else(degenerate)?;
         let d = self.dim();
         let mut residual = DVector::zeros(d + 1);
         for i in 0..d {
@@ -228,9 +226,7 @@ impl<F: Fn(f64, f64) -> ChainParams> System<'_, F> {
         if self.kind == CurveKind::Grazing {
             let params = self.params(u);
             let gap = self.gap(&params, &self.state(u));
-            return self
-                .condition(&[], gap)
-                .ok_or_else(degenerate);
+            return self.condition(&[], gap).ok_or_else(degenerate);
         }
         Ok(self.evaluate(u)?.condition)
     }
