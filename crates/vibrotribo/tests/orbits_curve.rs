@@ -252,7 +252,20 @@ fn grazing_curve_is_where_the_steady_amplitude_equals_the_gap() {
             p.parameter,
             p.parameter2
         );
-        assert_true_orbit(&config(p.parameter, p.parameter2), p, curve.period);
+        // The grazing orbit touches the stop with zero speed: with the stop 1 nm higher it is
+        // an impact-free orbit of the engine, with the stop 1 nm lower it hits it.
+        let above = config(p.parameter, p.parameter2 + 1e-9);
+        assert_true_orbit(&above, p, curve.period);
+        assert_eq!(
+            impact_speed(&above, p, curve.period),
+            0.0,
+            "an impact 1 nm above the grazing"
+        );
+        let below = config(p.parameter, p.parameter2 - 1e-9);
+        assert!(
+            impact_speed(&below, p, curve.period) > 0.0,
+            "no impact 1 nm below the grazing at {p:?}"
+        );
     }
     let last = curve.points.last().expect("points");
     assert!(
