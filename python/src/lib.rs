@@ -10,6 +10,7 @@ mod attractors;
 mod chirp;
 mod config;
 mod convert;
+mod curve;
 mod interrupt;
 mod limits;
 mod loads;
@@ -50,6 +51,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loads::load_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::continue_, m)?)?;
+    m.add_function(wrap_pyfunction!(curve::curve, m)?)?;
     m.add_function(wrap_pyfunction!(lyapunov::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(chirp::chirp, m)?)?;
     m.add_function(wrap_pyfunction!(attractors::basins, m)?)?;

@@ -66,6 +66,12 @@ PARITY = {
         "--max-points": "max_points", "--mechanics-only": "mechanics_only", "--out": None,
         "--plot": None, "--diagram-steps": None, "--mass": None,
     }),
+    "curve": (vt.curve, {
+        "<CONFIG>": "config", "--kind": "kind", "--param": "param", "--near": "near",
+        "--param2": "param2", "--from2": "from2", "--to2": "to2", "--period": "period",
+        "--window": "window", "--transient": "transient", "--max-points": "max_points",
+        "--mechanics-only": "mechanics_only", "--out": None,
+    }),
     "sweep": (vt.sweep, {
         "<CONFIG>": "config", "--param": "param", "--from": "values", "--to": "values",
         "--steps": "values", "--continuation": "continuation", "--shard": None, "--out": None,

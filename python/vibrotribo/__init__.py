@@ -51,6 +51,7 @@ from ._results import (
     Table,
 )
 from ._studies import Attractors, Basins, Chirp, MassRatioOptimum, SpiceExport
+from ._curve import Curve
 from ._vibrotribo import Config, OrbitNotFound, __version__, grid, log_spaced
 
 # A Config is a read-only mapping of its effective values (cfg["excitation.amplitude"]).
@@ -64,6 +65,8 @@ __all__ = [
     "load_sweep",
     "periodic",
     "continue_",
+    "curve",
+    "Curve",
     "lyapunov",
     "Lyapunov",
     "chirp",
@@ -377,6 +380,47 @@ def continue_(
         mechanics_only=mechanics_only,
     )
     return Continuation._from(raw)
+
+
+def curve(
+    config: ConfigLike,
+    kind: str,
+    param: str,
+    near: float,
+    param2: str,
+    from2: float,
+    to2: float,
+    *,
+    period: Optional[int] = None,
+    window: float = 0.05,
+    transient: int = 200,
+    max_points: int = 200,
+    mechanics_only: bool = False,
+) -> Curve:
+    """Follows a bifurcation in two keys, as ``vibrotribo curve`` does: the bifurcation of
+    ``kind`` (``fold``, ``period_doubling``, ``neimark_sacker`` or ``grazing``) nearest
+    ``param = near`` on the branch (of ``period``, default that of the orbit found after
+    ``transient`` periods at ``near``) is located with ``param2 = from2`` within
+    ``near ± window·|near|``, then continued in (``param``, ``param2``) by pseudo-arclength
+    on its defining system (orbit plus condition) until ``param2 = to2``, ``max_points``, or
+    a codimension-two point where the orbit's event sequence changes. Unless
+    ``mechanics_only``, the harvester's average power on every point is computed.
+    """
+    raw = _vibrotribo.curve(
+        _config(config),
+        kind,
+        param,
+        float(near),
+        param2,
+        float(from2),
+        float(to2),
+        period=_count(period, "period", least=1),
+        window=float(window),
+        transient=_count(transient, "transient"),
+        max_points=_count(max_points, "max_points", least=2),
+        mechanics_only=mechanics_only,
+    )
+    return Curve._from(raw)
 
 
 def lyapunov(

@@ -180,6 +180,23 @@ def continue_(
 ) -> Dict[str, Any]:
     """A continuation: the parameter's name and the branches."""
 
+def curve(
+    config: Any,
+    kind: str,
+    param: str,
+    near: float,
+    param2: str,
+    from2: float,
+    to2: float,
+    *,
+    period: Optional[int] = None,
+    window: Optional[float] = None,
+    transient: Optional[int] = None,
+    max_points: Optional[int] = None,
+    mechanics_only: bool = False,
+) -> Dict[str, Any]:
+    """A bifurcation curve in two keys: its points, codimension-two points and end."""
+
 def grid(start: float, stop: float, steps: int) -> npt.NDArray[np.float64]:
     """`steps` values equally spaced from `start` to `stop` (both included, `stop` exactly)."""
 

@@ -11,6 +11,7 @@ mod basins;
 mod chirp;
 mod config;
 mod continuation;
+mod curve;
 mod export_spice;
 mod job;
 mod limits;
@@ -55,6 +56,9 @@ enum Command {
     Periodic(periodic::PeriodicArgs),
     /// Follow a periodic orbit in a parameter: stability, bifurcations, power along the branch.
     Continue(continuation::ContinueArgs),
+    /// Follow a fold, period doubling, Neimark–Sacker or grazing point in a second parameter:
+    /// the bifurcation curve and its codimension-two points.
+    Curve(curve::CurveArgs),
     /// Sweep one parameter: orbit diagram, impact velocities, period, power.
     Sweep(sweep::SweepArgs),
     /// Combine the shards of one sweep, map or basins job (`--shard I/N`) into the unsharded
@@ -145,6 +149,7 @@ fn run() -> anyhow::Result<()> {
         Command::ExportSpice(args) => export_spice::run(&args),
         Command::Periodic(args) => periodic::run(&args),
         Command::Continue(args) => continuation::run(&args),
+        Command::Curve(args) => curve::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Chirp(args) => chirp::run(&args),

@@ -82,6 +82,7 @@ pub mod branch;
 #[cfg(feature = "config")]
 pub mod config;
 pub mod coupling;
+pub mod curve;
 pub mod dynamics;
 pub mod electrical;
 mod error;

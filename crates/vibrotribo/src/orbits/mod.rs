@@ -49,6 +49,7 @@
 //! the stop meets it where its steady amplitude equals the gap.
 
 pub mod continuation;
+pub mod curve;
 mod error;
 mod floquet;
 mod gaps;
