@@ -133,8 +133,8 @@ pub fn check_recorded(options: &vibrotribo::study::PointOptions) -> anyhow::Resu
     let needed = popts.samples_needed() as u64;
     if options.recorded_periods < needed {
         anyhow::bail!(
-            "--recorded {}: a start's period test reads {needed} recorded periods (({} + 1) repeats \
-             of the largest period tested, {}); with fewer no start can be classified: give \
+            "--recorded {}: a start's period test reads {needed} recorded periods ({} + 1 times \
+             the largest period tested, {}); with fewer no start can be classified: give \
              --recorded {needed} or more",
             options.recorded_periods,
             popts.repeats,
