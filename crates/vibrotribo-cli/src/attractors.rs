@@ -98,7 +98,7 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
     }
     crate::limits::check_grid("--steps × --samples", args.steps as f64 * args.samples as f64)?;
     set_threads(args.run.threads)?;
-    let base = args.input.load()?;
+    let base = args.input.load_within(args.run.allow_large)?;
     base.check_uncoupled("attractors")?;
     base.check_periodic("attractor census (`attractors`)")?;
     let options = AttractorOptions {
@@ -134,6 +134,7 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
     };
     let masses = chain.len();
     let o = starts.point_runner().options();
+    crate::job::check_recorded(o)?;
     let settings = json!({
         "command": "attractors",
         "param": args.param,

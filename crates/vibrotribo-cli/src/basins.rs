@@ -213,7 +213,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
         bail!("--resume needs --out DIR (the directory of the job to continue)");
     }
     set_threads(args.run.threads)?;
-    let base = args.input.load()?;
+    let base = args.input.load_within(args.run.allow_large)?;
     base.check_uncoupled("basins")?;
     base.check_periodic("basins of attraction (`basins`)")?;
     let masses = base.chain().len();
@@ -245,6 +245,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     let (xk, yk) = (args.x.as_str(), args.y.as_str());
     let scale = SectionScale::of(starts.point_runner().base().chain());
     let o = starts.point_runner().options();
+    crate::job::check_recorded(o)?;
     let settings = json!({
         "command": "basins",
         "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": nx, "values": xs},

@@ -3,6 +3,7 @@
 
 use anyhow::{Context, Result};
 use vibrotribo::config::{Config, apply_overrides};
+use vibrotribo::excitation::WorkBudget;
 
 /// The configuration of a command: a TOML file and `--set` overrides.
 #[derive(Debug, clap::Args)]
@@ -20,11 +21,35 @@ impl ConfigArgs {
     /// the reason, for a base motion that cannot drive the chain
     /// ([`Config::check_runnable`]).
     pub fn load(&self) -> Result<Config> {
-        let mut config = match &self.config {
-            Some(path) => Config::from_path(path)?,
-            None => Config::default(),
+        self.load_within(false)
+    }
+
+    /// [`load`](Self::load) with the base motion built within the documented limit
+    /// ([`vibrotribo::excitation::MAX_PIECE_EVALUATIONS`]) unless `allow_large`, stopped by
+    /// SIGINT/SIGTERM ([`Interrupted`](crate::progress::Interrupted): nothing was written).
+    pub fn load_within(&self, allow_large: bool) -> Result<Config> {
+        let budget = WorkBudget {
+            allow_large,
+            stop: crate::progress::stop_flag(),
         };
-        apply_overrides(&mut config, &self.set).context("--set")?;
+        let loaded = (|| -> Result<Config> {
+            let mut config = match &self.config {
+                Some(path) => Config::from_path_within(path, &budget)?,
+                None => Config::default(),
+            };
+            config.set_budget(budget.clone());
+            apply_overrides(&mut config, &self.set).context("--set")?;
+            Ok(config)
+        })();
+        let config = match loaded {
+            Err(_) if crate::progress::interrupted() => {
+                return Err(crate::progress::Interrupted {
+                    what: "while building the base motion; nothing was written".into(),
+                }
+                .into());
+            }
+            other => other?,
+        };
         // Every command simulates: refuse base motions that cannot drive the chain, naming why.
         config.check_runnable()?;
         Ok(config)

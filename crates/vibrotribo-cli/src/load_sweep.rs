@@ -58,7 +58,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         bail!("--steps must be at least 1");
     }
     limits::check_grid("--steps", args.steps as f64)?;
-    let config = args.input.load()?;
+    let config = args.input.load_within(args.allow_large)?;
     let spec = config.run_spec(false);
 
     // One-way coupling: the mechanics is simulated once and replayed for every load; two-way:

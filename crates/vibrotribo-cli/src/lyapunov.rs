@@ -40,6 +40,9 @@ pub struct LyapunovArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Build a random base motion even if it costs more than 10⁹ harmonic evaluations.
+    #[arg(long)]
+    pub allow_large: bool,
 }
 
 /// An exponent for people: `−∞` for a collapsed direction.
@@ -56,7 +59,7 @@ pub fn run(args: &LyapunovArgs) -> Result<()> {
     if args.periods == 0 {
         bail!("--periods must be at least 1");
     }
-    let config = args.input.load()?;
+    let config = args.input.load_within(args.allow_large)?;
     config.check_uncoupled("lyapunov")?;
     config.check_periodic("Lyapunov exponents (`lyapunov`)")?;
     let mut spec = config.run_spec(true);

@@ -75,8 +75,9 @@ enum Command {
     /// expected power or power per mass, under breakdown and displacement constraints.
     Optimize(optimize::OptimizeArgs),
     /// Basins of attraction over two initial conditions: the attractors, their basin
-    /// fractions, periods, impacts and power (starts run 500 transient and 100 recorded
-    /// periods unless --transient/--recorded say).
+    /// fractions, periods, impacts and power (each start settles, by default until its motion
+    /// repeats, at most --settle-cap periods, or exactly --transient periods (default 500)
+    /// with --settle fixed; then 100 recorded periods unless --recorded says).
     Basins(basins::BasinsArgs),
     /// Attractors of random starts across a parameter: basin fractions (± standard error),
     /// power per attractor and the expected power of an unknown start.

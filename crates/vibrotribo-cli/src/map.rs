@@ -113,7 +113,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         bail!("--resume needs --out DIR (the directory of the job to continue)");
     }
     set_threads(args.run.threads)?;
-    let base = args.input.load()?;
+    let base = args.input.load_within(args.run.allow_large)?;
     let (px, py) = (Param::new(&base, &args.x)?, Param::new(&base, &args.y)?);
     if px.overlaps(&py) {
         bail!(
@@ -369,7 +369,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         bail!("the optimal mass ratio maximises power: --mechanics-only does not apply");
     }
     set_threads(args.run.threads)?;
-    let base = args.input.load()?;
+    let base = args.input.load_within(args.run.allow_large)?;
     let runner = args.run.runner(base)?;
     let contacts = runner.contacts();
     let (omegas, ratios) = (

@@ -46,6 +46,12 @@ pub fn interrupted() -> bool {
     FLAGS.get().is_some_and(|f| f.any.load(Ordering::SeqCst))
 }
 
+/// The flag a SIGINT or SIGTERM sets, for the library's long phases that poll one (a base
+/// motion's build, the motion classification); `None` before the handlers are installed.
+pub fn stop_flag() -> Option<Arc<AtomicBool>> {
+    FLAGS.get().map(|f| Arc::clone(&f.any))
+}
+
 /// The exit status for the signal that stopped the program: 143 after SIGTERM, else 130.
 pub fn interrupt_status() -> u8 {
     match FLAGS.get() {

@@ -8,10 +8,11 @@ use anyhow::Result;
 use serde_json::json;
 use vibrotribo::config::Config;
 use vibrotribo::electrical::{HarvesterParams, Load, LoadKind, TransducerMode};
+use vibrotribo::excitation::WorkBudget;
 use vibrotribo::merit::MeritWatch;
 use vibrotribo::study::{
-    Ending, Motion, MotionReport, RunMotion, RunObserver, RunOutcome, RunSpec, Sample, SettleMode, settle,
-    simulate,
+    Ending, LyapunovSkipped, Motion, MotionReport, RunMotion, RunObserver, RunOutcome, RunSpec, Sample,
+    SettleMode, settle, simulate,
 };
 use vibrotribo::{ChainParams, Event, StateView};
 
@@ -38,7 +39,10 @@ pub struct SimulateArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
-    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
+    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB, build a random
+    /// base motion costlier than 10⁹ harmonic evaluations, and compute the motion's Lyapunov
+    /// exponent when its cost, (2N)³ × periods, exceeds 10¹¹ (without it the motion is then
+    /// reported `undetermined`, with the reason).
     #[arg(long)]
     pub allow_large: bool,
     /// Write into an --out directory that holds another job's results (files of the same
@@ -172,7 +176,7 @@ impl RunObserver for Files {
 
 /// Runs `vibrotribo simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    let config = args.input.load()?;
+    let config = args.input.load_within(args.allow_large)?;
     let mut spec = config.sampled_run_spec(args.mechanics_only);
     spec.breakdown_check = true;
     check_size(&config, &spec, args.out.is_some(), args.allow_large)?;
@@ -231,8 +235,17 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     };
     watch.progress.finish();
     // A motion under a base motion that is not periodic is not classified (no period).
+    // Its Lyapunov run, where one is needed, within the documented cost unless
+    // --allow-large, and stopped by SIGINT/SIGTERM.
+    let budget = WorkBudget {
+        allow_large: args.allow_large,
+        stop: crate::progress::stop_flag(),
+    };
     let motion = (outcome.ending == Ending::Completed && config.is_periodic())
-        .then(|| run_motion.finish(&spec, &outcome.final_state, settled.as_ref()));
+        .then(|| run_motion.finish_within(&spec, &outcome.final_state, settled.as_ref(), &budget));
+    let classification_stopped = motion
+        .as_ref()
+        .is_some_and(|m| m.lyapunov_skipped == Some(LyapunovSkipped::Stopped));
     let elapsed = started.elapsed().as_secs_f64();
     let failure = failure_error(&outcome);
     let energy = outcome
@@ -251,6 +264,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             summary["settle_cap_periods"] = json!(a.cap_periods);
         }
         summary["motion"] = vibrotribo::report::motion_json(motion.as_ref());
+        if classification_stopped {
+            summary["interrupted"] = json!(true);
+        }
         if let Some(w) = &merit {
             vibrotribo::report::insert_merit(&mut summary, merit_report.as_ref());
             crate::merit::write_boundary(dir, w.boundary())?;
@@ -277,6 +293,20 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     plotted?;
     if let Some(e) = failure {
         return Err(e);
+    }
+    if classification_stopped {
+        return Err(Interrupted {
+            what: format!(
+                "while classifying the motion, after the {} periods of the run{}",
+                outcome.periods,
+                if args.out.is_some() {
+                    "; the files hold the whole run, summary.json says \"interrupted\": true"
+                } else {
+                    ""
+                }
+            ),
+        }
+        .into());
     }
     if outcome.ending == Ending::Stopped {
         return Err(Interrupted {
@@ -326,10 +356,13 @@ fn print_motion(m: &MotionReport) {
             Some((l, s)) => format!("λ1 = {l:.4} ± {s:.4} 1/s"),
             None => "no Lyapunov exponent".into(),
         },
-        Motion::Undetermined => {
-            "the window cannot tell: too short, or a two-way coupled run neither periodic nor converging"
-                .into()
-        }
+        Motion::Undetermined => match m.lyapunov_skipped {
+            Some(why) => format!("not classified: {why}"),
+            None => {
+                "the window cannot tell: too short, or a two-way coupled run neither periodic nor converging"
+                    .into()
+            }
+        },
     };
     let detail = match m.coexisting {
         Some((p, r)) => {

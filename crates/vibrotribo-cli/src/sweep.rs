@@ -179,7 +179,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         );
     }
     set_threads(args.run.threads)?;
-    let base = args.input.load()?;
+    let base = args.input.load_within(args.run.allow_large)?;
     if args.lyapunov {
         base.check_periodic("--lyapunov (Lyapunov exponents)")?;
     }

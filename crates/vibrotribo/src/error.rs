@@ -189,6 +189,20 @@ pub enum SimError {
         /// Last mass of the cluster (1-based).
         last: usize,
     },
+    /// A cluster's stiffness, damping and mass at the excitation frequency are beyond the
+    /// range of double precision: the particular solution's K² or (K − Mω²)² + (Cω)²
+    /// overflows (e.g. a stiffness of 1e300 N/m).
+    #[error(
+        "the cluster of masses {first}..={last} has a stiffness, damping or mass so far from the excitation's \
+         scales that its closed-form flow overflows double precision (K² or (K − Mω²)² + (Cω)² is infinite): \
+         give oscillator.stiffness, damping and masses within about 1e±100 of each other in SI units"
+    )]
+    OutOfRange {
+        /// First mass of the cluster (1-based).
+        first: usize,
+        /// Last mass of the cluster (1-based).
+        last: usize,
+    },
     /// An observer failed the run (see [`Observer::proceed`](crate::Observer::proceed)).
     #[error("{0}")]
     Observer(String),

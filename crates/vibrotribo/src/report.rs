@@ -220,7 +220,7 @@ pub fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
         return serde_json::Value::Null;
     };
     let finite = |x: f64| x.is_finite().then_some(x);
-    json!({
+    let mut j = json!({
         "motion": m.motion.as_str(),
         "period": if m.motion == Motion::Periodic { m.residual_period } else { 0 },
         "residual": finite(m.residual),
@@ -235,7 +235,11 @@ pub fn motion_json(m: Option<&MotionReport>) -> serde_json::Value {
         "section_curve_ratio": m.curve_ratio,
         "label_source": m.label_source.map(|s| s.as_str()),
         "coexisting": m.coexisting.map(|(p, r)| json!({"period": p, "max_abs_multiplier": r})),
-    })
+    });
+    if let Some(skipped) = m.lyapunov_skipped {
+        j["lyapunov_skipped"] = json!(skipped.to_string());
+    }
+    j
 }
 
 #[cfg(test)]

@@ -78,7 +78,8 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
-    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB.
+    /// Run even if the estimated output exceeds 20 GiB or the memory 4 GiB, or if a random
+    /// base motion's build exceeds 10⁹ harmonic evaluations.
     #[arg(long)]
     pub allow_large: bool,
     /// Write into an --out directory that holds another job's results (files of the same
@@ -123,4 +124,22 @@ pub struct MergeArgs {
     /// Where to write the merged files (a new or empty directory).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+}
+
+/// Refuses a start's recorded window too short for its period test (`--recorded` below
+/// (repeats + 1) × the largest period tested): every start would fail, none be classified.
+pub fn check_recorded(options: &vibrotribo::study::PointOptions) -> anyhow::Result<()> {
+    let popts = options.period_options();
+    let needed = popts.samples_needed() as u64;
+    if options.recorded_periods < needed {
+        anyhow::bail!(
+            "--recorded {}: a start's period test reads {needed} recorded periods ({} + 1 times \
+             the largest period tested, {}); with fewer no start can be classified: give \
+             --recorded {needed} or more",
+            options.recorded_periods,
+            popts.repeats,
+            popts.max_period
+        );
+    }
+    Ok(())
 }

@@ -7,7 +7,7 @@ mod files;
 mod grid;
 mod run;
 
-pub use args::{MergeArgs, RunArgs, Shard};
+pub use args::{MergeArgs, RunArgs, Shard, check_recorded};
 pub use files::{header_len, point_columns};
 pub use grid::{CHECKPOINT, CsvSpec, GridOutput, Layout, merge, read_checkpoint};
 pub use run::{

@@ -279,6 +279,75 @@ fn known_cases(out: &Path) -> Vec<Vec<String>> {
     cases
 }
 
+/// `--set` arguments of a chain of `n` equal masses (the default case's m1, its spring and
+/// damper) with gaps of 2 cm, at rest.
+fn chain(n: usize) -> Vec<String> {
+    let list = |x: &str, len: usize| format!("[{}]", vec![x; len].join(","));
+    [
+        format!("oscillator.masses={}", list("0.048", n)),
+        "oscillator.stiffness=120.0".into(),
+        "oscillator.damping=0.02".into(),
+        format!("oscillator.gaps={}", list("0.02", n - 1)),
+        format!("run.initial_positions={}", list("0.0", n)),
+        format!("run.initial_velocities={}", list("0.0", n)),
+    ]
+    .into_iter()
+    .flat_map(|s| ["--set".to_string(), s])
+    .collect()
+}
+
+/// `--set` arguments of a flat random excitation over 0.001–5000 Hz for 20 s: 100 000
+/// harmonics, some 10¹⁰ evaluations to build.
+fn wide_random() -> Vec<String> {
+    [
+        "excitation.kind=\"random\"",
+        "excitation.rms_acceleration=1.0",
+        "excitation.f_low_hz=0.001",
+        "excitation.f_high_hz=5000",
+        "excitation.duration_s=20",
+    ]
+    .into_iter()
+    .flat_map(|s| ["--set".to_string(), s.to_string()])
+    .collect()
+}
+
+/// Long phases asked to stop by SIGTERM two seconds in (a large random excitation's build,
+/// a chain of 2000 masses), and the same sizes without `--allow-large` (refused or skipped
+/// with the reason): each must end cleanly, the signalled ones within the stop bound.
+fn signalled_cases() -> Vec<(Vec<String>, bool)> {
+    let short = strings(&["--set", "run.periods=8", "--set", "run.transient_periods=4"]);
+    let case = |head: &[&str], tail: &[Vec<String>], signal: bool| {
+        let mut c = strings(head);
+        for t in tail {
+            c.extend(t.iter().cloned());
+        }
+        (c, signal)
+    };
+    vec![
+        case(&["simulate", "-q"], &[wide_random(), short.clone()], false),
+        case(
+            &["simulate", "-q", "--allow-large"],
+            &[wide_random(), short.clone()],
+            true,
+        ),
+        case(
+            &[
+                "lyapunov",
+                "-q",
+                "--allow-large",
+                "--periods",
+                "5",
+                "--transient",
+                "2",
+            ],
+            &[wide_random(), short.clone()],
+            true,
+        ),
+        case(&["simulate", "-q"], &[chain(2000), short.clone()], true),
+        case(&["simulate", "-q"], &[chain(2000), short.clone()], false),
+    ]
+}
+
 /// A small seeded generator (xorshift64*), so that a failing case can be run again.
 struct Rng(u64);
 
@@ -356,8 +425,21 @@ fn base_case(command: usize, run: &str) -> Vec<&str> {
         ],
         9 => vec!["optimize-mass-ratio", "--omega-steps", "2", "--rm-steps", "2"],
         10 => vec![
-            "basins", "--x", "x1", "--x-from", "-0.01", "--x-to", "0.01", "--y", "v1", "--y-from", "-0.1",
-            "--y-to", "0.1", "--grid", "2x2",
+            "basins",
+            "--x",
+            "run.initial_positions[0]",
+            "--x-from",
+            "-0.01",
+            "--x-to",
+            "0.01",
+            "--y",
+            "run.initial_velocities[0]",
+            "--y-from",
+            "-0.1",
+            "--y-to",
+            "0.1",
+            "--grid",
+            "2x2",
         ],
         11 => vec![
             "attractors",
@@ -542,6 +624,14 @@ fn hostile(seed: u64, count: usize) {
     let mut tally = Tally::default();
     for args in known_cases(scratch.path()) {
         let e = run_case(&args, scratch.path(), None);
+        tally.add(&args, &e);
+    }
+    for (args, signal) in signalled_cases() {
+        let e = run_case(
+            &args,
+            scratch.path(),
+            signal.then_some((Duration::from_secs(2), SIGTERM)),
+        );
         tally.add(&args, &e);
     }
     // A finished run for export-spice, merge and plot to read.

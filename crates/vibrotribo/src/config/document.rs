@@ -10,7 +10,7 @@ use super::error::ConfigError;
 use super::keys::{self, PerMass};
 use super::param::Param;
 use crate::electrical::{ChargeOptions, HarvesterParams, TransducerMode};
-use crate::excitation::{BaseMotion, ExcitationKind, ExcitationSpec, Harmonic, Quantity, Sweep};
+use crate::excitation::{BaseMotion, ExcitationKind, ExcitationSpec, Harmonic, Quantity, Sweep, WorkBudget};
 use crate::model::{ChainParams, ChainState, Excitation, Frequency, SimOptions, Stops};
 use crate::study::{Harvester, RunSettings, RunSpec, Sampling};
 
@@ -160,6 +160,9 @@ pub struct Config {
     /// The base motion built, for every kind but `harmonic` (shared: configurations are
     /// cloned often).
     base: Option<Arc<BaseMotion>>,
+    /// How much work building the base motion may do, and its stop flag (kept for the
+    /// configurations derived from this one).
+    budget: WorkBudget,
 }
 
 impl Default for Config {
@@ -177,17 +180,41 @@ impl Config {
             message: e.to_string(),
         })?;
         let dir = path.parent().map(Path::to_path_buf);
-        Self::parse(&text, &path.display().to_string(), dir)
+        Self::parse(&text, &path.display().to_string(), dir, &WorkBudget::default())
+    }
+
+    /// [`from_path`](Self::from_path) with the base motion built within `budget` (a random
+    /// signal costlier than [`MAX_PIECE_EVALUATIONS`](crate::excitation::MAX_PIECE_EVALUATIONS)
+    /// harmonic evaluations is refused unless it allows large builds; a set stop flag stops
+    /// the build). The configurations derived from this one keep the budget.
+    pub fn from_path_within(path: &Path, budget: &WorkBudget) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let dir = path.parent().map(Path::to_path_buf);
+        Self::parse(&text, &path.display().to_string(), dir, budget)
+    }
+
+    /// The budget future base-motion builds of this configuration and those derived from it
+    /// (by [`set`](Self::set), [`with_values`](Self::with_values)) are held to.
+    pub fn set_budget(&mut self, budget: WorkBudget) {
+        self.budget = budget;
     }
 
     /// Reads a configuration from TOML text (a record's relative path is relative to the
     /// working directory).
     pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
-        Self::parse(text, "the configuration", None)
+        Self::parse(text, "the configuration", None, &WorkBudget::default())
     }
 
-    fn parse(text: &str, origin: &str, base_dir: Option<PathBuf>) -> Result<Self, ConfigError> {
-        let table: Table = toml::from_str(text).map_err(|e| ConfigError::Syntax {
+    fn parse(
+        text: &str,
+        origin: &str,
+        base_dir: Option<PathBuf>,
+        budget: &WorkBudget,
+    ) -> Result<Self, ConfigError> {
+        let mut table: Table = toml::from_str(text).map_err(|e| ConfigError::Syntax {
             origin: origin.to_string(),
             message: e.to_string(),
         })?;
@@ -196,7 +223,10 @@ impl Config {
             origin: format!("in {origin}"),
             message: e.to_string(),
         })?;
-        Self::from_table_in(table, base_dir)
+        if let Some(dir) = base_dir.as_deref() {
+            resolve_record_path(&mut table, dir);
+        }
+        Self::read_table(table, None, budget)
     }
 
     /// Reads a configuration from a TOML tree (as parsed, or built from a Python dict); a
@@ -213,13 +243,13 @@ impl Config {
         if let Some(dir) = base_dir.as_deref() {
             resolve_record_path(&mut table, dir);
         }
-        Self::read_table(table, None)
+        Self::read_table(table, None, &WorkBudget::default())
     }
 
     /// The tree `table` read into the document's types and resolved; what `previous` (a
     /// configuration this one is derived from) already read or built is reused where its
     /// inputs are the same (a record's samples, a base motion's spline).
-    fn read_table(table: Table, previous: Option<&Config>) -> Result<Self, ConfigError> {
+    fn read_table(table: Table, previous: Option<&Config>, budget: &WorkBudget) -> Result<Self, ConfigError> {
         let doc: Document = serde_path_to_error::deserialize(Value::Table(table.clone())).map_err(|e| {
             // A key the schema lacks is named as one (the deserialiser calls it a field).
             if let Some(key) = keys::unknown_key_in(&table) {
@@ -235,16 +265,18 @@ impl Config {
                 message: e.into_inner().message().trim().to_string(),
             }
         })?;
-        Self::resolve(table, doc, previous)
+        Self::resolve(table, doc, previous, budget)
     }
 
     /// The configuration of the document `doc` read from `table`: the chain, the initial
     /// state and the base motion derived, everything validated (see
-    /// [`read_table`](Self::read_table) for `previous`).
+    /// [`read_table`](Self::read_table) for `previous`); the base motion is built within
+    /// `budget`.
     pub(super) fn resolve(
         table: Table,
         doc: Document,
         previous: Option<&Config>,
+        budget: &WorkBudget,
     ) -> Result<Self, ConfigError> {
         let chain = chain_of(&doc).map_err(|e| e.renamed(keys::chain_key))?;
         let mut harvester = doc.harvester.clone().unwrap_or_default();
@@ -274,7 +306,7 @@ impl Config {
             (_, Some(p)) if p.excitation == excitation && p.base.is_some() => p.base.clone(),
             (kind, _) => Some(Arc::new(
                 excitation
-                    .build(chain_harmonic(&chain))
+                    .build_within(chain_harmonic(&chain), budget)
                     .map_err(|e| super::excitation::named(kind, e))?,
             )),
         };
@@ -310,6 +342,7 @@ impl Config {
             excitation,
             base,
             doc,
+            budget: budget.clone(),
         })
     }
 
@@ -344,7 +377,7 @@ impl Config {
             keys::set_key(&mut table, key, value).map_err(|e| tell(&[(shown.clone(), key)], e))?;
             set.push((shown, key));
         }
-        *self = Self::read_table(table, Some(self)).map_err(|e| tell(&set, e))?;
+        *self = Self::read_table(table, Some(self), &self.budget).map_err(|e| tell(&set, e))?;
         Ok(())
     }
 
@@ -365,7 +398,7 @@ impl Config {
                 .map_err(|e| tell(&[(shown.clone(), param.key())], e))?;
             set.push((shown, param.key()));
         }
-        Self::resolve(table, doc, Some(self)).map_err(|e| tell(&set, e))
+        Self::resolve(table, doc, Some(self), &self.budget).map_err(|e| tell(&set, e))
     }
 
     /// [`with_values`](Self::with_values) through the TOML tree ([`set_all`](Self::set_all)):

@@ -189,7 +189,7 @@ fn split_key(key: &str) -> Result<(Vec<&str>, Option<usize>), ConfigError> {
         Some(open) => {
             let close = key
                 .strip_suffix(']')
-                .ok_or_else(|| ConfigError::Malformed(format!("key `{key}`: missing closing `]`")))?;
+                .ok_or_else(|| indexed_key_not_last(key, open))?;
             let idx: usize = close[open + 1..].parse().map_err(|_| {
                 ConfigError::Malformed(format!("key `{key}`: the index must be a non-negative integer"))
             })?;
@@ -198,6 +198,28 @@ fn split_key(key: &str) -> Result<(Vec<&str>, Option<usize>), ConfigError> {
         None => (key, None),
     };
     Ok((path.split('.').collect(), index))
+}
+
+/// The error of a key with an index `[i]` that does not end it: a field of one element of an
+/// array of tables (`excitation.harmonics[0].amplitude`) cannot be set alone; such an array
+/// is set whole. Keys without a closing `]` are named as such.
+fn indexed_key_not_last(key: &str, open: usize) -> ConfigError {
+    let Some(close) = key[open..].find(']').map(|c| open + c) else {
+        return ConfigError::Malformed(format!("key `{key}`: missing closing `]`"));
+    };
+    let array = &key[..open];
+    let example = if array == "excitation.harmonics" {
+        "--set 'excitation.harmonics=[{amplitude = 0.001, ratio = 1.0}, {amplitude = 0.0005, ratio = 2.0}]'"
+            .to_string()
+    } else {
+        format!("--set '{array}=[...]'")
+    };
+    ConfigError::Malformed(format!(
+        "key `{key}`: an index selects one number of an array of numbers and must end the key \
+         (`oscillator.gaps[1]`); `{}` after `{}` is not supported: set the array `{array}` whole, e.g. {example}",
+        &key[close + 1..],
+        &key[..=close],
+    ))
 }
 
 fn number(value: &Value, key: &str) -> Result<f64, ConfigError> {

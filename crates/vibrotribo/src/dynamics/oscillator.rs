@@ -212,6 +212,9 @@ impl Oscillator {
         let det = d * d + cw * cw;
         let (pc, ps) = if a == 0.0 {
             (0.0, 0.0)
+        } else if !(det.is_finite() && (kk * kk).is_finite()) {
+            // Beyond double precision (a stiffness of 1e300): not a resonance.
+            return Err(SimError::OutOfRange { first: 0, last: 0 });
         } else if det <= 1e-24 * (kk * kk) {
             // Undamped and driven exactly at resonance: no bounded particular solution.
             return Err(SimError::UndampedResonance { first: 0, last: 0 });

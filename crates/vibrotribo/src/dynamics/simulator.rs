@@ -672,9 +672,15 @@ impl Simulator {
                 s,
                 vs,
             )
-            .map_err(|_| SimError::UndampedResonance {
-                first: first + 1,
-                last: last + 1,
+            .map_err(|e| match e {
+                SimError::OutOfRange { .. } => SimError::OutOfRange {
+                    first: first + 1,
+                    last: last + 1,
+                },
+                _ => SimError::UndampedResonance {
+                    first: first + 1,
+                    last: last + 1,
+                },
             })?;
             self.term_scale = self.term_scale.max(osc.magnitude());
             self.clusters.push(ClusterFlow {

@@ -39,6 +39,29 @@ pub enum SignalError {
     /// The signal would need more knots or components than allowed.
     #[error("{0}")]
     TooLarge(String),
+    /// Building the signal's pieces would cost more than
+    /// [`MAX_PIECE_EVALUATIONS`](super::MAX_PIECE_EVALUATIONS) harmonic evaluations.
+    #[error(
+        "the signal has {harmonics} harmonics over {intervals} intervals: about {:.1e} harmonic evaluations to build, \
+         more than the limit of {:.0e} (about half a minute); narrow the band (f_low_hz, f_high_hz), \
+         shorten the duration or raise spline_tolerance, or allow large jobs (--allow-large)",
+        super::budget::build_cost(*harmonics, *intervals),
+        super::MAX_PIECE_EVALUATIONS
+    )]
+    Costly {
+        /// Harmonics of the signal.
+        harmonics: usize,
+        /// Intervals of its pieces.
+        intervals: usize,
+    },
+    /// The build was stopped by its budget's stop flag.
+    #[error("stopped while building the signal, after {done} of {intervals} intervals")]
+    Stopped {
+        /// Intervals built.
+        done: usize,
+        /// Intervals asked for.
+        intervals: usize,
+    },
 }
 
 /// Why a base motion cannot drive a run: the combination named and the reason.

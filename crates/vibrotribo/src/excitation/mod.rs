@@ -15,7 +15,7 @@
 //! bounds), `harmonics.rs` (harmonics, multisines, sampling a smooth signal into a spline),
 //! `pieces.rs` (sums of harmonics as degree-7 Chebyshev interpolants, far fewer intervals
 //! than a spline: what the engine runs multisines and random signals on),
-//! `chirp.rs`, `random.rs` (random-phase multisine from a PSD), `record.rs` (CSV records,
+//! `budget.rs` (the cost of a build, its limit and its stop flag), `chirp.rs`, `random.rs` (random-phase multisine from a PSD), `record.rs` (CSV records,
 //! exact integration with baseline correction), `error.rs`.
 //!
 //! [`ExcitationSpec`] is what the `[excitation]` table of a configuration says (see
@@ -23,6 +23,7 @@
 //! makes it a [`BaseMotion`]. Times are those of the run: t = 0 is its start (for a record,
 //! its first sample).
 
+mod budget;
 mod chirp;
 mod error;
 mod harmonics;
@@ -33,6 +34,7 @@ mod spline;
 
 use std::sync::Arc;
 
+pub use budget::{MAX_PIECE_EVALUATIONS, WorkBudget, build_cost};
 pub use chirp::{Chirp, Sweep};
 pub use error::{BaseMotionError, SignalError};
 pub use harmonics::{
@@ -140,8 +142,16 @@ impl ExcitationSpec {
 
     /// The base motion. `harmonic` is the chain's excitation (amplitude m, ω rad/s), used by
     /// the harmonic kind only. Chirps, random signals and records can be expensive (up to
-    /// [`MAX_KNOTS`] knots): build once per run.
+    /// [`MAX_KNOTS`] knots): build once per run. A random signal's build is refused above
+    /// [`MAX_PIECE_EVALUATIONS`] (see [`build_within`](Self::build_within)).
     pub fn build(&self, harmonic: Harmonic) -> Result<BaseMotion, SignalError> {
+        self.build_within(harmonic, &WorkBudget::default())
+    }
+
+    /// [`build`](Self::build) within `budget`: a random signal costlier than
+    /// [`MAX_PIECE_EVALUATIONS`] is refused unless it allows large builds, and its build
+    /// stops when its stop flag is set ([`SignalError::Stopped`]).
+    pub fn build_within(&self, harmonic: Harmonic, budget: &WorkBudget) -> Result<BaseMotion, SignalError> {
         Ok(match self {
             ExcitationSpec::Harmonic => BaseMotion::Harmonics(vec![harmonic]),
             ExcitationSpec::Multisine(h) => BaseMotion::Harmonics(h.clone()),
@@ -157,7 +167,7 @@ impl ExcitationSpec {
                 spec,
                 relative_tolerance,
             } => {
-                let (pieces, harmonics) = spec.to_pieces(*relative_tolerance)?;
+                let (pieces, harmonics) = spec.to_pieces(*relative_tolerance, budget)?;
                 BaseMotion::Pieces(PiecesMotion {
                     pieces: Arc::new(pieces),
                     harmonics,

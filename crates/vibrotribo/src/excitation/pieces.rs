@@ -16,6 +16,7 @@
 
 use std::f64::consts::PI;
 
+use super::budget::{POLL_INTERVALS, WorkBudget};
 use super::error::SignalError;
 use super::harmonics::{Harmonic, MAX_KNOTS};
 
@@ -110,10 +111,23 @@ fn factorial_n1() -> f64 {
 
 impl HarmonicPieces {
     /// The sum of `harmonics` on `[0, end]` (s) within `tolerance` (m) in displacement (see
-    /// [`piece_accuracy`]).
+    /// [`piece_accuracy`]), whatever its cost.
     pub fn new(harmonics: &[Harmonic], end: f64, tolerance: f64) -> Result<Self, SignalError> {
+        Self::new_within(harmonics, end, tolerance, &WorkBudget::unlimited())
+    }
+
+    /// [`new`](Self::new) within `budget`: refused before it starts if harmonics × intervals
+    /// exceed what it allows ([`WorkBudget::check`]), stopped ([`SignalError::Stopped`]) when
+    /// its stop flag is set (read every [`POLL_INTERVALS`] intervals).
+    pub fn new_within(
+        harmonics: &[Harmonic],
+        end: f64,
+        tolerance: f64,
+        budget: &WorkBudget,
+    ) -> Result<Self, SignalError> {
         let accuracy = piece_accuracy(harmonics, end, tolerance)?;
         let n = accuracy.intervals;
+        budget.check(harmonics.len(), n)?;
         let knots: Vec<f64> = (0..=n).map(|k| end * k as f64 / n as f64).collect();
         // Chebyshev points (roots of T₈) on [−1, 1], and the matrix taking values at them
         // to monomial coefficients in z (from the Chebyshev series by the DCT, then each
@@ -133,6 +147,12 @@ impl HarmonicPieces {
         let mut phase = vec![(0.0, 0.0); harmonics.len() * M];
         for m in 0..n {
             let mid = (m as f64 + 0.5) * h;
+            if m % POLL_INTERVALS == 0 && budget.stopped() {
+                return Err(SignalError::Stopped {
+                    done: m,
+                    intervals: n,
+                });
+            }
             if m % RESYNC == 0 {
                 for (j, hm) in harmonics.iter().enumerate() {
                     for (i, z) in nodes.iter().enumerate() {

@@ -7,6 +7,7 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;
 
+use super::budget::WorkBudget;
 use super::error::SignalError;
 use super::harmonics::{
     Harmonic, MAX_KNOTS, SplineAccuracy, evaluate_sum, fourth_derivative_bound, intervals_for,
@@ -265,8 +266,15 @@ impl RandomSpec {
 
     /// The displacement as degree-7 piecewise polynomials over `[0, D]` within
     /// `relative_tolerance` times the RMS displacement ([`HarmonicPieces`], what the engine
-    /// is driven by), and the displacement harmonics they interpolate.
-    pub fn to_pieces(&self, relative_tolerance: f64) -> Result<(HarmonicPieces, Vec<Harmonic>), SignalError> {
+    /// is driven by), and the displacement harmonics they interpolate. Refused before it
+    /// starts if it costs more than `budget` allows ([`WorkBudget::check`]: harmonics ×
+    /// intervals above [`MAX_PIECE_EVALUATIONS`](super::MAX_PIECE_EVALUATIONS)); stopped by
+    /// its stop flag.
+    pub fn to_pieces(
+        &self,
+        relative_tolerance: f64,
+        budget: &WorkBudget,
+    ) -> Result<(HarmonicPieces, Vec<Harmonic>), SignalError> {
         if !(relative_tolerance.is_finite() && relative_tolerance > 0.0) {
             return Err(SignalError::Invalid(format!(
                 "spline_tolerance = {relative_tolerance}: must be finite and > 0"
@@ -276,7 +284,7 @@ impl RandomSpec {
         let rms = (harmonics.iter().map(|h| h.amplitude * h.amplitude).sum::<f64>() / 2.0).sqrt();
         // A zero signal needs one interval, whatever the tolerance.
         let tolerance = (relative_tolerance * rms).max(f64::MIN_POSITIVE);
-        let pieces = HarmonicPieces::new(&harmonics, self.duration, tolerance)?;
+        let pieces = HarmonicPieces::new_within(&harmonics, self.duration, tolerance, budget)?;
         Ok((pieces, harmonics))
     }
 

@@ -32,7 +32,10 @@ pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
 pub use mass_ratio::{
     MassRatioOptimum, PAPER_MASS_RATIO_FIT, mass_ratio_optima, paper_mass_ratio_fit, refine_maximum,
 };
-pub use motion::{LabelSource, Motion, MotionReport, Window, classify, exponent_sign};
+pub use motion::{
+    LabelSource, LyapunovSkipped, MAX_CLASSIFY_WORK, Motion, MotionReport, Window, classify, classify_cost,
+    exponent_sign,
+};
 pub use observer::{Checkpoint, ElectricalSample, Mechanics, RunObserver, Sample};
 pub use orbit::{power_on_orbit, power_on_periodic_state};
 pub use point::{

@@ -37,14 +37,26 @@
 //! The Lyapunov exponent is computed only for a point that is neither periodic nor settling
 //! (over the recorded window when the settling already found the motion irregular, else by
 //! a run of the same length from the final state), so periodic points cost nothing extra.
+//!
+//! That run carries 2N tangent vectors and folds them by a QR decomposition every period:
+//! about (2N)³ operations a period ([`classify_cost`]). A run costlier than
+//! [`MAX_CLASSIFY_WORK`] (a chain of a few hundred masses) is not made unless the budget
+//! allows large jobs: the motion is then `undetermined`, and
+//! [`MotionReport::lyapunov_skipped`] says why. The run polls the budget's stop flag at
+//! every period's end.
 
 use std::cmp::Ordering;
+use std::ops::ControlFlow;
 
 use super::lyapunov::lyapunov_spectrum;
+use super::observer::RunObserver;
 use super::point::{PointOptions, PointResult};
 use super::settings::RunSpec;
 use super::settle::{SettleEnding, Settled, ShotOrbit, section_states};
+use super::simulate::Ending;
+use crate::StateView;
 use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, contracting_divisor, converging_lag};
+use crate::excitation::WorkBudget;
 use crate::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
 use crate::sensitivity::length_scale;
@@ -139,6 +151,64 @@ pub struct MotionReport {
     /// and the recorded window is not on: its minimal period and largest multiplier modulus
     /// (over that period).
     pub coexisting: Option<(u32, f64)>,
+    /// Why the Lyapunov exponent a non-periodic, non-converging window needs was not
+    /// computed (the motion is then `undetermined`).
+    pub lyapunov_skipped: Option<LyapunovSkipped>,
+}
+
+/// Most tangent-space work, (2N)³ × periods ([`classify_cost`]), the classification's
+/// Lyapunov run does unless large jobs are allowed: 10¹¹, about a minute on one core (a chain
+/// of about 100 masses over the default window).
+pub const MAX_CLASSIFY_WORK: f64 = 1e11;
+
+/// The tangent-space work of a classifying Lyapunov run of a chain of `masses` masses over
+/// `periods` periods: (2N)³ per period, the QR of its 2N × 2N basis (the state-transition
+/// matrices of its events cost as much again or more).
+pub fn classify_cost(masses: usize, periods: u64) -> f64 {
+    (2.0 * masses as f64).powi(3) * periods as f64
+}
+
+/// Why a classification computed no Lyapunov exponent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LyapunovSkipped {
+    /// Its cost ([`classify_cost`]) is above [`MAX_CLASSIFY_WORK`] and large jobs were not
+    /// allowed.
+    Costly {
+        /// Tangent directions, 2N.
+        dimension: usize,
+        /// Periods of the run.
+        periods: u64,
+    },
+    /// The budget's stop flag was set during the run.
+    Stopped,
+}
+
+impl std::fmt::Display for LyapunovSkipped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            LyapunovSkipped::Costly { dimension, periods } => write!(
+                f,
+                "the Lyapunov exponent of {dimension} tangent directions over {periods} periods would cost \
+                 about {:.1e} operations, more than the limit of {MAX_CLASSIFY_WORK:.0e} (allow large jobs, \
+                 --allow-large, to compute it)",
+                (dimension as f64).powi(3) * periods as f64
+            ),
+            LyapunovSkipped::Stopped => f.write_str("the Lyapunov run was stopped by a signal"),
+        }
+    }
+}
+
+/// A run observer that stops the run at a period's end once the budget's flag is set.
+struct Poll<'a>(&'a WorkBudget);
+
+impl RunObserver for Poll<'_> {
+    fn period(&mut self, _periods: u64, _state: &StateView<'_>) -> ControlFlow<()> {
+        if self.0.stopped() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
 }
 
 /// Error bars a Lyapunov exponent must clear to count as nonzero.
@@ -178,7 +248,8 @@ impl<'a> Window<'a> {
 /// the adaptive settling before it, `None` after a fixed transient of
 /// `options.transient_periods`; `spectrum` the Lyapunov spectrum over the window if one was
 /// computed. Without one, a window that is neither periodic nor settling gets the spectrum
-/// over `options.recorded_periods` periods from its final state (mechanics only).
+/// over `options.recorded_periods` periods from its final state (mechanics only), within
+/// `budget` ([`MAX_CLASSIFY_WORK`] unless it allows large jobs; stopped by its flag).
 pub fn classify(
     params: &ChainParams,
     sim_options: &SimOptions,
@@ -186,6 +257,7 @@ pub fn classify(
     window: Window<'_>,
     settled: Option<&Settled>,
     spectrum: Option<&LyapunovSpectrum>,
+    budget: &WorkBudget,
 ) -> MotionReport {
     let n = params.len();
     let test_window = options.period_options().samples_needed() as f64;
@@ -205,6 +277,7 @@ pub fn classify(
         curve_ratio: None,
         label_source: None,
         coexisting: None,
+        lyapunov_skipped: None,
     };
     let scale = amplitude(window.positions);
     report.coexisting = settled
@@ -260,13 +333,26 @@ pub fn classify(
     let spectrum = match spectrum {
         Some(s) => Some(s.clone()),
         None => {
-            let mut spec = RunSpec::new(params.clone(), WARMUP + options.recorded_periods);
+            let periods = WARMUP + options.recorded_periods;
+            if classify_cost(n, periods) > MAX_CLASSIFY_WORK && !budget.allow_large {
+                report.motion = Motion::Undetermined;
+                report.lyapunov_skipped = Some(LyapunovSkipped::Costly {
+                    dimension: 2 * n,
+                    periods,
+                });
+                return report;
+            }
+            let mut spec = RunSpec::new(params.clone(), periods);
             spec.initial = window.final_state.clone();
             spec.options = sim_options.clone();
             spec.transient_periods = WARMUP;
-            lyapunov_spectrum(&spec, &LyapunovOptions::default(), &mut ())
-                .ok()
-                .and_then(|r| r.spectrum.ok())
+            let run = lyapunov_spectrum(&spec, &LyapunovOptions::default(), &mut Poll(budget)).ok();
+            if run.as_ref().is_some_and(|r| r.outcome.ending == Ending::Stopped) {
+                report.motion = Motion::Undetermined;
+                report.lyapunov_skipped = Some(LyapunovSkipped::Stopped);
+                return report;
+            }
+            run.and_then(|r| r.spectrum.ok())
         }
     };
     report.curve_ratio = section_curve_ratio(params, window);

@@ -280,6 +280,7 @@ pub fn run_point(
                     },
                     None,
                     spectrum,
+                    &crate::excitation::WorkBudget::default(),
                 ));
                 no_period_while_settling(&mut r);
             }
@@ -334,6 +335,7 @@ pub fn run_point(
                 },
                 Some(&settled),
                 spectrum,
+                &crate::excitation::WorkBudget::default(),
             ));
             no_period_while_settling(&mut r);
         }

@@ -8,6 +8,7 @@ use super::point::PointOptions;
 use super::settings::RunSpec;
 use super::settle::Settled;
 use crate::analysis::{AnalysisError, StroboscopicOptions, StroboscopicSection, detect_period};
+use crate::excitation::WorkBudget;
 use crate::model::ChainState;
 
 /// Watches a run's stroboscopic samples after its transient (attach [`observer`](Self::observer)
@@ -57,12 +58,26 @@ impl RunMotion {
     }
 
     /// The motion of a run of `spec` that ended in `final_state`, after the settling
-    /// `settled` (if the run was settled first).
+    /// `settled` (if the run was settled first); a Lyapunov run it needs is made within the
+    /// default budget ([`MAX_CLASSIFY_WORK`](super::MAX_CLASSIFY_WORK), never stopped).
     pub fn finish(
         &self,
         spec: &RunSpec,
         final_state: &ChainState,
         settled: Option<&Settled>,
+    ) -> MotionReport {
+        self.finish_within(spec, final_state, settled, &WorkBudget::default())
+    }
+
+    /// [`finish`](Self::finish) within `budget`: a costlier Lyapunov run is made only if it
+    /// allows large jobs, and stops when its flag is set
+    /// ([`MotionReport::lyapunov_skipped`](super::MotionReport::lyapunov_skipped) says which).
+    pub fn finish_within(
+        &self,
+        spec: &RunSpec,
+        final_state: &ChainState,
+        settled: Option<&Settled>,
+        budget: &WorkBudget,
     ) -> MotionReport {
         let strobe = &self.strobe.inner;
         let n = spec.chain.len();
@@ -86,6 +101,7 @@ impl RunMotion {
             },
             settled,
             None,
+            budget,
         )
     }
 }
