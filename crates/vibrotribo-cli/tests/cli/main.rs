@@ -17,6 +17,7 @@ mod lyapunov;
 mod map_one_parameter_twice;
 mod optimize;
 mod periodic_orbits;
+mod plot_dir_draws_every_kind;
 mod plot_skips_empty_figures;
 mod resume_checks_files;
 mod serve;
