@@ -168,3 +168,42 @@ fn plot_draws_an_optimisation() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(std::fs::read(run.join("convergence.png")).unwrap() == before);
 }
+
+#[cfg(unix)]
+/// `optimize-mass-ratio` stopped by Ctrl-C said "nothing was written" beside a written
+/// `power_grid.csv`; it names the file and what it holds.
+#[test]
+fn interrupted_optimal_mass_ratio_names_the_grid_it_kept() {
+    let tmp = tempdir();
+    let out = tmp.path().join("rmo");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_vibrotribo"))
+        .args(["optimize-mass-ratio", "-q", "--omega-steps", "40", "--rm-steps", "100", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("cannot run vibrotribo");
+    // Stop it once the grid file holds a row.
+    let grid = out.join("power_grid.csv");
+    let rows = || {
+        std::fs::read_to_string(&grid)
+            .map(|t| t.lines().count())
+            .unwrap_or(0)
+    };
+    while rows() < 2 {
+        if child.try_wait().expect("waits").is_some() {
+            panic!("the run ended before it was stopped");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    let o = child.wait_with_output().expect("waits");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(!err.contains("nothing was written"), "{err}");
+    assert!(err.contains("power_grid.csv holds the"), "{err}");
+    assert!(rows() >= 2);
+}
