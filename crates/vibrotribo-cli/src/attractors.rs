@@ -15,9 +15,7 @@ use vibrotribo::sweep::grid;
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
 use crate::job::{RunArgs, check_all, check_distinct, set_threads};
-use crate::manifest::{
-    AttractorTolerances, AttractorsManifest, Kind, StartBoxRecord, read, to_value,
-};
+use crate::manifest::{AttractorTolerances, AttractorsManifest, Kind, StartBoxRecord, read, to_value};
 use crate::output::{CsvFile, check_out_dir, create_dir, csv_text, numbered, read_csv, si, write_json};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};

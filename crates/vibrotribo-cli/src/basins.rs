@@ -19,9 +19,7 @@ use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::job::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
 use crate::limits;
-use crate::manifest::{
-    Axis, BasinTolerances, BasinsManifest, Kind, SectionScaleRecord, ShardRecord, read,
-};
+use crate::manifest::{Axis, BasinTolerances, BasinsManifest, Kind, SectionScaleRecord, ShardRecord, read};
 use crate::output::{CsvFile, csv_text, numbered, read_csv, si};
 use crate::plot::{self, CategoryMap, Figure};
 use crate::progress::Interrupted;
@@ -407,7 +405,14 @@ fn names(c: &Classification) -> Vec<String> {
 
 /// Reads the fingerprints of a complete basins directory and the settings that classify
 /// them.
-fn read_job(dir: &Path) -> Result<(BasinsManifest, Vec<Option<Fingerprint>>, SectionScale, AttractorOptions)> {
+fn read_job(
+    dir: &Path,
+) -> Result<(
+    BasinsManifest,
+    Vec<Option<Fingerprint>>,
+    SectionScale,
+    AttractorOptions,
+)> {
     let m: BasinsManifest = read(&dir.join("basins.json"))?;
     if !m.complete {
         bail!(
@@ -522,10 +527,7 @@ pub fn plot_basins(dir: &Path) -> Result<()> {
         missing: "no run (e.g. overlapping masses)",
     };
     let fig = Figure::new(
-        format!(
-            "Basins of attraction ({} transient periods)",
-            m.transient_periods
-        ),
+        format!("Basins of attraction ({} transient periods)", m.transient_periods),
         m.x.param.clone(),
         m.y.param.clone(),
     );

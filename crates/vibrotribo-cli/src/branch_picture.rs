@@ -93,7 +93,10 @@ impl Drawing {
     /// `continue.json` (`m`).
     pub fn read(dir: &Path, m: &ContinueManifest) -> Result<Self> {
         let (h, rows) = read_csv(&dir.join("branch.csv"))?;
-        let masses = h.iter().filter(|c| c.starts_with('x') && c.ends_with("_m")).count();
+        let masses = h
+            .iter()
+            .filter(|c| c.starts_with('x') && c.ends_with("_m"))
+            .count();
         let (cb, cp, cs) = (column(&h, "branch")?, column(&h, "param")?, column(&h, "stable")?);
         let xs: Vec<usize> = (1..=masses)
             .map(|i| column(&h, &format!("x{i}_m")))
@@ -130,7 +133,10 @@ impl Drawing {
         }
         for f in &m.bifurcations {
             let Some(branch) = branches.get_mut(f.branch) else {
-                bail!("continue.json: bifurcation on branch {}, which it does not list", f.branch);
+                bail!(
+                    "continue.json: bifurcation on branch {}, which it does not list",
+                    f.branch
+                );
             };
             if f.state.len() != 2 * masses {
                 bail!(
@@ -154,7 +160,12 @@ impl Drawing {
 
 /// The default brute-force diagram of `continue --plot` (the mass shown, 1-based: `None` for
 /// the default; values of the diagram).
-pub fn diagram_of<'a>(m: &'a ContinueManifest, masses: usize, mass: Option<usize>, steps: usize) -> Result<Diagram<'a>> {
+pub fn diagram_of<'a>(
+    m: &'a ContinueManifest,
+    masses: usize,
+    mass: Option<usize>,
+    steps: usize,
+) -> Result<Diagram<'a>> {
     let mass = mass.unwrap_or(if masses > 1 { 2 } else { 1 });
     if mass == 0 || mass > masses {
         bail!("the mass shown must be between 1 and {masses}");
@@ -346,7 +357,6 @@ pub fn draw(
     })
 }
 
-
 /// The upper corner of the data's box with fewer points in its top-left or top-right third
 /// (where the legend hides the least).
 fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Legend {
@@ -380,4 +390,3 @@ fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Leg
         Legend::UpperRight
     }
 }
-

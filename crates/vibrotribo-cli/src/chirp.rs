@@ -285,7 +285,12 @@ fn run_record(r: &ChirpRun) -> ChirpRunRecord {
 }
 
 /// `chirp.json`: the settings, per direction the run and its jump, the hysteresis.
-fn manifest(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], elapsed: f64) -> Result<ChirpManifest> {
+fn manifest(
+    config: &Config,
+    options: &ChirpOptions,
+    runs: &[ChirpRun],
+    elapsed: f64,
+) -> Result<ChirpManifest> {
     let chain = config.chain();
     let hz = chain.omega() / chain.omega_ratio() / std::f64::consts::TAU;
     let find = |d: Direction| runs.iter().find(|r| r.direction == d);

@@ -6,15 +6,15 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
+use vibrotribo::ChainParams;
 use vibrotribo::branch::{BranchOptions, config_family, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
     Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
 };
-use vibrotribo::ChainParams;
 
-use crate::config::ConfigArgs;
 use crate::branch_picture::Drawing;
+use crate::config::ConfigArgs;
 use crate::manifest::{
     BifurcationRecord, BranchRecord, CascadeRecord, ContinueManifest, Kind, ParentRecord, to_value,
 };
@@ -366,7 +366,9 @@ fn write_files(
         .iter()
         .map(|b| BranchRecord {
             period: b.period,
-            parent: b.parent.map(|(branch, bifurcation)| ParentRecord { branch, bifurcation }),
+            parent: b
+                .parent
+                .map(|(branch, bifurcation)| ParentRecord { branch, bifurcation }),
             points: b.points.len(),
             end: end_text(&b.end),
         })

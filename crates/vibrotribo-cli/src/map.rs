@@ -18,8 +18,8 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{
-    Axis, FitManifest, FitRecord, Kind, MapManifest, PaperFitRecord, SettleRecord, ShardRecord, base_motion_of, read,
-    to_value,
+    Axis, FitManifest, FitRecord, Kind, MapManifest, PaperFitRecord, SettleRecord, ShardRecord,
+    base_motion_of, read, to_value,
 };
 use crate::output::{CsvFile, check_out_dir, column, create_dir, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Series};

@@ -148,7 +148,11 @@ fn print_orbit(orbit: &PeriodicOrbit, power: Option<&ElectricalOutcome>) {
     }
 }
 
-fn manifest(config: &Config, orbit: &PeriodicOrbit, power: Option<&ElectricalOutcome>) -> Result<PeriodicManifest> {
+fn manifest(
+    config: &Config,
+    orbit: &PeriodicOrbit,
+    power: Option<&ElectricalOutcome>,
+) -> Result<PeriodicManifest> {
     let mut state = orbit.state.positions.clone();
     state.extend(&orbit.state.velocities);
     let per = orbit.impacts_per_period();
@@ -177,7 +181,11 @@ fn manifest(config: &Config, orbit: &PeriodicOrbit, power: Option<&ElectricalOut
         unstable_dimension: orbit.unstable_dimension(),
         impacts_per_period: per.iter().sum::<f64>(),
         impacts_per_period_by_contact: per,
-        impacts_per_orbit: orbit.events.iter().filter(|e| e.kind == EventKind::Impact).count(),
+        impacts_per_orbit: orbit
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::Impact)
+            .count(),
         min_closing_speed_m_s: orbit.min_closing_speed().map(|m| m.1),
         min_closing_speed_contact: orbit.min_closing_speed().map(|m| m.0 + 1),
         sticks: orbit.sticks(),

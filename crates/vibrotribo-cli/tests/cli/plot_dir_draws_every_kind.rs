@@ -43,7 +43,11 @@ fn plot_equals_the_commands_plot(kind: &str, args: &[&str]) {
     }
     let o = vibrotribo(&["plot", copy.to_str().unwrap()]);
     assert!(o.status.success(), "plot of a {kind} directory: {}", stderr(&o));
-    assert_eq!(pictures(&copy), drawn, "{kind}: the pictures of plot and of --plot");
+    assert_eq!(
+        pictures(&copy),
+        drawn,
+        "{kind}: the pictures of plot and of --plot"
+    );
     for name in drawn.iter().filter(|n| n.ends_with(".png")) {
         let (a, b) = (
             std::fs::read(run.join(name)).unwrap(),
@@ -127,13 +131,36 @@ fn plot_draws_the_other_kinds() {
     );
     plot_equals_the_commands_plot(
         "lyapunov",
-        &["lyapunov", "-q", "--periods", "20", "--transient", "10", "--batches", "4"],
+        &[
+            "lyapunov",
+            "-q",
+            "--periods",
+            "20",
+            "--transient",
+            "10",
+            "--batches",
+            "4",
+        ],
     );
     plot_equals_the_commands_plot(
         "attractors",
         &[
-            "attractors", "-q", "--param", "omega_ratio", "--from", "0.7", "--to", "0.8", "--steps", "2",
-            "--samples", "3", "--transient", "20", "--recorded", "10",
+            "attractors",
+            "-q",
+            "--param",
+            "omega_ratio",
+            "--from",
+            "0.7",
+            "--to",
+            "0.8",
+            "--steps",
+            "2",
+            "--samples",
+            "3",
+            "--transient",
+            "20",
+            "--recorded",
+            "10",
         ],
     );
 }
@@ -177,7 +204,15 @@ fn interrupted_optimal_mass_ratio_names_the_grid_it_kept() {
     let tmp = tempdir();
     let out = tmp.path().join("rmo");
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_vibrotribo"))
-        .args(["optimize-mass-ratio", "-q", "--omega-steps", "40", "--rm-steps", "100", "--out"])
+        .args([
+            "optimize-mass-ratio",
+            "-q",
+            "--omega-steps",
+            "40",
+            "--rm-steps",
+            "100",
+            "--out",
+        ])
         .arg(&out)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
