@@ -187,7 +187,7 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
                 Series::new("impacts per period", &sp, &ipp),
                 Series::new("period", &sp, &period),
             ],
-            4,
+            7,
         )
     })
 }
