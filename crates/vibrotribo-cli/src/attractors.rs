@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
-use serde_json::json;
 use vibrotribo::attractors::{
     AcrossDelivery, AttractorOptions, RandomStarts, StartBox, StartRunner, ValueAttractors, attractors_across,
 };
@@ -16,9 +15,8 @@ use vibrotribo::sweep::grid;
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
 use crate::job::{RunArgs, check_all, check_distinct, set_threads};
-use crate::output::{
-    CsvFile, check_out_dir, create_dir, csv_text, numbered, read_csv, read_json, si, write_json,
-};
+use crate::manifest::{AttractorTolerances, AttractorsManifest, Kind, StartBoxRecord, read, to_value};
+use crate::output::{CsvFile, check_out_dir, create_dir, csv_text, numbered, read_csv, si, write_json};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};
 
@@ -135,31 +133,36 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
     let masses = chain.len();
     let o = starts.point_runner().options();
     crate::job::check_recorded(o)?;
-    let settings = json!({
-        "command": "attractors",
-        "param": args.param,
-        "from": args.from,
-        "to": args.to,
-        "steps": args.steps,
-        "values": values,
-        "samples": args.samples,
-        "seed": args.seed,
-        "start_box": bounds.map(|b| json!({"positions_m": b.positions, "velocities_m_s": b.velocities})),
-        "transient_periods": o.transient_periods,
-        "recorded_periods": o.recorded_periods,
-        "attractor_options": {
-            "period_tolerance": options.period_tolerance,
-            "match_tolerance": options.match_tolerance,
-            "cell": options.cell,
-            "continuation_distance": options.continuation_distance,
+    let manifest = AttractorsManifest {
+        command: Kind::Attractors,
+        param: args.param.clone(),
+        from: args.from,
+        to: args.to,
+        steps: args.steps,
+        values: values.clone(),
+        samples: args.samples,
+        seed: args.seed,
+        start_box: bounds.map(|b| StartBoxRecord {
+            positions_m: b.positions,
+            velocities_m_s: b.velocities,
+        }),
+        transient_periods: o.transient_periods,
+        recorded_periods: o.recorded_periods,
+        attractor_options: AttractorTolerances {
+            period_tolerance: options.period_tolerance,
+            match_tolerance: options.match_tolerance,
+            cell: options.cell,
+            continuation_distance: options.continuation_distance,
         },
-        "mechanics_only": starts.point_runner().mechanics_only(),
-        "settings": starts.point_runner().base().table(),
-        "vibrotribo_version": env!("CARGO_PKG_VERSION"),
-    });
+        mechanics_only: starts.point_runner().mechanics_only(),
+        settings: serde_json::to_value(starts.point_runner().base().table())?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        complete: false,
+        done: 0,
+    };
     let mut files = match &args.out {
         Some(dir) => {
-            let ours = with_progress(&settings, false, 0);
+            let ours = to_value(&manifest)?;
             check_out_dir(dir, "attractors.json", args.run.force, |old| {
                 with_progress(old, false, 0) == ours
             })?;
@@ -236,7 +239,11 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
         e.flush()?;
         write_json(
             &dir.join("attractors.json"),
-            &with_progress(&settings, complete, finished),
+            &to_value(&AttractorsManifest {
+                complete,
+                done: finished,
+                ..manifest
+            })?,
         )?;
         if complete && args.plot {
             plot_attractors(dir)?;
@@ -258,10 +265,11 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
     Ok(())
 }
 
-fn with_progress(settings: &serde_json::Value, complete: bool, done: usize) -> serde_json::Value {
-    let mut m = settings.clone();
-    m["complete"] = json!(complete);
-    m["done"] = json!(done);
+/// The manifest `m` as a fresh job's: incomplete, nothing done.
+fn with_progress(m: &serde_json::Value, complete: bool, done: usize) -> serde_json::Value {
+    let mut m = m.clone();
+    m["complete"] = serde_json::Value::from(complete);
+    m["done"] = serde_json::Value::from(done);
     m
 }
 
@@ -332,11 +340,9 @@ fn print_value(v: &ValueAttractors, param: &str) {
 
 /// Draws the fractions (stacked bands) and powers of an `attractors` directory.
 pub fn plot_attractors(dir: &Path) -> Result<()> {
-    let m = read_json(&dir.join("attractors.json"))?;
-    let param = m["param"].as_str().unwrap_or("parameter").to_string();
-    let values: Vec<f64> = serde_json::from_value(m["values"].clone()).context("attractors.json: values")?;
-    let done = m["done"].as_u64().unwrap_or(values.len() as u64) as usize;
-    let values = &values[..done.min(values.len())];
+    let m: AttractorsManifest = read(&dir.join("attractors.json"))?;
+    let param = m.param.clone();
+    let values = &m.values[..m.done.min(m.values.len())];
     let (h, rows) = read_csv(&dir.join("attractors.csv"))?;
     let col = |name: &str| crate::output::column(&h, name);
     let (cp, ca, cf, cw) = (
@@ -373,7 +379,7 @@ pub fn plot_attractors(dir: &Path) -> Result<()> {
     let fig = Figure::new(
         format!(
             "Basin fractions of the attractors ({} random starts per value)",
-            m["samples"]
+            m.samples
         ),
         param.clone(),
         "basin fraction",

@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
-use serde_json::{Value, json};
+use serde::Deserialize;
+use serde_json::Value;
 use vibrotribo::attractors::{
     AttractorOptions, Classification, Fingerprint, SectionScale, StartRunner, classify,
 };
@@ -18,7 +19,8 @@ use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::job::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
 use crate::limits;
-use crate::output::{CsvFile, csv_text, numbered, read_csv, read_json, si};
+use crate::manifest::{Axis, BasinTolerances, BasinsManifest, Kind, SectionScaleRecord, ShardRecord, read};
+use crate::output::{CsvFile, csv_text, numbered, read_csv, si};
 use crate::plot::{self, CategoryMap, Figure};
 use crate::progress::Interrupted;
 
@@ -246,24 +248,44 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     let scale = SectionScale::of(starts.point_runner().base().chain());
     let o = starts.point_runner().options();
     crate::job::check_recorded(o)?;
-    let settings = json!({
-        "command": "basins",
-        "x": {"param": args.x, "from": args.x_from, "to": args.x_to, "steps": nx, "values": xs},
-        "y": {"param": args.y, "from": args.y_from, "to": args.y_to, "steps": ny, "values": ys},
-        "transient_periods": o.transient_periods,
-        "recorded_periods": o.recorded_periods,
-        "max_period_detected": o.period_options().max_period,
-        "attractor_options": {
-            "period_tolerance": options.period_tolerance,
-            "match_tolerance": options.match_tolerance,
-            "cell": options.cell,
+    let settings = crate::manifest::to_value(&BasinsManifest {
+        command: Kind::Basins,
+        x: Axis {
+            param: args.x.clone(),
+            from: args.x_from,
+            to: args.x_to,
+            steps: nx,
+            values: xs.clone(),
         },
-        "section_scale": {"masses": masses, "length_m": scale.length, "speed_m_s": scale.speed},
-        "mechanics_only": starts.point_runner().mechanics_only(),
-        "shard": args.shard.map(|s| json!({"index": s.index, "count": s.count})),
-        "settings": starts.point_runner().base().table(),
-        "vibrotribo_version": env!("CARGO_PKG_VERSION"),
-    });
+        y: Axis {
+            param: args.y.clone(),
+            from: args.y_from,
+            to: args.y_to,
+            steps: ny,
+            values: ys.clone(),
+        },
+        transient_periods: o.transient_periods,
+        recorded_periods: o.recorded_periods,
+        max_period_detected: o.period_options().max_period,
+        attractor_options: BasinTolerances {
+            period_tolerance: options.period_tolerance,
+            match_tolerance: options.match_tolerance,
+            cell: options.cell,
+        },
+        section_scale: SectionScaleRecord {
+            masses,
+            length_m: scale.length,
+            speed_m_s: scale.speed,
+        },
+        mechanics_only: starts.point_runner().mechanics_only(),
+        shard: args.shard.map(|s| ShardRecord {
+            index: s.index,
+            count: s.count,
+        }),
+        settings: serde_json::to_value(starts.point_runner().base().table())?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        complete: false,
+    })?;
     let keys: Vec<String> = points.iter().map(key_of).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -384,9 +406,16 @@ fn names(c: &Classification) -> Vec<String> {
 
 /// Reads the fingerprints of a complete basins directory and the settings that classify
 /// them.
-fn read_job(dir: &Path) -> Result<(Value, Vec<Option<Fingerprint>>, SectionScale, AttractorOptions)> {
-    let m = read_json(&dir.join("basins.json"))?;
-    if m["complete"] != json!(true) {
+fn read_job(
+    dir: &Path,
+) -> Result<(
+    BasinsManifest,
+    Vec<Option<Fingerprint>>,
+    SectionScale,
+    AttractorOptions,
+)> {
+    let m: BasinsManifest = read(&dir.join("basins.json"))?;
+    if !m.complete {
         bail!(
             "{} is incomplete: finish it with --resume (or merge its shards) first",
             dir.display()
@@ -394,27 +423,17 @@ fn read_job(dir: &Path) -> Result<(Value, Vec<Option<Fingerprint>>, SectionScale
     }
     let (_, rows) = read_csv(&dir.join("starts.csv"))?;
     let fingerprints = rows.iter().map(|r| parse_row(r)).collect::<Result<Vec<_>>>()?;
-    let s = &m["section_scale"];
+    let s = &m.section_scale;
     let scale = SectionScale {
-        masses: s["masses"]
-            .as_u64()
-            .context("basins.json: section_scale.masses")? as usize,
-        length: s["length_m"]
-            .as_f64()
-            .context("basins.json: section_scale.length_m")?,
-        speed: s["speed_m_s"]
-            .as_f64()
-            .context("basins.json: section_scale.speed_m_s")?,
+        masses: s.masses,
+        length: s.length_m,
+        speed: s.speed_m_s,
     };
-    let a = &m["attractor_options"];
+    let a = &m.attractor_options;
     let options = AttractorOptions {
-        period_tolerance: a["period_tolerance"]
-            .as_f64()
-            .context("basins.json: period_tolerance")?,
-        match_tolerance: a["match_tolerance"]
-            .as_f64()
-            .context("basins.json: match_tolerance")?,
-        cell: a["cell"].as_f64().context("basins.json: cell")?,
+        period_tolerance: a.period_tolerance,
+        match_tolerance: a.match_tolerance,
+        cell: a.cell,
         ..AttractorOptions::default()
     };
     Ok((m, fingerprints, scale, options))
@@ -490,10 +509,10 @@ pub fn finish(dir: &Path) -> Result<Classification> {
 pub fn plot_basins(dir: &Path) -> Result<()> {
     let (m, fingerprints, scale, options) = read_job(dir)?;
     let c = classify(&fingerprints, &scale, &options);
-    let axis = |a: &str| -> Result<Vec<f64>> {
-        serde_json::from_value(m[a]["values"].clone()).with_context(|| format!("basins.json: {a} values"))
-    };
-    let (xs, ys) = (axis("x")?, axis("y")?);
+    let (xs, ys) = (&m.x.values, &m.y.values);
+    if xs.is_empty() || ys.is_empty() {
+        bail!("{}: basins.json has an empty axis", dir.display());
+    }
     let mut names = names(&c);
     for (a, name) in names.iter_mut().enumerate() {
         let (f, _) = c.fraction(a);
@@ -508,14 +527,10 @@ pub fn plot_basins(dir: &Path) -> Result<()> {
         names: &names,
         missing: "no run (e.g. overlapping masses)",
     };
-    let label = |a: &str| m[a]["param"].as_str().unwrap_or(a).to_string();
     let fig = Figure::new(
-        format!(
-            "Basins of attraction ({} transient periods)",
-            m["transient_periods"]
-        ),
-        label("x"),
-        label("y"),
+        format!("Basins of attraction ({} transient periods)", m.transient_periods),
+        m.x.param.clone(),
+        m.y.param.clone(),
     );
     crate::plot::both(dir, "basins", |path| plot::category_map(path, &fig, &map))
 }
@@ -523,10 +538,8 @@ pub fn plot_basins(dir: &Path) -> Result<()> {
 /// Merges the shards of a basins job (`vibrotribo merge`) and classifies the result.
 pub fn merge(args: &MergeArgs) -> Result<()> {
     let keys = |m: &Value| -> Result<Vec<String>> {
-        let axis = |a: &str| -> Result<Vec<f64>> {
-            serde_json::from_value(m[a]["values"].clone()).with_context(|| format!("basins.json: {a} values"))
-        };
-        Ok(points_of(&axis("x")?, &axis("y")?).iter().map(key_of).collect())
+        let m = BasinsManifest::deserialize(m).context("basins.json")?;
+        Ok(points_of(&m.x.values, &m.y.values).iter().map(key_of).collect())
     };
     crate::job::merge(&args.shards, &args.out, &layout(), keys)?;
     let classes = finish(&args.out)?;

@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use serde_json::json;
 use vibrotribo::config::Config;
 use vibrotribo::excitation::Sweep;
 use vibrotribo::study::{
@@ -16,7 +15,8 @@ use vibrotribo::study::{
 };
 
 use crate::config::ConfigArgs;
-use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, read_json, write_json};
+use crate::manifest::{ChirpManifest, ChirpRunRecord, HysteresisRecord, JumpRecord, Kind, read, to_value};
+use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
 use crate::progress::{Interrupted, Progress, Watch};
 
@@ -143,7 +143,7 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         write_response(dir, &config, &runs, args.mechanics_only)?;
         write_json(
             &dir.join("chirp.json"),
-            &manifest(&config, &options, &runs, elapsed),
+            &to_value(&manifest(&config, &options, &runs, elapsed)?)?,
         )?;
         println!("  wrote {0}/response.csv, {0}/chirp.json", dir.display());
         if args.plot {
@@ -262,65 +262,74 @@ fn write_response(dir: &Path, config: &Config, runs: &[ChirpRun], mechanics_only
     f.flush()
 }
 
-fn run_json(r: &ChirpRun) -> serde_json::Value {
-    json!({
-        "f_start_hz": r.chirp.f_start_hz,
-        "f_end_hz_requested": r.chirp.frequency_hz(r.duration_s),
-        "run_duration_s": r.chirp.duration,
-        "periods": r.outcome.periods,
-        "cycles": r.cycles.len(),
-        "impacts": r.cycles.iter().map(|c| c.impacts).sum::<u64>(),
-        "complete": r.outcome.ending == Ending::Completed,
-        "failure": r.outcome.failure().map(|e| e.to_string()),
-        "jump": r.jump.as_ref().map(|j| json!({
-            "omega_ratio": j.omega_ratio,
-            "frequency_hz": r.chirp.frequency_hz(r.cycles[j.index].end_s),
-            "cycle": r.cycles[j.index].cycle,
-            "mass": j.mass + 1,
-            "size_m": j.size_m,
-            "relative": j.relative,
-        })),
-        "base_motion": vibrotribo::report::base_motion_json(&r.config, &r.config.run_spec(true)),
-    })
+fn run_record(r: &ChirpRun) -> ChirpRunRecord {
+    ChirpRunRecord {
+        f_start_hz: r.chirp.f_start_hz,
+        f_end_hz_requested: r.chirp.frequency_hz(r.duration_s),
+        run_duration_s: r.chirp.duration,
+        periods: r.outcome.periods,
+        cycles: r.cycles.len(),
+        impacts: r.cycles.iter().map(|c| c.impacts).sum::<u64>(),
+        complete: r.outcome.ending == Ending::Completed,
+        failure: r.outcome.failure().map(|e| e.to_string()),
+        jump: r.jump.as_ref().map(|j| JumpRecord {
+            omega_ratio: j.omega_ratio,
+            frequency_hz: r.chirp.frequency_hz(r.cycles[j.index].end_s),
+            cycle: r.cycles[j.index].cycle,
+            mass: j.mass + 1,
+            size_m: j.size_m,
+            relative: j.relative,
+        }),
+        base_motion: vibrotribo::report::base_motion_json(&r.config, &r.config.run_spec(true)),
+    }
 }
 
 /// `chirp.json`: the settings, per direction the run and its jump, the hysteresis.
-fn manifest(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], elapsed: f64) -> serde_json::Value {
+fn manifest(
+    config: &Config,
+    options: &ChirpOptions,
+    runs: &[ChirpRun],
+    elapsed: f64,
+) -> Result<ChirpManifest> {
     let chain = config.chain();
     let hz = chain.omega() / chain.omega_ratio() / std::f64::consts::TAU;
     let find = |d: Direction| runs.iter().find(|r| r.direction == d);
     let jump = |d: Direction| find(d).and_then(|r| r.jump.as_ref()).map(|j| j.omega_ratio);
-    json!({
-        "command": "chirp",
-        "from": options.from,
-        "to": options.to,
-        "duration_s": options.duration_s,
-        "sweep": sweep_name(options.sweep),
-        "amplitude_m": runs.first().map(|r| r.chirp.amplitude),
-        "mechanics_only": options.mechanics_only,
-        "start": if options.settled_start { "settled" } else { "initial_state" },
-        "samples_per_cycle": options.samples_per_cycle,
-        "natural_frequency_hz": hz,
-        "sweep_rate_omega_per_s": (options.to - options.from) / options.duration_s,
-        "jump_window_cycles": options.jump_window,
-        "jump_criterion": "the cycle boundary where the median amplitude of the jump_window cycles after it differs most from that of the jump_window cycles before it, for any mass, relative to that mass's largest amplitude in the chirp; omega_ratio at that boundary",
-        "up": find(Direction::Up).map(run_json),
-        "down": find(Direction::Down).map(run_json),
-        "hysteresis": match (jump(Direction::Up), jump(Direction::Down)) {
-            (Some(u), Some(d)) => json!({"up_jump_omega_ratio": u, "down_jump_omega_ratio": d, "width": u - d}),
-            _ => serde_json::Value::Null,
+    Ok(ChirpManifest {
+        command: Kind::Chirp,
+        from: options.from,
+        to: options.to,
+        duration_s: options.duration_s,
+        sweep: sweep_name(options.sweep).to_string(),
+        amplitude_m: runs.first().map(|r| r.chirp.amplitude),
+        mechanics_only: options.mechanics_only,
+        start: if options.settled_start { "settled" } else { "initial_state" }.to_string(),
+        samples_per_cycle: options.samples_per_cycle,
+        natural_frequency_hz: hz,
+        sweep_rate_omega_per_s: (options.to - options.from) / options.duration_s,
+        jump_window_cycles: options.jump_window,
+        jump_criterion: "the cycle boundary where the median amplitude of the jump_window cycles after it differs most from that of the jump_window cycles before it, for any mass, relative to that mass's largest amplitude in the chirp; omega_ratio at that boundary".to_string(),
+        up: find(Direction::Up).map(run_record),
+        down: find(Direction::Down).map(run_record),
+        hysteresis: match (jump(Direction::Up), jump(Direction::Down)) {
+            (Some(u), Some(d)) => Some(HysteresisRecord {
+                up_jump_omega_ratio: u,
+                down_jump_omega_ratio: d,
+                width: u - d,
+            }),
+            _ => None,
         },
-        "complete": runs.len() == 2 && runs.iter().all(|r| r.outcome.ending == Ending::Completed),
-        "wall_time_s": elapsed,
-        "settings": config.table(),
-        "vibrotribo_version": env!("CARGO_PKG_VERSION"),
+        complete: runs.len() == 2 && runs.iter().all(|r| r.outcome.ending == Ending::Completed),
+        wall_time_s: elapsed,
+        settings: serde_json::to_value(config.table())?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
     })
 }
 
 /// `response.png`/`.svg`: each mass's amplitude against Ω, up (solid) and down (dashed)
 /// together, from `response.csv`.
 pub fn plot_chirp(dir: &Path) -> Result<()> {
-    let settings = read_json(&dir.join("chirp.json"))?;
+    let m: ChirpManifest = read(&dir.join("chirp.json"))?;
     let (header, rows) = read_csv(&dir.join("response.csv"))?;
     let dir_col = column(&header, "direction")?;
     let omega = column(&header, "omega_ratio")?;
@@ -351,8 +360,8 @@ pub fn plot_chirp(dir: &Path) -> Result<()> {
         ..Figure::new(
             format!(
                 "Chirp response, {} s each way ({})",
-                settings["duration_s"],
-                settings["sweep"].as_str().unwrap_or("linear")
+                serde_json::Value::from(m.duration_s),
+                m.sweep
             ),
             "Ω = ω/√(k1/m1)",
             "amplitude relative to the base (m)",

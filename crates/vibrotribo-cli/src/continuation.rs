@@ -6,19 +6,22 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use serde_json::json;
+use vibrotribo::ChainParams;
 use vibrotribo::branch::{BranchOptions, config_family, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
     Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
 };
-use vibrotribo::study::PointOptions;
-use vibrotribo::sweep::{PointRunner, grid};
-use vibrotribo::{ChainParams, ChainState, Simulator};
 
+use crate::branch_picture::Drawing;
 use crate::config::ConfigArgs;
+use crate::manifest::{
+    BifurcationRecord, BranchRecord, CascadeRecord, ContinueManifest, Kind, ParentRecord, to_value,
+};
 use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
-use crate::plot::{self, Figure, Legend, Series, Shape, both};
+
+/// Values of the brute-force orbit diagram under a continuation's picture, by default.
+pub const DEFAULT_DIAGRAM_STEPS: usize = 200;
 
 /// Options of `vibrotribo continue`.
 #[derive(Debug, clap::Args)]
@@ -58,7 +61,7 @@ pub struct ContinueArgs {
     #[arg(long)]
     pub plot: bool,
     /// Values of the brute-force orbit diagram drawn under the branches with --plot.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = DEFAULT_DIAGRAM_STEPS)]
     pub diagram_steps: usize,
     /// The mass shown in the plot (1-based; default 2, or 1 for a single mass).
     #[arg(long)]
@@ -125,7 +128,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
 }
 
 /// What a bifurcation is, in words, with its detail.
-fn describe(kind: &BifurcationKind) -> (&'static str, String) {
+pub(crate) fn describe(kind: &BifurcationKind) -> (&'static str, String) {
     match kind {
         BifurcationKind::Fold => ("fold", String::new()),
         BifurcationKind::BranchPoint => ("branch_point", String::new()),
@@ -354,89 +357,70 @@ fn write_files(
                     .as_ref()
                     .map_or(String::new(), |a| csv_text(&multipliers_text(a))),
             ])?;
-            listed.push(bifurcation_json(i, f));
+            listed.push(bifurcation_record(i, f));
         }
     }
     bif.flush()?;
-    let branches: Vec<serde_json::Value> = result
+    let branches: Vec<BranchRecord> = result
         .branches
         .iter()
-        .map(|b| {
-            json!({
-                "period": b.period,
-                "parent": b.parent.map(|(p, k)| json!({"branch": p, "bifurcation": k})),
-                "points": b.points.len(),
-                "end": end_text(&b.end),
-            })
+        .map(|b| BranchRecord {
+            period: b.period,
+            parent: b
+                .parent
+                .map(|(branch, bifurcation)| ParentRecord { branch, bifurcation }),
+            points: b.points.len(),
+            end: end_text(&b.end),
         })
         .collect();
-    write_json(
-        &dir.join("continue.json"),
-        &json!({
-            "command": "continue",
-            "param": args.param,
-            "from": args.from,
-            "to": args.to,
-            "transient_periods": args.transient,
-            "doublings": args.doublings,
-            "max_points": args.max_points,
-            "mechanics_only": args.mechanics_only,
-            "branches": branches,
-            "bifurcations": listed,
-            "cascade": cascade_json(result),
-            "settings": config.table(),
-            "vibrotribo_version": env!("CARGO_PKG_VERSION"),
-        }),
-    )
-}
-
-/// The cascade of period doublings from the first branch and its Feigenbaum ratios.
-fn cascade_json(result: &Continuation) -> serde_json::Value {
     let points: Vec<f64> = vibrotribo::orbits::cascade(result)
         .iter()
         .map(|b| b.parameter)
         .collect();
-    json!({
-        "period_doublings": points,
-        "feigenbaum_ratios": vibrotribo::orbits::feigenbaum_ratios(&points),
-    })
-}
-
-fn bifurcation_json(branch: usize, f: &Bifurcation) -> serde_json::Value {
-    let (kind, detail) = describe(&f.kind);
-    json!({
-        "branch": branch,
-        "kind": kind,
-        "detail": detail,
-        "param": f.parameter,
-        "precision": f.precision,
-        "child_branch": f.child,
-        "multipliers": f.point.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-        "crossing": f.crossing.map(|c| c.kind.name()),
-        "nordmark": f.crossing.and_then(|c| c.nordmark).map(|n| n.name()),
-        "multipliers_after": f.after.as_ref().map(|a| a.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
-    })
-}
-
-/// The positions of `mass` at t = kT, k = 0 … period − 1, along the orbit through `state`.
-fn section_positions(
-    chain: &ChainParams,
-    state: &ChainState,
-    period: u32,
-    mass: usize,
-    config: &Config,
-) -> Vec<f64> {
-    let mut out = vec![state.positions[mass]];
-    let Ok(mut sim) = Simulator::new(chain, state, config.sim_options().clone()) else {
-        return out;
+    let manifest = ContinueManifest {
+        command: Kind::Continue,
+        param: args.param.clone(),
+        from: args.from,
+        to: args.to,
+        transient_periods: args.transient,
+        doublings: args.doublings,
+        max_points: args.max_points,
+        mechanics_only: args.mechanics_only,
+        branches,
+        bifurcations: listed,
+        cascade: CascadeRecord {
+            feigenbaum_ratios: vibrotribo::orbits::feigenbaum_ratios(&points),
+            period_doublings: points,
+        },
+        settings: serde_json::to_value(config.table())?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
     };
-    for k in 1..period {
-        if sim.run_until(f64::from(k) * chain.period(), &mut ()).is_err() {
-            break;
-        }
-        out.push(sim.state().positions[mass]);
+    write_json(&dir.join("continue.json"), &to_value(&manifest)?)
+}
+
+fn bifurcation_record(branch: usize, f: &Bifurcation) -> BifurcationRecord {
+    let (kind, detail) = describe(&f.kind);
+    let pairs = |p: &BranchPoint| p.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>();
+    BifurcationRecord {
+        branch,
+        kind: kind.to_string(),
+        detail,
+        param: f.parameter,
+        precision: f.precision,
+        child_branch: f.child,
+        multipliers: pairs(&f.point),
+        crossing: f.crossing.map(|c| c.kind.name().to_string()),
+        nordmark: f.crossing.and_then(|c| c.nordmark).map(|n| n.name().to_string()),
+        multipliers_after: f.after.as_ref().map(pairs),
+        state: f
+            .point
+            .state
+            .positions
+            .iter()
+            .chain(&f.point.state.velocities)
+            .copied()
+            .collect(),
     }
-    out
 }
 
 /// The brute-force orbit diagram under a picture of branches.
@@ -463,166 +447,5 @@ pub fn plot_branches(
     result: &Continuation,
     family: &impl Fn(f64) -> ChainParams,
 ) -> Result<()> {
-    let mass = diagram.mass;
-    let (lo, hi) = diagram.range;
-    // Brute force: every value from the configured initial state, mechanics only.
-    let options = PointOptions {
-        transient_periods: diagram.transient,
-        recorded_periods: 64,
-        ..PointOptions::default()
-    };
-    let runner = PointRunner::new(config.clone(), options, true);
-    let values = grid(lo, hi, diagram.steps.max(2));
-    let mut dx = Vec::new();
-    let mut dy = Vec::new();
-    let _ = vibrotribo::sweep::run_grid(
-        &runner,
-        &values,
-        |&v| vec![(diagram.param, v)],
-        64,
-        |d| {
-            if let vibrotribo::sweep::Delivery::Point(&v, Ok(p)) = d {
-                for x in p.position_series(mass) {
-                    dx.push(v);
-                    dy.push(x);
-                }
-            }
-            std::ops::ControlFlow::Continue(())
-        },
-    );
-    // Branch curves: one series per run of equal stability and per section point.
-    let mut curves: Vec<(Vec<f64>, Vec<f64>, bool)> = Vec::new();
-    for b in &result.branches {
-        let sections: Vec<Vec<f64>> = b
-            .points
-            .iter()
-            .map(|p| section_positions(&family(p.parameter), &p.state, b.period, mass, config))
-            .collect();
-        for k in 0..b.period as usize {
-            let mut start = 0;
-            while start < b.points.len() {
-                let stable = b.points[start].stable;
-                let mut end = start;
-                while end + 1 < b.points.len() && b.points[end + 1].stable == stable {
-                    end += 1;
-                }
-                // Runs overlap by one point so that the branch is drawn without holes.
-                let stop = (end + 1).min(b.points.len() - 1);
-                let xs: Vec<f64> = (start..=stop).map(|j| b.points[j].parameter).collect();
-                let ys: Vec<f64> = (start..=stop)
-                    .map(|j| sections[j].get(k).copied().unwrap_or(f64::NAN))
-                    .collect();
-                curves.push((xs, ys, stable));
-                start = end + 1;
-            }
-        }
-    }
-    // Bifurcations: a marker per kind on the branch, at each section point of its orbit.
-    let mut marks: Vec<Marks> = Vec::new();
-    for b in &result.branches {
-        for f in &b.bifurcations {
-            let (label, shape, colour) = marker_of(&f.kind);
-            let ys = section_positions(&family(f.parameter), &f.point.state, b.period, mass, config);
-            let at = match marks.iter().position(|m| m.0 == label) {
-                Some(i) => i,
-                None => {
-                    marks.push((label, shape, colour, Vec::new(), Vec::new()));
-                    marks.len() - 1
-                }
-            };
-            for y in ys {
-                marks[at].3.push(f.parameter);
-                marks[at].4.push(y);
-            }
-        }
-    }
-    let mut lines: Vec<Series> = Vec::new();
-    let (mut stable_named, mut unstable_named) = (false, false);
-    for (x, y, stable) in &curves {
-        let named = if *stable {
-            &mut stable_named
-        } else {
-            &mut unstable_named
-        };
-        let s = if *named {
-            Series::unlabelled(x, y)
-        } else {
-            Series::new(if *stable { "stable" } else { "unstable" }, x, y)
-        };
-        *named = true;
-        lines.push(if *stable {
-            s.colour(0)
-        } else {
-            s.colour(3).dashed()
-        });
-    }
-    let mut points = vec![Series::new("brute force", &dx, &dy).colour(7)];
-    points.extend(
-        marks
-            .iter()
-            .map(|(label, shape, colour, x, y)| Series::new(label, x, y).colour(*colour).marker(*shape, 11)),
-    );
-    let mut fig = Figure::new(
-        format!("Periodic orbits in {}", diagram.param),
-        diagram.param,
-        format!("x{} at t = nT [m]", mass + 1),
-    );
-    let all_x = dx.iter().chain(curves.iter().flat_map(|c| c.0.iter()));
-    let all_y = dy.iter().chain(curves.iter().flat_map(|c| c.1.iter()));
-    fig.legend = emptier_upper_corner(all_x.copied().zip(all_y.copied()));
-    both(dir, name, |path| {
-        plot::lines_and_points(path, &fig, &lines, &points, 3)
-    })
-}
-
-/// The upper corner of the data's box with fewer points in its top-left or top-right third
-/// (where the legend hides the least).
-fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Legend {
-    let finite = points.filter(|(x, y)| x.is_finite() && y.is_finite());
-    let bounds = |pick: fn(&(f64, f64)) -> f64| {
-        finite
-            .clone()
-            .map(|p| pick(&p))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            })
-    };
-    let ((x0, x1), (y0, y1)) = (bounds(|p| p.0), bounds(|p| p.1));
-    let top = y1 - (y1 - y0) / 3.0;
-    let count = |left: bool| {
-        finite
-            .clone()
-            .filter(|(x, y)| {
-                *y >= top
-                    && if left {
-                        *x <= x0 + (x1 - x0) / 3.0
-                    } else {
-                        *x >= x1 - (x1 - x0) / 3.0
-                    }
-            })
-            .count()
-    };
-    if count(true) < count(false) {
-        Legend::UpperLeft
-    } else {
-        Legend::UpperRight
-    }
-}
-
-/// The bifurcations of one kind on a picture: legend entry, marker shape, palette colour, and
-/// the points (parameter, section position).
-type Marks = (&'static str, Shape, usize, Vec<f64>, Vec<f64>);
-
-/// The legend entry, marker shape and palette colour of a bifurcation's kind.
-fn marker_of(kind: &BifurcationKind) -> (&'static str, Shape, usize) {
-    match kind {
-        BifurcationKind::Fold => ("fold", Shape::Triangle, 1),
-        BifurcationKind::BranchPoint => ("branch point", Shape::Square, 4),
-        BifurcationKind::PeriodDoubling => ("period doubling", Shape::Circle, 2),
-        BifurcationKind::NeimarkSacker { .. } => ("Neimark–Sacker", Shape::Diamond, 6),
-        BifurcationKind::Grazing { .. } => ("grazing", Shape::Cross, 5),
-        BifurcationKind::Sticking { .. } => ("sticking", Shape::Square, 8),
-        BifurcationKind::SequenceChange => ("sequence change", Shape::Diamond, 9),
-        _ => ("other", Shape::Diamond, 7),
-    }
+    crate::branch_picture::draw(dir, name, config, diagram, &Drawing::of(result), family)
 }

@@ -1,16 +1,16 @@
 //! `vibrotribo load-sweep`: average power against load resistance (on one mechanical run, or a
 //! coupled run per load under two-way coupling), the optimal load, and the V–Q cycle.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Result, bail};
-use serde_json::json;
+use anyhow::{Context, Result, bail};
 use vibrotribo::electrical::{HarvesterParams, Load, log_spaced};
 use vibrotribo::study::{LoadStudyOptions, load_study};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::output::{CsvFile, create_dir, si, write_json};
+use crate::manifest::{LoadSweepManifest, MarginRecord, read, to_value};
+use crate::output::{CsvFile, column, create_dir, read_csv, si, write_json};
 use crate::plot::{self, both};
 use crate::progress::{Interrupted, Progress, Watch};
 
@@ -134,7 +134,6 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
             &dir.join("vq_cycle.csv"),
             &["load_resistance_ohm", "time_s", "q_c", "v_v", "i_a"],
         )?;
-        let mut cycles = Vec::new();
         let mut margins = Vec::new();
         for cycle in &study.vq_cycles {
             let (r, c, margin) = (cycle.load_resistance_ohm, &cycle.samples, cycle.breakdown);
@@ -155,50 +154,29 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
                     String::new()
                 }
             );
-            margins.push(json!({"load_resistance_ohm": r, "air_breakdown": margin}));
-            cycles.push((r, c.charge_c.clone(), c.voltage_v.clone()));
+            margins.push(MarginRecord {
+                load_resistance_ohm: r,
+                air_breakdown: margin,
+            });
         }
         vq.flush()?;
-        let mut manifest = json!({
-                "optimum": best,
-                "optimum_at_edge": sweep.optimum_at_edge,
-                "configured_load_ohm": configured,
-                "configured_average_power_w": p_configured,
-                "power_ratio_configured_to_optimum": p_configured / best.average_power_w,
-                "air_breakdown_last_period": margins,
-                "points": sweep.points,
-                "periods": spec.periods,
-                "transient_periods": spec.transient_periods,
-                "harvester": harvester,
-                "settings": config.table(),
-        });
-        if let Some(b) = vibrotribo::report::base_motion_json(&config, &spec) {
-            manifest["base_motion"] = b;
-        }
-        write_json(&dir.join("load_sweep.json"), &manifest)?;
+        let manifest = LoadSweepManifest {
+            optimum: best,
+            optimum_at_edge: sweep.optimum_at_edge,
+            configured_load_ohm: configured,
+            configured_average_power_w: p_configured,
+            power_ratio_configured_to_optimum: p_configured / best.average_power_w,
+            air_breakdown_last_period: margins,
+            points: sweep.points.clone(),
+            periods: spec.periods,
+            transient_periods: spec.transient_periods,
+            harvester,
+            settings: serde_json::to_value(config.table())?,
+            base_motion: vibrotribo::report::base_motion_json(&config, &spec),
+        };
+        write_json(&dir.join("load_sweep.json"), &to_value(&manifest)?)?;
         if args.plot {
-            let xs: Vec<f64> = sweep.points.iter().map(|p| p.resistance_ohm.log10()).collect();
-            let ys: Vec<f64> = sweep.points.iter().map(|p| p.average_power_w).collect();
-            let mut fig = plot::Figure::new(
-                "Average power against load resistance",
-                "log10(R / Ω)",
-                "average power P_a [W]",
-            );
-            fig.y_scale = plot::Scale::Log;
-            both(dir, "load_sweep", |path| {
-                plot::line_plot(path, &fig, &[plot::Series::new("P_a(R)", &xs, &ys)])
-            })?;
-            let labels: Vec<String> = cycles
-                .iter()
-                .map(|(r, _, _)| format!("R = {}", si(*r, "Ω")))
-                .collect();
-            let series: Vec<plot::Series> = cycles
-                .iter()
-                .zip(&labels)
-                .map(|((_, q, v), l)| plot::Series::new(l, q, v))
-                .collect();
-            let fig = plot::Figure::new("V–Q cycle (last period)", "charge Q [C]", "voltage V [V]");
-            both(dir, "vq_cycle", |path| plot::line_plot(path, &fig, &series))?;
+            plot_load_sweep(dir)?;
         }
         println!(
             "  wrote {0}/load_sweep.csv, {0}/vq_cycle.csv, {0}/load_sweep.json",
@@ -206,4 +184,58 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Draws the power against the load and the V–Q cycles of a `load-sweep` directory
+/// (`load_sweep.png`, `vq_cycle.png` and their `.svg`).
+pub fn plot_load_sweep(dir: &Path) -> Result<()> {
+    let m: LoadSweepManifest = read(&dir.join("load_sweep.json"))?;
+    let xs: Vec<f64> = m.points.iter().map(|p| p.resistance_ohm.log10()).collect();
+    let ys: Vec<f64> = m.points.iter().map(|p| p.average_power_w).collect();
+    let mut fig = plot::Figure::new(
+        "Average power against load resistance",
+        "log10(R / Ω)",
+        "average power P_a [W]",
+    );
+    fig.y_scale = plot::Scale::Log;
+    both(dir, "load_sweep", |path| {
+        plot::line_plot(path, &fig, &[plot::Series::new("P_a(R)", &xs, &ys)])
+    })?;
+    // The cycles of vq_cycle.csv, one per load in the order written.
+    let (h, rows) = read_csv(&dir.join("vq_cycle.csv"))?;
+    let (cr, ct, cq, cv) = (
+        column(&h, "load_resistance_ohm")?,
+        column(&h, "time_s")?,
+        column(&h, "q_c")?,
+        column(&h, "v_v")?,
+    );
+    // A cycle starts where the load changes or the time goes back.
+    let mut cycles: Vec<(f64, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut last_time = f64::INFINITY;
+    for r in &rows {
+        let number = |c: usize| -> Result<f64> {
+            r[c].parse()
+                .with_context(|| format!("vq_cycle.csv: {} is not a number", r[c]))
+        };
+        let (load, time) = (number(cr)?, number(ct)?);
+        if cycles.last().is_none_or(|c| c.0 != load) || time < last_time {
+            cycles.push((load, Vec::new(), Vec::new()));
+        }
+        if let Some(c) = cycles.last_mut() {
+            c.1.push(number(cq)?);
+            c.2.push(number(cv)?);
+        }
+        last_time = time;
+    }
+    let labels: Vec<String> = cycles
+        .iter()
+        .map(|(r, _, _)| format!("R = {}", si(*r, "Ω")))
+        .collect();
+    let series: Vec<plot::Series> = cycles
+        .iter()
+        .zip(&labels)
+        .map(|((_, q, v), l)| plot::Series::new(l, q, v))
+        .collect();
+    let fig = plot::Figure::new("V–Q cycle (last period)", "charge Q [C]", "voltage V [V]");
+    both(dir, "vq_cycle", |path| plot::line_plot(path, &fig, &series))
 }

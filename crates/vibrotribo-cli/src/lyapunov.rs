@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use serde_json::json;
 use vibrotribo::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use vibrotribo::study::{Ending, lyapunov_spectrum};
 
 use crate::config::ConfigArgs;
-use crate::output::{create_dir, read_json, write_json};
+use crate::manifest::{LyapunovManifest, RunningRecord, finite, finite_all, read, to_value};
+use crate::output::{create_dir, write_json};
 use crate::plot::{self, Figure, Legend, Series};
 use crate::progress::{Interrupted, Progress, Watch};
 
@@ -108,7 +108,7 @@ pub fn run(args: &LyapunovArgs) -> Result<()> {
         create_dir(dir)?;
         write_json(
             &dir.join("lyapunov.json"),
-            &spectrum_json(&spectrum, args, interrupted, &config),
+            &to_value(&manifest(&spectrum, args, interrupted, &config)?)?,
         )?;
         if args.plot {
             plot_lyapunov(dir)?;
@@ -134,49 +134,52 @@ pub fn run(args: &LyapunovArgs) -> Result<()> {
 
 /// `lyapunov.json`: exponents (1/s, largest first; `null` for −∞), their spread, the
 /// convergence and the settings.
-fn spectrum_json(
+fn manifest(
     s: &LyapunovSpectrum,
     args: &LyapunovArgs,
     interrupted: bool,
     config: &vibrotribo::config::Config,
-) -> serde_json::Value {
-    json!({
-        "exponents": s.exponents,
-        "spread": s.spread,
-        "periods": s.periods,
-        "time_s": s.time,
-        "largest": s.largest(),
-        "largest_spread": s.largest_spread(),
-        "sum": s.sum(),
-        "kaplan_yorke_dimension": s.kaplan_yorke_dimension(),
-        "collapsed": s.collapsed,
-        "skipped_periods": s.skipped_periods,
-        "non_smooth_count": s.non_smooth_count,
-        "non_smooth": s.non_smooth.iter().map(ToString::to_string).collect::<Vec<_>>(),
-        "reorthonormalisations": s.reorthonormalisations,
-        "batches": s.batches,
-        "running": s.running.iter().map(|(n, e)| json!({"periods": n, "exponents": e})).collect::<Vec<_>>(),
-        "transient_periods": args.transient,
-        "seed": args.seed,
-        "interrupted": interrupted,
-        "settings": config.table(),
+) -> Result<LyapunovManifest> {
+    Ok(LyapunovManifest {
+        exponents: finite_all(&s.exponents),
+        spread: finite_all(&s.spread),
+        periods: s.periods,
+        time_s: s.time,
+        largest: finite(s.largest()),
+        largest_spread: finite(s.largest_spread()),
+        sum: finite(s.sum()),
+        kaplan_yorke_dimension: finite(s.kaplan_yorke_dimension()),
+        collapsed: s.collapsed,
+        skipped_periods: s.skipped_periods,
+        non_smooth_count: s.non_smooth_count,
+        non_smooth: s.non_smooth.iter().map(ToString::to_string).collect(),
+        reorthonormalisations: s.reorthonormalisations,
+        batches: s.batches.iter().map(|b| finite_all(b)).collect(),
+        running: s
+            .running
+            .iter()
+            .map(|(n, e)| RunningRecord {
+                periods: *n,
+                exponents: finite_all(e),
+            })
+            .collect(),
+        transient_periods: args.transient,
+        seed: args.seed,
+        interrupted,
+        settings: serde_json::to_value(config.table())?,
     })
 }
 
 /// Draws the running exponents of a `lyapunov` directory (`lyapunov_running.png`/`.svg`).
 pub fn plot_lyapunov(dir: &Path) -> Result<()> {
-    let j = read_json(&dir.join("lyapunov.json"))?;
-    let running = j["running"].as_array().cloned().unwrap_or_default();
-    let periods: Vec<f64> = running
-        .iter()
-        .map(|r| r["periods"].as_f64().unwrap_or(f64::NAN))
-        .collect();
-    let dim = j["exponents"].as_array().map_or(0, Vec::len);
+    let m: LyapunovManifest = read(&dir.join("lyapunov.json"))?;
+    let periods: Vec<f64> = m.running.iter().map(|r| r.periods as f64).collect();
+    let dim = m.exponents.len();
     let columns: Vec<Vec<f64>> = (0..dim)
         .map(|i| {
-            running
+            m.running
                 .iter()
-                .map(|r| r["exponents"][i].as_f64().unwrap_or(f64::NAN))
+                .map(|r| r.exponents.get(i).copied().flatten().unwrap_or(f64::NAN))
                 .collect()
         })
         .collect();

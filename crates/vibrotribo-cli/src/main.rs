@@ -8,6 +8,7 @@ mod stdout;
 
 mod attractors;
 mod basins;
+mod branch_picture;
 mod chirp;
 mod config;
 mod continuation;

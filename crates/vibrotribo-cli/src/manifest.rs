@@ -15,6 +15,10 @@ use vibrotribo::config::Config;
 use vibrotribo::study::{PointOptions, SettleMode};
 use vibrotribo::sweep::Continuation;
 
+mod commands;
+
+pub use commands::*;
+
 /// What an output directory holds: the command that wrote it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -35,7 +39,27 @@ pub enum Kind {
     Lyapunov,
     /// `vibrotribo simulate` (`summary.json` beside `trajectory.csv`; it names no command).
     Simulate,
+    /// `vibrotribo load-sweep` (`load_sweep.json`, which names no command).
+    #[serde(rename = "load-sweep")]
+    LoadSweep,
+    /// `vibrotribo periodic` (`periodic.json`, which names no command).
+    Periodic,
+    /// `vibrotribo optimize-mass-ratio` (`fit.json` beside `optimum.csv`; it names no command).
+    #[serde(rename = "optimize-mass-ratio")]
+    OptimizeMassRatio,
+    /// `vibrotribo optimize` (`optimize.json`, which names no command).
+    Optimize,
 }
+
+/// The manifests that name no command, by file name, with a data file that must sit beside.
+const NAMED_MANIFESTS: [(&str, &str, Kind); 6] = [
+    ("lyapunov.json", "lyapunov.json", Kind::Lyapunov),
+    ("load_sweep.json", "load_sweep.csv", Kind::LoadSweep),
+    ("periodic.json", "periodic.json", Kind::Periodic),
+    ("fit.json", "optimum.csv", Kind::OptimizeMassRatio),
+    ("optimize.json", "evaluations.jsonl", Kind::Optimize),
+    ("summary.json", "trajectory.csv", Kind::Simulate),
+];
 
 /// The manifests that name their command, by file name.
 const COMMAND_MANIFESTS: [(&str, Kind); 6] = [
@@ -80,13 +104,10 @@ pub fn kind_of(dir: &Path) -> Result<Option<Kind>> {
             ),
         };
     }
-    if dir.join("lyapunov.json").exists() {
-        Ok(Some(Kind::Lyapunov))
-    } else if dir.join("summary.json").exists() && dir.join("trajectory.csv").exists() {
-        Ok(Some(Kind::Simulate))
-    } else {
-        Ok(None)
-    }
+    Ok(NAMED_MANIFESTS
+        .iter()
+        .find(|(file, beside, _)| dir.join(file).exists() && dir.join(beside).exists())
+        .map(|(_, _, kind)| *kind))
 }
 
 fn is_false(b: &bool) -> bool {

@@ -2,12 +2,11 @@
 //! and `vibrotribo optimize-mass-ratio` (the optimal mass ratio R_mo(Ω) and the paper's
 //! quadratic fit of it, seed Fig. 16).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
-use serde_json::json;
 use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
 use vibrotribo::config::Param;
 
@@ -18,8 +17,11 @@ use crate::job::{
     header_len, point_columns, run_points, set_threads,
 };
 use crate::limits;
-use crate::manifest::{Axis, Kind, MapManifest, SettleRecord, ShardRecord, base_motion_of, to_value};
-use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
+use crate::manifest::{
+    Axis, FitManifest, FitRecord, Kind, MapManifest, PaperFitRecord, SettleRecord, ShardRecord,
+    base_motion_of, read, to_value,
+};
+use crate::output::{CsvFile, check_out_dir, column, create_dir, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Series};
 use crate::progress::Interrupted;
 use vibrotribo::sweep::{Cell, PointColumns, grid};
@@ -316,6 +318,28 @@ pub fn paper_fit(w: f64) -> f64 {
     vibrotribo::study::paper_mass_ratio_fit(w)
 }
 
+/// Draws the optima of an `optimize-mass-ratio` directory with their fit and the paper's
+/// (`optimal_mass_ratio.png`/`.svg`), over the Ω range of `power_grid.csv`.
+pub fn plot_optimize_mass_ratio(dir: &Path) -> Result<()> {
+    let m: FitManifest = read(&dir.join("fit.json"))?;
+    let (h, rows) = read_csv(&dir.join("power_grid.csv"))?;
+    let omegas = numbers(&rows, column(&h, "omega_ratio")?);
+    let (Some(&w_from), Some(&w_to)) = (omegas.first(), omegas.last()) else {
+        bail!("{}: power_grid.csv holds no point", dir.display());
+    };
+    // The fit of the optima, as the command made it (the file holds its coefficients only).
+    let fit = fit_quadratic(&m.omega_ratio, &m.optimal_mass_ratio).ok();
+    crate::plot::both(dir, "optimal_mass_ratio", |path| {
+        plot_optimal_mass_ratio(
+            path,
+            &m.omega_ratio,
+            &m.optimal_mass_ratio,
+            fit.as_ref(),
+            (w_from, w_to),
+        )
+    })
+}
+
 /// Draws the optima (`ws`, `rs`), the paper's fit and `fit` over `[w_from, w_to]` to `path`.
 pub fn plot_optimal_mass_ratio(
     path: &std::path::Path,
@@ -514,22 +538,28 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             ])?;
         }
         o.flush()?;
-        write_json(
-            &dir.join("fit.json"),
-            &json!({
-                "fit": fit.as_ref().map(|f| json!({"a": f.a, "b": f.b, "c": f.c, "r_squared": f.r_squared, "rms_residual": f.rms_residual})),
-                "paper_fit": {"a": PAPER_FIT[0], "b": PAPER_FIT[1], "c": PAPER_FIT[2]},
-                "omega_ratio": ws,
-                "optimal_mass_ratio": rs,
-                "transient_periods": runner.options().transient_periods,
-                "recorded_periods": runner.options().recorded_periods,
-                "settings": runner.base().table(),
+        let manifest = FitManifest {
+            fit: fit.as_ref().map(|f| FitRecord {
+                a: f.a,
+                b: f.b,
+                c: f.c,
+                r_squared: f.r_squared,
+                rms_residual: f.rms_residual,
             }),
-        )?;
+            paper_fit: PaperFitRecord {
+                a: PAPER_FIT[0],
+                b: PAPER_FIT[1],
+                c: PAPER_FIT[2],
+            },
+            omega_ratio: ws,
+            optimal_mass_ratio: rs,
+            transient_periods: runner.options().transient_periods,
+            recorded_periods: runner.options().recorded_periods,
+            settings: serde_json::to_value(runner.base().table())?,
+        };
+        write_json(&dir.join("fit.json"), &to_value(&manifest)?)?;
         if args.plot {
-            crate::plot::both(dir, "optimal_mass_ratio", |path| {
-                plot_optimal_mass_ratio(path, &ws, &rs, fit.as_ref(), (args.omega_from, args.omega_to))
-            })?;
+            plot_optimize_mass_ratio(dir)?;
         }
         println!(
             "  wrote {0}/power_grid.csv, {0}/optimum.csv, {0}/fit.json",

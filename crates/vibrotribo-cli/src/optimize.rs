@@ -263,7 +263,7 @@ pub fn run(args: &OptimizeArgs) -> Result<()> {
     anchor_record(&mut table, args.input.config.as_deref())?;
     let toml = toml::to_string(&table).context("cannot write the best design as TOML")?;
     write_atomic(&dir.join("best.toml"), toml.as_bytes())?;
-    plot_convergence(dir, &result.history, objective)?;
+    plot_convergence(dir)?;
     print_result(&problem, &manifest, dir);
     Ok(())
 }
@@ -304,9 +304,29 @@ fn read_cache(path: &Path, cache: &mut Cache) -> Result<()> {
     Ok(())
 }
 
-/// `convergence.png/.svg`: the best feasible objective against the evaluations made.
-fn plot_convergence(dir: &Path, history: &[HistoryPoint], objective: Objective) -> Result<()> {
-    let (x, y): (Vec<f64>, Vec<f64>) = history
+/// What the convergence picture reads of `optimize.json` (the keys of [`Manifest`] it needs).
+#[derive(Debug, Deserialize)]
+struct ConvergenceView {
+    /// The objective's name.
+    objective_name: String,
+    /// The search after each iteration.
+    history: Vec<HistoryView>,
+}
+
+/// Of a [`HistoryPoint`]: the evaluations made and the best feasible objective then.
+#[derive(Debug, Deserialize)]
+struct HistoryView {
+    evaluations: u64,
+    best_objective: Option<f64>,
+}
+
+/// `convergence.png/.svg`: the best feasible objective against the evaluations made, from the
+/// `optimize.json` of `dir`.
+pub fn plot_convergence(dir: &Path) -> Result<()> {
+    let m: ConvergenceView = crate::manifest::read(&dir.join("optimize.json"))?;
+    let objective: Objective = m.objective_name.parse()?;
+    let (x, y): (Vec<f64>, Vec<f64>) = m
+        .history
         .iter()
         .filter_map(|h| Some((h.evaluations as f64, h.best_objective?)))
         .unzip();
@@ -330,7 +350,7 @@ fn plot_convergence(dir: &Path, history: &[HistoryPoint], objective: Objective) 
             &fig,
             &[Series::unlabelled(&x, &y)],
             &[Series::unlabelled(&x, &y)],
-            4,
+            7,
         )
     })
 }

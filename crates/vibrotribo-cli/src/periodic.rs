@@ -5,15 +5,15 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use serde_json::json;
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
     PeriodicOrbit, ShootingOptions, find_periodic_orbit, periodic_orbit_from_transient,
 };
 use vibrotribo::study::ElectricalOutcome;
-use vibrotribo::{EventKind, UniformSampler};
+use vibrotribo::{ChainState, EventKind, Simulator, UniformSampler};
 
 use crate::config::ConfigArgs;
+use crate::manifest::{OrbitEventRecord, PeriodicManifest, config_of, read, to_value};
 use crate::output::{create_dir, numbered, si, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
 
@@ -76,10 +76,10 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
         create_dir(dir)?;
         write_json(
             &dir.join("periodic.json"),
-            &orbit_json(&config, &orbit, power.as_ref()),
+            &to_value(&manifest(&config, &orbit, power.as_ref())?)?,
         )?;
         if args.plot {
-            plot_orbit(dir, &config, &orbit)?;
+            plot_periodic(dir)?;
         }
         println!("  wrote {}/periodic.json", dir.display());
     }
@@ -148,68 +148,86 @@ fn print_orbit(orbit: &PeriodicOrbit, power: Option<&ElectricalOutcome>) {
     }
 }
 
-fn orbit_json(
+fn manifest(
     config: &Config,
     orbit: &PeriodicOrbit,
     power: Option<&ElectricalOutcome>,
-) -> serde_json::Value {
+) -> Result<PeriodicManifest> {
     let mut state = orbit.state.positions.clone();
     state.extend(&orbit.state.velocities);
     let per = orbit.impacts_per_period();
-    let events: Vec<serde_json::Value> = orbit
+    let events = orbit
         .events
         .iter()
-        .map(|e| {
-            json!({
-                "time_s": e.time,
-                "kind": e.kind.as_str(),
-                "contact": e.contact + 1,
-                "rel_velocity_m_s": e.velocity_before,
-                "rel_velocity_after_m_s": e.velocity_after,
-            })
+        .map(|e| OrbitEventRecord {
+            time_s: e.time,
+            kind: e.kind.as_str().to_string(),
+            contact: e.contact + 1,
+            rel_velocity_m_s: e.velocity_before,
+            rel_velocity_after_m_s: e.velocity_after,
         })
         .collect();
     let p = power.and_then(|p| p.power.as_ref());
-    json!({
-        "period": orbit.period,
-        "state": state,
-        "state_names": numbered("x", orbit.params.len(), "_m")
+    Ok(PeriodicManifest {
+        period: orbit.period,
+        state,
+        state_names: numbered("x", orbit.params.len(), "_m")
             .into_iter()
             .chain(numbered("v", orbit.params.len(), "_m_s"))
-            .collect::<Vec<_>>(),
-        "multipliers": orbit.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-        "multiplier_moduli": orbit.multipliers.iter().map(|m| m.norm()).collect::<Vec<_>>(),
-        "stable": orbit.stable,
-        "unstable_dimension": orbit.unstable_dimension(),
-        "impacts_per_period": per.iter().sum::<f64>(),
-        "impacts_per_period_by_contact": per,
-        "impacts_per_orbit": orbit.events.iter().filter(|e| e.kind == EventKind::Impact).count(),
-        "min_closing_speed_m_s": orbit.min_closing_speed().map(|m| m.1),
-        "min_closing_speed_contact": orbit.min_closing_speed().map(|m| m.0 + 1),
-        "sticks": orbit.sticks(),
-        "average_power_w": p.map(|p| p.average_power_w),
-        "energy_per_period_j": p.map(|p| p.energy_per_period_j),
-        "residual": orbit.residual,
-        "residual_history": orbit.residuals,
-        "events": events,
-        "excitation_period_s": orbit.params.period(),
-        "omega_ratio": orbit.params.omega_ratio(),
-        "parameters": orbit.params,
-        "settings": config.table(),
+            .collect(),
+        multipliers: orbit.multipliers.iter().map(|m| [m.re, m.im]).collect(),
+        multiplier_moduli: orbit.multipliers.iter().map(|m| m.norm()).collect(),
+        stable: orbit.stable,
+        unstable_dimension: orbit.unstable_dimension(),
+        impacts_per_period: per.iter().sum::<f64>(),
+        impacts_per_period_by_contact: per,
+        impacts_per_orbit: orbit
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::Impact)
+            .count(),
+        min_closing_speed_m_s: orbit.min_closing_speed().map(|m| m.1),
+        min_closing_speed_contact: orbit.min_closing_speed().map(|m| m.0 + 1),
+        sticks: orbit.sticks(),
+        average_power_w: p.map(|p| p.average_power_w),
+        energy_per_period_j: p.map(|p| p.energy_per_period_j),
+        residual: orbit.residual,
+        residual_history: orbit.residuals.clone(),
+        events,
+        excitation_period_s: orbit.params.period(),
+        omega_ratio: orbit.params.omega_ratio(),
+        parameters: orbit.params.clone(),
+        settings: serde_json::to_value(config.table())?,
     })
 }
 
 /// Phase portraits of every mass over one period of the orbit (section point marked) and the
 /// multipliers in the complex plane with the unit circle.
-fn plot_orbit(dir: &Path, config: &Config, orbit: &PeriodicOrbit) -> Result<()> {
-    let n = orbit.params.len();
+pub fn plot_periodic(dir: &Path) -> Result<()> {
+    let orbit: PeriodicManifest = read(&dir.join("periodic.json"))?;
+    let config = config_of(&orbit.settings)?;
+    let n = orbit.parameters.len();
+    if orbit.state.len() != 2 * n {
+        bail!(
+            "periodic.json: the state has {} entries, expected {} (positions and velocities)",
+            orbit.state.len(),
+            2 * n
+        );
+    }
+    let (positions, velocities) = orbit.state.split_at(n);
     let samples = 400 * orbit.period as usize;
-    let mut sampler = UniformSampler::new(n, 0.0, orbit.duration() / samples as f64);
-    orbit.replay(config.sim_options(), &mut sampler)?;
+    let duration = f64::from(orbit.period) * orbit.parameters.period();
+    let mut sampler = UniformSampler::new(n, 0.0, duration / samples as f64);
+    let start = ChainState {
+        positions: positions.to_vec(),
+        velocities: velocities.to_vec(),
+    };
+    let mut sim = Simulator::new(&orbit.parameters, &start, config.sim_options().clone())?;
+    sim.run_until(duration, &mut sampler)?;
     for i in 0..n {
         let x: Vec<f64> = sampler.positions.iter().skip(i).step_by(n).copied().collect();
         let v: Vec<f64> = sampler.velocities.iter().skip(i).step_by(n).copied().collect();
-        let (x0, v0) = ([orbit.state.positions[i]], [orbit.state.velocities[i]]);
+        let (x0, v0) = ([positions[i]], [velocities[i]]);
         let mut fig = Figure::new(
             format!(
                 "Period-{} orbit: mass {} (section t ≡ 0 mod T marked)",
@@ -236,9 +254,9 @@ fn plot_orbit(dir: &Path, config: &Config, orbit: &PeriodicOrbit) -> Result<()> 
         })
         .collect();
     let (cx, cy): (Vec<f64>, Vec<f64>) = circle.into_iter().unzip();
-    let re: Vec<f64> = orbit.multipliers.iter().map(|m| m.re).collect();
-    let im: Vec<f64> = orbit.multipliers.iter().map(|m| m.im).collect();
-    let r = orbit.spectral_radius().max(1.0) * 1.1;
+    let re: Vec<f64> = orbit.multipliers.iter().map(|m| m[0]).collect();
+    let im: Vec<f64> = orbit.multipliers.iter().map(|m| m[1]).collect();
+    let r = orbit.multiplier_moduli.first().map_or(0.0, |r| *r).max(1.0) * 1.1;
     let mut fig = Figure::new("Floquet multipliers", "Re λ", "Im λ");
     fig.size = (800, 800);
     fig.x_range = Some((-r, r));

@@ -11,7 +11,8 @@ use crate::manifest::{Kind, MapManifest, SweepManifest, kind_of, read};
 use crate::output::{CsvFile, column, numbers, read_csv, read_json, si};
 use crate::plot::{self, Figure, HeatMap, Legend, Scale, Series, both};
 
-/// Draws whatever `dir` holds: a `simulate`, `sweep` or `map` output directory.
+/// Draws whatever `dir` holds: the output directory of any command that writes one, told by
+/// its manifest; each kind with the drawing code of its command's `--plot`.
 pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
     if !dir.exists() {
         bail!("{} does not exist", dir.display());
@@ -33,8 +34,15 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         Some(Kind::Chirp) => crate::chirp::plot_chirp(dir),
         Some(Kind::Lyapunov) => crate::lyapunov::plot_lyapunov(dir),
         Some(Kind::Simulate) => analyze_run(dir, psd_mass),
-        Some(Kind::Continue) | None => bail!(
-            "{} holds no vibrotribo results (expected summary.json and trajectory.csv, sweep.json, map.json, chirp.json, basins.json, attractors.json or lyapunov.json)",
+        Some(Kind::Continue) => {
+            crate::branch_picture::plot_dir(dir, None, crate::continuation::DEFAULT_DIAGRAM_STEPS)
+        }
+        Some(Kind::LoadSweep) => crate::load_sweep::plot_load_sweep(dir),
+        Some(Kind::Periodic) => crate::periodic::plot_periodic(dir),
+        Some(Kind::OptimizeMassRatio) => crate::map::plot_optimize_mass_ratio(dir),
+        Some(Kind::Optimize) => crate::optimize::plot_convergence(dir),
+        None => bail!(
+            "{} holds no vibrotribo results (expected the manifest of a command: summary.json beside trajectory.csv, sweep.json, map.json, basins.json, attractors.json, chirp.json, continue.json, lyapunov.json, load_sweep.json, periodic.json, fit.json beside optimum.csv, or optimize.json)",
             dir.display()
         ),
     }
@@ -179,7 +187,7 @@ pub fn plot_sweep(dir: &Path) -> Result<()> {
                 Series::new("impacts per period", &sp, &ipp),
                 Series::new("period", &sp, &period),
             ],
-            4,
+            7,
         )
     })
 }

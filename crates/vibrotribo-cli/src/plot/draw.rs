@@ -47,7 +47,7 @@ pub fn scatter_plot(path: &Path, figure: &Figure, series: &[Series<'_>], marker_
 }
 
 /// Phase portrait: each trajectory (x = position, y = velocity) as a line, and the
-/// Poincaré `section` points (if any) as black 5-pixel marks on top.
+/// Poincaré `section` points (if any) as black 7-pixel marks on top.
 pub fn phase_portrait(
     path: &Path,
     figure: &Figure,
@@ -58,7 +58,7 @@ pub fn phase_portrait(
     let layers = Layers {
         lines: trajectories,
         points: &points,
-        marker_px: 5,
+        marker_px: 7,
     };
     write(path, figure.size, &xy_chart(figure, layers)?)
 }

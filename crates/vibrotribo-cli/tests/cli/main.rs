@@ -19,6 +19,7 @@ mod map_one_parameter_twice;
 mod messages_name_the_problem;
 mod optimize;
 mod periodic_orbits;
+mod plot_dir_draws_every_kind;
 mod plot_skips_empty_figures;
 mod resume_checks_files;
 mod serve;

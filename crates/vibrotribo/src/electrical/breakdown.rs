@@ -195,7 +195,7 @@ impl GapField {
 
 /// The worst ratio |V_gap| / V_b over samples of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BreakdownMargin {
     /// Largest |V_gap|/V_b seen (≥ 1 means the air would break down), dimensionless.
     pub worst_ratio: f64,

@@ -9,7 +9,7 @@ use crate::error::ParamError;
 
 /// Average power at one load.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct LoadPoint {
     /// Load resistance R, Ω.
     pub resistance_ohm: f64,

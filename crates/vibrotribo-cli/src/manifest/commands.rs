@@ -1,0 +1,616 @@
+//! The manifests of the commands other than the grid jobs, each a serde type that its command
+//! writes and `plot DIR` (and `--resume`, `merge`) reads. The fields are in the order of the
+//! files' keys.
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use vibrotribo::electrical::breakdown::BreakdownMargin;
+use vibrotribo::electrical::{HarvesterParams, LoadPoint};
+use vibrotribo::model::ChainParams;
+
+use super::{Axis, Kind, ShardRecord};
+
+/// The classification tolerances of `basins.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BasinTolerances {
+    /// Relative tolerance of the period detection.
+    pub period_tolerance: f64,
+    /// Relative distance under which two attractors are one.
+    pub match_tolerance: f64,
+    /// Side of a fingerprint's cell, relative.
+    pub cell: f64,
+}
+
+/// The scales that make a section point dimensionless.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SectionScaleRecord {
+    /// Number of masses.
+    pub masses: usize,
+    /// Length scale, m.
+    pub length_m: f64,
+    /// Speed scale, m/s.
+    pub speed_m_s: f64,
+}
+
+/// `basins.json`: everything that determines a basins job's output.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BasinsManifest {
+    /// Always [`Kind::Basins`].
+    pub command: Kind,
+    /// The x axis.
+    pub x: Axis,
+    /// The y axis.
+    pub y: Axis,
+    /// Transient periods per start.
+    pub transient_periods: u64,
+    /// Recorded periods per start.
+    pub recorded_periods: u64,
+    /// Longest period detected, in excitation periods.
+    pub max_period_detected: usize,
+    /// How attractors are told apart.
+    pub attractor_options: BasinTolerances,
+    /// The scales of the section.
+    pub section_scale: SectionScaleRecord,
+    /// Mechanics only (no harvester).
+    pub mechanics_only: bool,
+    /// The shard, if the job is one.
+    pub shard: Option<ShardRecord>,
+    /// The configuration (the library's document).
+    pub settings: Value,
+    /// The program's version.
+    pub vibrotribo_version: String,
+    /// Whether the job finished (written by the job machinery; read only).
+    #[serde(default, skip_serializing)]
+    pub complete: bool,
+}
+
+/// The box random starts are drawn from, around the configured state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StartBoxRecord {
+    /// Half-width of the positions, m.
+    pub positions_m: f64,
+    /// Half-width of the velocities, m/s.
+    pub velocities_m_s: f64,
+}
+
+/// The classification settings of `attractors.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AttractorTolerances {
+    /// Relative tolerance of the period detection.
+    pub period_tolerance: f64,
+    /// Relative distance under which two attractors are one.
+    pub match_tolerance: f64,
+    /// Side of a fingerprint's cell, relative.
+    pub cell: f64,
+    /// Relative distance under which an attractor continues one of the previous value.
+    pub continuation_distance: f64,
+}
+
+/// `attractors.json`: the settings of an attractors study and how far it got.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AttractorsManifest {
+    /// Always [`Kind::Attractors`].
+    pub command: Kind,
+    /// The varied key.
+    pub param: String,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Number of values.
+    pub steps: usize,
+    /// The values, in order.
+    pub values: Vec<f64>,
+    /// Random starts per value.
+    pub samples: usize,
+    /// Seed of the starts.
+    pub seed: u64,
+    /// The box of the starts (`None`: the library's default).
+    pub start_box: Option<StartBoxRecord>,
+    /// Transient periods per start.
+    pub transient_periods: u64,
+    /// Recorded periods per start.
+    pub recorded_periods: u64,
+    /// How attractors are told apart and followed.
+    pub attractor_options: AttractorTolerances,
+    /// Mechanics only (no harvester).
+    pub mechanics_only: bool,
+    /// The configuration (the library's document).
+    pub settings: Value,
+    /// The program's version.
+    pub vibrotribo_version: String,
+    /// Whether every value was run.
+    pub complete: bool,
+    /// Values run.
+    pub done: usize,
+}
+
+/// The jump of one chirp direction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JumpRecord {
+    /// Ω at the jump.
+    pub omega_ratio: f64,
+    /// Excitation frequency at the jump, Hz.
+    pub frequency_hz: f64,
+    /// The cycle at the jump.
+    pub cycle: u64,
+    /// The mass whose amplitude jumps most (1-based).
+    pub mass: usize,
+    /// The jump's size, m.
+    pub size_m: f64,
+    /// The jump relative to that mass's largest amplitude.
+    pub relative: f64,
+}
+
+/// One direction of a chirp.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChirpRunRecord {
+    /// Frequency at the start, Hz.
+    pub f_start_hz: f64,
+    /// Frequency the end would have had, Hz.
+    pub f_end_hz_requested: f64,
+    /// Duration run, s.
+    pub run_duration_s: f64,
+    /// Excitation periods run.
+    pub periods: u64,
+    /// Cycles measured.
+    pub cycles: usize,
+    /// Impacts over the run.
+    pub impacts: u64,
+    /// Whether it ran to its end.
+    pub complete: bool,
+    /// Why it stopped early.
+    pub failure: Option<String>,
+    /// Its jump, if any.
+    pub jump: Option<JumpRecord>,
+    /// Its base motion, when it is not the chain's own harmonic.
+    pub base_motion: Option<Value>,
+}
+
+/// The hysteresis of a chirp: the up and down jumps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HysteresisRecord {
+    /// Ω of the up jump.
+    pub up_jump_omega_ratio: f64,
+    /// Ω of the down jump.
+    pub down_jump_omega_ratio: f64,
+    /// Their difference.
+    pub width: f64,
+}
+
+/// `chirp.json`: the settings, per direction the run and its jump, the hysteresis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChirpManifest {
+    /// Always [`Kind::Chirp`].
+    pub command: Kind,
+    /// Ω at the start of the up chirp.
+    pub from: f64,
+    /// Ω at its end.
+    pub to: f64,
+    /// Duration of each direction, s.
+    pub duration_s: f64,
+    /// `linear` or `exponential`.
+    pub sweep: String,
+    /// Base amplitude, m.
+    pub amplitude_m: Option<f64>,
+    /// Mechanics only (no harvester).
+    pub mechanics_only: bool,
+    /// `settled` or `initial_state`.
+    pub start: String,
+    /// Samples per excitation cycle.
+    pub samples_per_cycle: u64,
+    /// Natural frequency √(k1/m1)/2π, Hz.
+    pub natural_frequency_hz: f64,
+    /// dΩ/dt, 1/s.
+    pub sweep_rate_omega_per_s: f64,
+    /// Cycles on each side of a jump.
+    pub jump_window_cycles: usize,
+    /// How a jump is found, in words.
+    pub jump_criterion: String,
+    /// The up chirp.
+    pub up: Option<ChirpRunRecord>,
+    /// The down chirp.
+    pub down: Option<ChirpRunRecord>,
+    /// Both jumps, when both were found.
+    pub hysteresis: Option<HysteresisRecord>,
+    /// Whether both directions ran to their end.
+    pub complete: bool,
+    /// Wall-clock time, s.
+    pub wall_time_s: f64,
+    /// The configuration (the library's document).
+    pub settings: Value,
+    /// The program's version.
+    pub vibrotribo_version: String,
+}
+
+/// Where a branch of a continuation comes from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParentRecord {
+    /// The parent branch (0-based).
+    pub branch: usize,
+    /// The bifurcation on it (0-based).
+    pub bifurcation: usize,
+}
+
+/// One branch of a continuation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BranchRecord {
+    /// Period of its orbits, in excitation periods.
+    pub period: u32,
+    /// Where it branched off.
+    pub parent: Option<ParentRecord>,
+    /// Points on it.
+    pub points: usize,
+    /// Why it ended, in words.
+    pub end: String,
+}
+
+/// One bifurcation of a continuation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BifurcationRecord {
+    /// Its branch (0-based).
+    pub branch: usize,
+    /// Its kind (`fold`, `period_doubling`, …).
+    pub kind: String,
+    /// Its detail, in words.
+    pub detail: String,
+    /// The parameter there.
+    pub param: f64,
+    /// How precisely the parameter is known.
+    pub precision: f64,
+    /// The branch it starts (0-based).
+    pub child_branch: Option<usize>,
+    /// Floquet multipliers there, `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+    /// The kind of a grazing crossing.
+    pub crossing: Option<String>,
+    /// Its Nordmark class.
+    pub nordmark: Option<String>,
+    /// Multipliers just past it.
+    pub multipliers_after: Option<Vec<[f64; 2]>>,
+    /// The orbit's state at t ≡ 0 (mod T) there: positions (m) then velocities (m/s).
+    #[serde(default)]
+    pub state: Vec<f64>,
+}
+
+/// The cascade of period doublings from the first branch.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CascadeRecord {
+    /// Parameters of the doublings.
+    pub period_doublings: Vec<f64>,
+    /// Ratios of successive intervals.
+    pub feigenbaum_ratios: Vec<f64>,
+}
+
+/// `continue.json`: the settings, branches and bifurcations of a continuation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContinueManifest {
+    /// Always [`Kind::Continue`].
+    pub command: Kind,
+    /// The continued key.
+    pub param: String,
+    /// Start of the range.
+    pub from: f64,
+    /// End of the range.
+    pub to: f64,
+    /// Transient periods before the first orbit.
+    pub transient_periods: u32,
+    /// Depth of period doublings followed.
+    pub doublings: u32,
+    /// Most points per branch.
+    pub max_points: usize,
+    /// Mechanics only (no harvester).
+    pub mechanics_only: bool,
+    /// The branches.
+    pub branches: Vec<BranchRecord>,
+    /// The bifurcations, by branch.
+    pub bifurcations: Vec<BifurcationRecord>,
+    /// The doubling cascade.
+    pub cascade: CascadeRecord,
+    /// The configuration (the library's document).
+    pub settings: Value,
+    /// The program's version.
+    pub vibrotribo_version: String,
+}
+
+/// The air-breakdown margin at one load over the last period.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MarginRecord {
+    /// The load, Ω.
+    pub load_resistance_ohm: f64,
+    /// The margin.
+    pub air_breakdown: BreakdownMargin,
+}
+
+/// `load_sweep.json`: the optimal load and the sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LoadSweepManifest {
+    /// The best load.
+    pub optimum: LoadPoint,
+    /// Whether the best grid point is at an end of the range.
+    pub optimum_at_edge: bool,
+    /// The configured load, Ω.
+    pub configured_load_ohm: f64,
+    /// Average power at the configured load, W.
+    pub configured_average_power_w: f64,
+    /// Configured power over optimal power.
+    pub power_ratio_configured_to_optimum: f64,
+    /// Air-breakdown margins at the loads of `vq_cycle.csv`.
+    pub air_breakdown_last_period: Vec<MarginRecord>,
+    /// Every load of the sweep.
+    pub points: Vec<LoadPoint>,
+    /// Periods run.
+    pub periods: u64,
+    /// Of which transient.
+    pub transient_periods: u64,
+    /// The harvester at the configured load.
+    pub harvester: HarvesterParams,
+    /// The configuration (the library's document).
+    pub settings: Value,
+    /// The base motion, when it is not the chain's own harmonic.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_motion: Option<Value>,
+}
+
+/// One event of a periodic orbit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OrbitEventRecord {
+    /// Time from the section, s.
+    pub time_s: f64,
+    /// `impact`, `stick`, `release`, ….
+    pub kind: String,
+    /// The contact (1-based).
+    pub contact: usize,
+    /// Relative velocity before, m/s.
+    pub rel_velocity_m_s: f64,
+    /// Relative velocity after, m/s.
+    pub rel_velocity_after_m_s: f64,
+}
+
+/// `periodic.json`: a periodic orbit, its stability and power.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PeriodicManifest {
+    /// Period in excitation periods.
+    pub period: u32,
+    /// State at t ≡ 0 (mod T): positions (m) then velocities (m/s).
+    pub state: Vec<f64>,
+    /// Names of the state's components.
+    pub state_names: Vec<String>,
+    /// Floquet multipliers, `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+    /// Their moduli.
+    pub multiplier_moduli: Vec<f64>,
+    /// Whether every multiplier is inside the unit circle.
+    pub stable: bool,
+    /// Multipliers outside it.
+    pub unstable_dimension: usize,
+    /// Impacts per excitation period, all contacts.
+    pub impacts_per_period: f64,
+    /// Impacts per excitation period by contact.
+    pub impacts_per_period_by_contact: Vec<f64>,
+    /// Impacts per orbit.
+    pub impacts_per_orbit: usize,
+    /// Slowest impact, m/s.
+    pub min_closing_speed_m_s: Option<f64>,
+    /// Its contact (1-based).
+    pub min_closing_speed_contact: Option<usize>,
+    /// Whether a contact sticks.
+    pub sticks: bool,
+    /// Average power, W.
+    pub average_power_w: Option<f64>,
+    /// Energy per excitation period, J.
+    pub energy_per_period_j: Option<f64>,
+    /// Final Newton residual.
+    pub residual: f64,
+    /// Residual of each Newton iteration.
+    pub residual_history: Vec<f64>,
+    /// The events along the orbit.
+    pub events: Vec<OrbitEventRecord>,
+    /// Excitation period T, s.
+    pub excitation_period_s: f64,
+    /// Ω.
+    pub omega_ratio: f64,
+    /// The chain's parameters.
+    pub parameters: ChainParams,
+    /// The configuration (the library's document).
+    pub settings: Value,
+}
+
+/// A quadratic fit R_mo(Ω) = a Ω² + b Ω + c to the optima.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitRecord {
+    /// a.
+    pub a: f64,
+    /// b.
+    pub b: f64,
+    /// c.
+    pub c: f64,
+    /// Coefficient of determination (`None`: the optima have no variance).
+    pub r_squared: Option<f64>,
+    /// RMS residual.
+    pub rms_residual: f64,
+}
+
+/// The paper's quadratic fit R_mo(Ω) = a Ω² + b Ω + c.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PaperFitRecord {
+    /// a.
+    pub a: f64,
+    /// b.
+    pub b: f64,
+    /// c.
+    pub c: f64,
+}
+
+/// `fit.json` (`optimize-mass-ratio`): the optima and their quadratic fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitManifest {
+    /// The fit to the optima.
+    pub fit: Option<FitRecord>,
+    /// The paper's fit.
+    pub paper_fit: PaperFitRecord,
+    /// Ω of each optimum.
+    pub omega_ratio: Vec<f64>,
+    /// The optimal mass ratio there.
+    pub optimal_mass_ratio: Vec<f64>,
+    /// Transient periods per point.
+    pub transient_periods: u64,
+    /// Recorded periods per point.
+    pub recorded_periods: u64,
+    /// The configuration (the library's document).
+    pub settings: Value,
+}
+
+/// `x`, or `None` where it is not finite (written `null`, as −∞ exponents are).
+pub fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// [`finite`] of each of `xs`.
+pub fn finite_all(xs: &[f64]) -> Vec<Option<f64>> {
+    xs.iter().copied().map(finite).collect()
+}
+
+/// The exponents after a number of periods.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunningRecord {
+    /// Periods averaged.
+    pub periods: u64,
+    /// The exponents then, 1/s (`null`: −∞).
+    pub exponents: Vec<Option<f64>>,
+}
+
+/// `lyapunov.json`: exponents (1/s, largest first; `null` for −∞), their spread, the
+/// convergence and the settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LyapunovManifest {
+    /// The exponents, 1/s, largest first.
+    pub exponents: Vec<Option<f64>>,
+    /// Their batch-means standard errors, 1/s.
+    pub spread: Vec<Option<f64>>,
+    /// Periods averaged.
+    pub periods: u64,
+    /// Time averaged, s.
+    pub time_s: f64,
+    /// The largest exponent, 1/s.
+    pub largest: Option<f64>,
+    /// Its spread, 1/s.
+    pub largest_spread: Option<f64>,
+    /// Sum of the exponents, 1/s.
+    pub sum: Option<f64>,
+    /// Kaplan–Yorke dimension.
+    pub kaplan_yorke_dimension: Option<f64>,
+    /// Directions collapsed by sticking.
+    pub collapsed: usize,
+    /// Periods skipped at non-differentiable points.
+    pub skipped_periods: u64,
+    /// Non-differentiable points met.
+    pub non_smooth_count: u64,
+    /// The first of them, in words.
+    pub non_smooth: Vec<String>,
+    /// Re-orthonormalisations.
+    pub reorthonormalisations: u64,
+    /// The exponents of each batch, 1/s.
+    pub batches: Vec<Vec<Option<f64>>>,
+    /// The exponents after each batch.
+    pub running: Vec<RunningRecord>,
+    /// Transient periods.
+    pub transient_periods: u64,
+    /// Seed of the initial directions.
+    pub seed: u64,
+    /// Whether the run was stopped early.
+    pub interrupted: bool,
+    /// The configuration (the library's document).
+    pub settings: Value,
+}
+
+/// The configuration a manifest's `settings` records.
+pub fn config_of(settings: &Value) -> anyhow::Result<vibrotribo::config::Config> {
+    use anyhow::Context;
+    let table: toml::Table =
+        serde_json::from_value(settings.clone()).context("the recorded settings are not a table")?;
+    Ok(vibrotribo::config::Config::from_table(table)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::de::DeserializeOwned;
+
+    /// `text` (a command's manifest as the program wrote it, with its `settings` emptied and
+    /// its long lists cut) read as `T` and written back gives the same text.
+    fn round_trips<T: DeserializeOwned + Serialize>(text: &str) -> T {
+        let m: T = serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"));
+        assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
+        m
+    }
+
+    #[test]
+    fn basins_manifest_round_trips_byte_for_byte() {
+        round_trips::<BasinsManifest>(
+            r#"{"command":"basins","x":{"param":"run.initial_positions[0]","from":-0.01,"to":0.01,"steps":3,"values":[-0.01,0.0,0.01]},"y":{"param":"run.initial_velocities[0]","from":-0.1,"to":0.1,"steps":3,"values":[-0.1,0.0,0.1]},"transient_periods":20,"recorded_periods":10,"max_period_detected":5,"attractor_options":{"period_tolerance":0.001,"match_tolerance":0.003,"cell":0.05},"section_scale":{"masses":3,"length_m":0.12,"speed_m_s":4.2},"mechanics_only":false,"shard":null,"settings":{},"vibrotribo_version":"0.1.0"}"#,
+        );
+    }
+
+    /// The job machinery's progress keys are read (`complete`) or ignored (`rows`).
+    #[test]
+    fn a_finished_basins_manifest_reads_as_complete() {
+        let text = r#"{"command":"basins","x":{"param":"a","from":0.0,"to":1.0,"steps":2,"values":[0.0,1.0]},"y":{"param":"b","from":0.0,"to":1.0,"steps":2,"values":[0.0,1.0]},"transient_periods":20,"recorded_periods":10,"max_period_detected":5,"attractor_options":{"period_tolerance":0.001,"match_tolerance":0.003,"cell":0.05},"section_scale":{"masses":3,"length_m":0.12,"speed_m_s":4.2},"mechanics_only":false,"shard":null,"settings":{},"vibrotribo_version":"0.1.0","complete":true,"done":4,"rows":{"starts.csv":4}}"#;
+        let m: BasinsManifest = serde_json::from_str(text).expect("a basins manifest");
+        assert!(m.complete);
+        let fresh = serde_json::to_string(&m).expect("serialises");
+        assert!(fresh.ends_with(r#""vibrotribo_version":"0.1.0"}"#), "{fresh}");
+    }
+
+    #[test]
+    fn attractors_manifest_round_trips_byte_for_byte() {
+        round_trips::<AttractorsManifest>(
+            r#"{"command":"attractors","param":"omega_ratio","from":0.7,"to":0.8,"steps":2,"values":[0.7],"samples":3,"seed":1,"start_box":null,"transient_periods":20,"recorded_periods":10,"attractor_options":{"period_tolerance":0.001,"match_tolerance":0.003,"cell":0.05,"continuation_distance":0.25},"mechanics_only":false,"settings":{},"vibrotribo_version":"0.1.0","complete":true,"done":2}"#,
+        );
+    }
+
+    #[test]
+    fn chirp_manifest_round_trips_byte_for_byte() {
+        round_trips::<ChirpManifest>(
+            r#"{"command":"chirp","from":2.3,"to":2.6,"duration_s":2.0,"sweep":"linear","amplitude_m":0.01,"mechanics_only":false,"start":"settled","samples_per_cycle":200,"natural_frequency_hz":7.7969680123367615,"sweep_rate_omega_per_s":0.15000000000000013,"jump_window_cycles":5,"jump_criterion":"the cycle boundary where the median amplitude of the jump_window cycles after it differs most from that of the jump_window cycles before it, for any mass, relative to that mass's largest amplitude in the chirp; omega_ratio at that boundary","up":{"f_start_hz":17.93302642837455,"f_end_hz_requested":20.272116832075582,"run_duration_s":2.000777735052508,"periods":39,"cycles":38,"impacts":38,"complete":true,"failure":null,"jump":{"omega_ratio":2.341448798185491,"frequency_hz":18.256201381976624,"cycle":5,"mass":1,"size_m":-0.000786467814282342,"relative":0.04832352312363258},"base_motion":{"kind":"chirp","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"15320","duration_s":"2.000777735052508e0","knot_spacing_s":"1.3059906886765717e-4","spline_error_bound_m":"9.99934915351887e-12","spline_velocity_error_bound_m_s":"2.45008770496561e-7"}},"down":{"f_start_hz":20.272116832075582,"f_end_hz_requested":17.93302642837455,"run_duration_s":2.000777735052508,"periods":39,"cycles":38,"impacts":38,"complete":true,"failure":null,"jump":{"omega_ratio":2.343133728181077,"frequency_hz":18.26933872725524,"cycle":33,"mass":1,"size_m":0.0005788544347253843,"relative":0.03631401105581164},"base_motion":{"kind":"chirp","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"15320","duration_s":"2.000777735052508e0","knot_spacing_s":"1.3059906886765717e-4","spline_error_bound_m":"9.997557130923704e-12","spline_velocity_error_bound_m_s":"2.4496486151348593e-7"}},"hysteresis":{"up_jump_omega_ratio":2.341448798185491,"down_jump_omega_ratio":2.343133728181077,"width":-0.0016849299955863373},"complete":true,"wall_time_s":1.5,"settings":{},"vibrotribo_version":"0.1.0"}"#,
+        );
+    }
+
+    #[test]
+    fn continue_manifest_round_trips_byte_for_byte() {
+        round_trips::<ContinueManifest>(
+            r#"{"command":"continue","param":"omega_ratio","from":0.7,"to":1.0,"transient_periods":200,"doublings":0,"max_points":2000,"mechanics_only":true,"branches":[{"period":1,"parent":null,"points":445,"end":"range end at 0.7"}],"bifurcations":[{"branch":0,"kind":"fold","detail":"","param":0.800850586304854,"precision":2.7024081030575457e-10,"child_branch":null,"multipliers":[[1.0671300722619446,0.0],[1.000010318521307,0.0],[0.8584749550410304,-0.07662192062756869],[0.8584749550410304,0.07662192062756869],[0.1302838658389211,0.0],[0.018015857594404754,0.0]],"crossing":null,"nordmark":null,"multipliers_after":null,"state":[0.01,-0.02,0.5,-0.25]}],"cascade":{"period_doublings":[],"feigenbaum_ratios":[]},"settings":{},"vibrotribo_version":"0.1.0"}"#,
+        );
+    }
+
+    #[test]
+    fn lyapunov_manifest_round_trips_byte_for_byte() {
+        let m = round_trips::<LyapunovManifest>(
+            r#"{"exponents":[-3.1202438773260632,null],"spread":[1.6395797461760684,1.6395797461762882],"periods":20,"time_s":1.0260398641294914,"largest":-3.1202438773260632,"largest_spread":1.6395797461760684,"sum":-10.658815658780885,"kaplan_yorke_dimension":0.0,"collapsed":0,"skipped_periods":0,"non_smooth_count":0,"non_smooth":[],"reorthonormalisations":30,"batches":[[1.4302536848834018,-12.089069343665027]],"running":[{"periods":5,"exponents":[1.4302536848834018,-12.089069343665027]}],"transient_periods":10,"seed":1,"interrupted":false,"settings":{}}"#,
+        );
+        // A −∞ exponent (a direction collapsed by sticking) is written null.
+        assert_eq!(m.exponents, [Some(-3.1202438773260632), None]);
+        assert_eq!(finite_all(&[1.0, f64::NEG_INFINITY]), [Some(1.0), None]);
+    }
+
+    #[test]
+    fn load_sweep_manifest_round_trips_byte_for_byte() {
+        round_trips::<LoadSweepManifest>(
+            r#"{"optimum":{"resistance_ohm":13550799443.411295,"average_power_w":3.127041765618578e-6,"energy_per_period_j":5.613652250477589e-7},"optimum_at_edge":false,"configured_load_ohm":100000.0,"configured_average_power_w":5.468294720027476e-11,"power_ratio_configured_to_optimum":0.00001748711763351124,"air_breakdown_last_period":[{"load_resistance_ohm":100000.0,"air_breakdown":{"worst_ratio":0.5233797000480489,"time_s":1.045750819267165,"gap":1,"gap_voltage_v":33878.99451676965,"gap_m":0.019826468931647315}}],"points":[{"resistance_ohm":1000.0,"average_power_w":5.468303763963152e-13,"energy_per_period_j":9.81667596140803e-14}],"periods":6,"transient_periods":2,"harvester":{"mode":"freestanding","voc_model":"paper","contact":0,"area":0.01,"charge_density":0.000015,"dielectric_thickness":[0.0001,0.0001],"relative_permittivity":[2.0,2.0],"load":"resistor","load_resistance":100000.0,"storage_capacitance":1e-6,"storage_load_resistance":null,"storage_initial_voltage":0.0,"target_voltage":null,"initial_charge":null,"coupling":"one_way","coupling_tolerance":1e-11,"diode_saturation_current":2.52e-9,"diode_ideality":1.752,"diode_series_resistance":0.568,"diode_thermal_voltage":0.025864917007157463,"diode_parallel_conductance":0.0},"settings":{},"base_motion":{"kind":"record","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"2999","duration_s":"2.999e1","record_scale_factor":"9.8e0","record_peak_acceleration_m_s2":"9.800501213296139e0","baseline_acceleration_offset_m_s2":"8.210046330600539e-4","baseline_acceleration_slope_m_s3":"-5.513643740029047e-5","baseline_relative_size":"8.495276781374053e-5","baseline_removed_displacement_m":"4.425899009433706e-2"}}"#,
+        );
+    }
+
+    #[test]
+    fn periodic_manifest_round_trips_byte_for_byte() {
+        round_trips::<PeriodicManifest>(
+            r#"{"period":1,"state":[-0.005571166234713745,-0.37889805643949115],"state_names":["x1_m","v1_m_s"],"multipliers":[[-0.15564532462113567,-0.7446897601001882],[-0.15564532462113567,0.7446897601001882]],"multiplier_moduli":[0.7607813785014027,0.7607813785014027],"stable":true,"unstable_dimension":0,"impacts_per_period":1.0,"impacts_per_period_by_contact":[0.0,1.0],"impacts_per_orbit":1,"min_closing_speed_m_s":0.31634845380098503,"min_closing_speed_contact":2,"sticks":false,"average_power_w":null,"energy_per_period_j":null,"residual":7.079712701691433e-14,"residual_history":[7.079712701691433e-14],"events":[{"time_s":0.036188481991832194,"kind":"impact","contact":2,"rel_velocity_m_s":0.31634845380098503,"rel_velocity_after_m_s":0.2530787630407881}],"excitation_period_s":0.051301993206474564,"omega_ratio":2.5,"parameters":{"masses":[0.05],"stiffness":[120.0],"damping":[0.09798],"gaps":[],"restitution":0.6,"excitation":{"amplitude":0.01,"frequency":{"omega_ratio":2.5}},"stops":{"upper":{"gap":0.0,"restitution":0.8,"frame":"fixed"}}},"settings":{}}"#,
+        );
+    }
+
+    #[test]
+    fn fit_manifest_round_trips_byte_for_byte() {
+        round_trips::<FitManifest>(
+            r#"{"fit":{"a":-38.248148530029624,"b":46.258965805636095,"c":-8.227063467002559,"r_squared":1.0,"rms_residual":6.409875621278547e-16},"paper_fit":{"a":11.43,"b":-28.46,"c":18.03},"omega_ratio":[0.55,0.75,0.95],"optimal_mass_ratio":[5.6453027957633335,4.9525773390828505,1.2],"transient_periods":20,"recorded_periods":10,"settings":{}}"#,
+        );
+    }
+}
