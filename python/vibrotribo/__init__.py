@@ -32,7 +32,7 @@ import collections.abc
 import hashlib
 import os
 import tempfile
-from typing import Any, Iterable, Literal, Mapping, Optional, Tuple, Union
+from typing import Any, Dict, Iterable, Literal, Mapping, Optional, Tuple, Union, overload
 
 import numpy as np
 
@@ -101,6 +101,12 @@ ChirpSweep = Literal["linear", "logarithmic"]
 Quantity = Literal["displacement", "acceleration"]
 
 
+@overload
+def _count(value: int, name: str, *, least: int = 0) -> int: ...
+@overload
+def _count(value: None, name: str, *, least: int = 0) -> None: ...
+@overload
+def _count(value: Optional[int], name: str, *, least: int = 0) -> Optional[int]: ...
 def _count(value: Optional[int], name: str, *, least: int = 0) -> Optional[int]:
     """``value`` as a whole number of at least ``least`` (None stays None), or a ValueError
     naming the argument."""
@@ -662,7 +668,8 @@ def export_spice(
         check=check,
         allow_large=allow_large,
     )
-    return SpiceExport(**{k: (tuple(v) if k == "window_s" else v) for k, v in raw.items()})
+    fields: Dict[str, Any] = {k: (tuple(v) if k == "window_s" else v) for k, v in raw.items()}
+    return SpiceExport(**fields)
 
 
 def with_base_motion(
@@ -714,7 +721,7 @@ def _floats(values: Iterable[float]) -> list:
     return [float(v) for v in np.asarray(values, dtype=float).ravel()]
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     # `vibrotribo.dask` without importing dask until it is used.
     if name == "dask":
         import importlib

@@ -28,7 +28,7 @@ imported until a sweep is submitted::
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, List, Optional
+from typing import Any, Dict, Iterable, List, Optional
 
 import numpy as np
 
@@ -97,7 +97,7 @@ def sweep(
         )
     cfg = _config(config)
     vals = _values(values, "values")
-    kwargs = dict(
+    kwargs: Dict[str, Any] = dict(
         transient=transient,
         recorded=recorded,
         mechanics_only=mechanics_only,
@@ -165,7 +165,7 @@ def map(  # noqa: A001 - the command's name
     returns for the same arguments."""
     cfg = _config(config)
     xs, ys = _values(x_values, "x_values"), _values(y_values, "y_values")
-    kwargs = dict(
+    kwargs: Dict[str, Any] = dict(
         transient=transient,
         recorded=recorded,
         mechanics_only=mechanics_only,
@@ -235,8 +235,8 @@ def basins(
 
     cfg = _config(config)
     nx, ny = _count(grid[0], "grid[0]", least=1), _count(grid[1], "grid[1]", least=1)
-    options = dict(cell=cell, section_tolerance=section_tolerance, match_tolerance=match_tolerance)
-    run = dict(
+    options: Dict[str, Any] = dict(cell=cell, section_tolerance=section_tolerance, match_tolerance=match_tolerance)
+    run: Dict[str, Any] = dict(
         transient=transient,
         recorded=recorded,
         mechanics_only=mechanics_only,
@@ -250,7 +250,7 @@ def basins(
                            **dict(run, transient=0, recorded=1, settle="fixed"), threads=1)
     xs = _vibrotribo.grid(float(x_from), float(x_to), int(nx)).tolist()
     ys = _vibrotribo.grid(float(y_from), float(y_to), int(ny)).tolist()
-    kwargs = dict(options, **run, threads=threads)
+    kwargs: Dict[str, Any] = dict(options, **run, threads=threads)
     futures = client.map(
         _basin_row,
         [cfg] * len(ys),
