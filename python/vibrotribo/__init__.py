@@ -327,7 +327,8 @@ def periodic(
     default 1), as ``vibrotribo periodic --transient 0``. Unless ``mechanics_only``, the
     harvester is run along the orbit: ``Orbit.average_power_w``, as ``vibrotribo periodic``
     reports it. Raises :class:`OrbitNotFound` if Newton does not converge or the motion is
-    not periodic.
+    not periodic. Ctrl-C raises ``KeyboardInterrupt`` within a Newton iteration or a piece
+    of the transient.
     """
     raw = _vibrotribo.periodic(
         _config(config),
@@ -365,8 +366,8 @@ def continue_(
     largest 0.1); ``max_points`` per branch (default 2000). Unless ``mechanics_only``, the
     harvester's average power on every point is computed (``Branch.points["average_power_w"]``,
     as ``vibrotribo continue`` writes it in ``branch.csv``). Ctrl-C raises
-    ``KeyboardInterrupt``: during the power, at the next point; during the continuation
-    itself (which has no checkpoint), when it returns.
+    ``KeyboardInterrupt``: during the continuation, within a step (the continuation is
+    stopped there); during the power, at the next point.
     """
     raw = _vibrotribo.continue_(
         _config(config),
