@@ -70,7 +70,10 @@ impl RunObserver for Signals {
 
 /// A cancel hook for the orbit solvers that runs Python's signal handlers (at most every
 /// [`INTERVAL`]), and the watcher that keeps the exception one raised.
-pub fn cancel_hook() -> (vibrotribo::orbits::Cancel, std::sync::Arc<std::sync::Mutex<Signals>>) {
+pub fn cancel_hook() -> (
+    vibrotribo::orbits::Cancel,
+    std::sync::Arc<std::sync::Mutex<Signals>>,
+) {
     let signals = std::sync::Arc::new(std::sync::Mutex::new(Signals::new()));
     let shared = std::sync::Arc::clone(&signals);
     let cancel = vibrotribo::orbits::Cancel::new(move || {

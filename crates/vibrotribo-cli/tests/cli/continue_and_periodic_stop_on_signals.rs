@@ -19,9 +19,18 @@ fn interrupted(args: &[&str], after: Duration, signal: &str) -> (ExitStatus, Str
         .unwrap();
     std::thread::sleep(after);
     let pid = child.id().to_string();
-    assert!(Command::new("kill").args([signal, &pid]).status().unwrap().success());
+    assert!(
+        Command::new("kill")
+            .args([signal, &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
     let o = child.wait_with_output().unwrap();
-    assert!(!o.status.success(), "finished before the signal: make the run longer");
+    assert!(
+        !o.status.success(),
+        "finished before the signal: make the run longer"
+    );
     (o.status, String::from_utf8_lossy(&o.stderr).into_owned())
 }
 

@@ -53,7 +53,11 @@ impl Cancel {
 
 impl fmt::Debug for Cancel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(if self.0.is_some() { "Cancel(hook)" } else { "Cancel(never)" })
+        f.write_str(if self.0.is_some() {
+            "Cancel(hook)"
+        } else {
+            "Cancel(never)"
+        })
     }
 }
 
