@@ -28,6 +28,7 @@ imported until a sweep is submitted::
 from __future__ import annotations
 
 import math
+import time
 from typing import Any, Dict, Iterable, List, Optional
 
 import numpy as np
@@ -38,11 +39,27 @@ from . import sweep as _serial_sweep
 
 __all__ = ["sweep", "map", "basins"]
 
+_POLL_S = 0.05
+"""How often the waiting loop looks at the futures, s."""
+
 
 def _gather(client: Any, futures: List[Any]) -> List[Any]:
     """The results of ``futures`` in order; on an interrupt or an error the futures not yet
-    done are cancelled first (the workers stop), then the exception is raised."""
+    done are cancelled first (the workers stop), then the exception is raised.
+
+    The waiting happens here, in Python, until every future is done (or one failed): a
+    Ctrl-C then lands in this loop, not inside the client's gathering coroutine, which an
+    interrupt would leave behind with a "Task exception was never retrieved"."""
     try:
+        i = 0
+        while i < len(futures):
+            f = futures[i]
+            if f.status == "error":
+                break  # gather raises its exception
+            if f.done():
+                i += 1
+            else:
+                time.sleep(_POLL_S)
         return client.gather(futures)
     except BaseException:
         client.cancel(futures, force=True)
