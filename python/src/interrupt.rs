@@ -67,3 +67,29 @@ impl RunObserver for Signals {
         }
     }
 }
+
+/// A cancel hook for the orbit solvers that runs Python's signal handlers (at most every
+/// [`INTERVAL`]), and the watcher that keeps the exception one raised.
+pub fn cancel_hook() -> (
+    vibrotribo::orbits::Cancel,
+    std::sync::Arc<std::sync::Mutex<Signals>>,
+) {
+    let signals = std::sync::Arc::new(std::sync::Mutex::new(Signals::new()));
+    let shared = std::sync::Arc::clone(&signals);
+    let cancel = vibrotribo::orbits::Cancel::new(move || {
+        // A poisoned lock (a panic while checking) stops the computation.
+        shared.lock().map_or(true, |mut s| s.check_now_and_then())
+    });
+    (cancel, signals)
+}
+
+/// The exception the signal handlers raised through a [`cancel_hook`], if one did.
+pub fn cancel_result(signals: &std::sync::Mutex<Signals>) -> PyResult<()> {
+    match signals.lock() {
+        Ok(mut s) => match s.raised.take() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        },
+        Err(_) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted")),
+    }
+}

@@ -20,7 +20,7 @@ use vibrotribo::orbits::{
 
 use crate::config::{config_error, config_of};
 use crate::convert::{array1, array2};
-use crate::interrupt::Signals;
+use crate::interrupt::{Signals, cancel_hook, cancel_result};
 
 create_exception!(
     vibrotribo,
@@ -127,7 +127,11 @@ pub fn periodic<'py>(
     let config = config_of(config)?;
     config.check_uncoupled("periodic").map_err(config_error)?;
     config.check_periodic("periodic orbits").map_err(config_error)?;
-    let options = shooting(&config, tolerance, max_iterations);
+    let (cancel, signals) = cancel_hook();
+    let options = ShootingOptions {
+        cancel,
+        ..shooting(&config, tolerance, max_iterations)
+    };
     let chain = config.chain().clone();
     let orbit = match guess {
         Some(g) => {
@@ -145,7 +149,9 @@ pub fn periodic<'py>(
             py.detach(|| periodic_orbit_from_transient(&chain, &initial, transient, period, &options))
         }
     };
-    // A Ctrl-C during the search raises here, before any array is made.
+    // A Ctrl-C during the search (polled at every Newton iteration and through the
+    // transient) raises here, before any array is made.
+    cancel_result(&signals)?;
     py.check_signals()?;
     let orbit = orbit.map_err(orbit_error)?;
     let power = if mechanics_only {
@@ -305,6 +311,10 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
             d.set_item("parameter", parameter)?;
             "collapsed"
         }
+        BranchEnd::Stopped { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "stopped"
+        }
         _ => "other",
     };
     d.set_item("reason", reason)?;
@@ -377,6 +387,7 @@ pub fn continue_<'py>(
     base.check_periodic("continuation of periodic orbits")
         .map_err(config_error)?;
     let d = BranchOptions::default();
+    let (cancel, signals) = cancel_hook();
     let options = BranchOptions {
         transient: transient.unwrap_or(d.transient),
         period,
@@ -385,6 +396,10 @@ pub fn continue_<'py>(
             doubling_depth: doubling_depth.unwrap_or(d.continuation.doubling_depth),
             initial_step: initial_step.unwrap_or(d.continuation.initial_step),
             max_step: max_step.unwrap_or(d.continuation.max_step),
+            shooting: ShootingOptions {
+                cancel,
+                ..d.continuation.shooting
+            },
             ..d.continuation
         },
     };
@@ -397,8 +412,9 @@ pub fn continue_<'py>(
         None => None,
     };
     let c = py.detach(|| continue_config(&base, &param, start, stop, guess, &options));
-    // The continuation has no checkpoint of its own: a Ctrl-C during it raises here, when it
-    // returns, before any array is made.
+    // A Ctrl-C during the continuation (polled at every step and Newton iteration) stops it
+    // and raises here, before any array is made.
+    cancel_result(&signals)?;
     py.check_signals()?;
     let c = c.map_err(|e| match e {
         BranchError::Value { source, .. } => config_error(source),

@@ -73,7 +73,13 @@ def test_an_interrupt_while_waiting_cancels_the_submitted_tasks():
         def cancel(self, futures, force=False):
             Client.cancelled = (list(futures), force)
 
-    futures = ["f1", "f2", "f3"]
+    class Future:
+        status = "finished"
+
+        def done(self):
+            return True
+
+    futures = [Future(), Future(), Future()]
     with pytest.raises(KeyboardInterrupt):
         vibrotribo.dask._gather(Client(), futures)
     assert Client.cancelled == (futures, True)

@@ -58,13 +58,13 @@ PARITY = {
     }),
     "periodic": (vt.periodic, {
         "<CONFIG>": "config", "--period": "period", "--transient": "transient",
-        "--mechanics-only": "mechanics_only", "--out": None, "--plot": None,
+        "--mechanics-only": "mechanics_only", "--out": None, "--plot": None, "-q": None,
     }),
     "continue": (vt.continue_, {
         "<CONFIG>": "config", "--param": "param", "--from": "start", "--to": "stop",
         "--period": "period", "--transient": "transient", "--doublings": "doubling_depth",
         "--max-points": "max_points", "--mechanics-only": "mechanics_only", "--out": None,
-        "--plot": None, "--diagram-steps": None, "--mass": None,
+        "--plot": None, "--diagram-steps": None, "--mass": None, "-q": None,
     }),
     "curve": (vt.curve, {
         "<CONFIG>": "config", "--kind": "kind", "--param": "param", "--near": "near",

@@ -32,7 +32,7 @@ import collections.abc
 import hashlib
 import os
 import tempfile
-from typing import Any, Iterable, Literal, Mapping, Optional, Tuple, Union
+from typing import Any, Dict, Iterable, Literal, Mapping, Optional, Tuple, Union, overload
 
 import numpy as np
 
@@ -104,6 +104,12 @@ ChirpSweep = Literal["linear", "logarithmic"]
 Quantity = Literal["displacement", "acceleration"]
 
 
+@overload
+def _count(value: int, name: str, *, least: int = 0) -> int: ...
+@overload
+def _count(value: None, name: str, *, least: int = 0) -> None: ...
+@overload
+def _count(value: Optional[int], name: str, *, least: int = 0) -> Optional[int]: ...
 def _count(value: Optional[int], name: str, *, least: int = 0) -> Optional[int]:
     """``value`` as a whole number of at least ``least`` (None stays None), or a ValueError
     naming the argument."""
@@ -324,7 +330,8 @@ def periodic(
     default 1), as ``vibrotribo periodic --transient 0``. Unless ``mechanics_only``, the
     harvester is run along the orbit: ``Orbit.average_power_w``, as ``vibrotribo periodic``
     reports it. Raises :class:`OrbitNotFound` if Newton does not converge or the motion is
-    not periodic.
+    not periodic. Ctrl-C raises ``KeyboardInterrupt`` within a Newton iteration or a piece
+    of the transient.
     """
     raw = _vibrotribo.periodic(
         _config(config),
@@ -362,8 +369,8 @@ def continue_(
     largest 0.1); ``max_points`` per branch (default 2000). Unless ``mechanics_only``, the
     harvester's average power on every point is computed (``Branch.points["average_power_w"]``,
     as ``vibrotribo continue`` writes it in ``branch.csv``). Ctrl-C raises
-    ``KeyboardInterrupt``: during the power, at the next point; during the continuation
-    itself (which has no checkpoint), when it returns.
+    ``KeyboardInterrupt``: during the continuation, within a step (the continuation is
+    stopped there); during the power, at the next point.
     """
     raw = _vibrotribo.continue_(
         _config(config),
@@ -706,7 +713,8 @@ def export_spice(
         check=check,
         allow_large=allow_large,
     )
-    return SpiceExport(**{k: (tuple(v) if k == "window_s" else v) for k, v in raw.items()})
+    fields: Dict[str, Any] = {k: (tuple(v) if k == "window_s" else v) for k, v in raw.items()}
+    return SpiceExport(**fields)
 
 
 def with_base_motion(
@@ -758,7 +766,7 @@ def _floats(values: Iterable[float]) -> list:
     return [float(v) for v in np.asarray(values, dtype=float).ravel()]
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     # `vibrotribo.dask` without importing dask until it is used.
     if name == "dask":
         import importlib

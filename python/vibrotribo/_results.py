@@ -5,9 +5,12 @@ installed. All of them pickle (Dask sends them between processes)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterator, List, Mapping, Optional
+from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Mapping, Optional
 
 import numpy as np
+
+if TYPE_CHECKING:  # pandas is optional: only to_pandas() needs it
+    import pandas
 
 from ._display import Display
 
@@ -25,7 +28,7 @@ __all__ = [
 ]
 
 
-def _pandas():
+def _pandas() -> Any:
     try:
         import pandas
     except ImportError as e:  # pragma: no cover - depends on the environment
@@ -76,10 +79,10 @@ class Table(Mapping[str, np.ndarray]):
             return columns[name]
         raise AttributeError(name)
 
-    def __getstate__(self):
+    def __getstate__(self) -> Dict[str, np.ndarray]:
         return self._columns
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: Dict[str, np.ndarray]) -> None:
         self._columns = state
 
     @property
@@ -113,7 +116,7 @@ class Table(Mapping[str, np.ndarray]):
         except ImportError:  # pragma: no cover - without pandas
             return "<pre>" + repr(self) + "</pre>"
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The table as a pandas DataFrame (same column names)."""
         return _pandas().DataFrame(dict(self._columns))
 
@@ -186,7 +189,7 @@ class Events(Display):
         columns.update(zip(_numbered("v", n, "_m_s"), self.v.T))
         return Table(columns)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The events as a pandas DataFrame with the columns of ``events.csv``."""
         return self.table().to_pandas()
 
@@ -285,7 +288,7 @@ class Simulation(Display):
         columns.update(zip(_numbered("d", n - 1, "_m"), self.d.T))
         return Table(columns)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The samples as a pandas DataFrame with the columns of ``trajectory.csv``."""
         return self.table().to_pandas()
 
@@ -346,7 +349,7 @@ class Sweep(Display):
 
     __hash__ = None  # type: ignore[assignment]
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The summary table as a pandas DataFrame."""
         return self.summary.to_pandas()
 
@@ -369,7 +372,7 @@ class Map(Display):
         ny, nx = len(self.settings["y_values"]), len(self.settings["x_values"])
         return self.summary[column].reshape(ny, nx)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The map as a pandas DataFrame."""
         return self.summary.to_pandas()
 
@@ -408,7 +411,7 @@ class LoadSweep(Display):
     def _from(cls, raw: Dict[str, Any]) -> "LoadSweep":
         return cls(**dict(raw, points=Table(raw["points"]), vq_cycle=Table(raw["vq_cycle"])))
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The points as a pandas DataFrame."""
         return self.points.to_pandas()
 
@@ -460,7 +463,7 @@ class Orbit(Display):
     def _from(cls, raw: Dict[str, Any]) -> "Orbit":
         return cls(**dict(raw, events=Table(raw["events"])))
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The orbit as a one-row pandas DataFrame: period, stability, spectral radius,
         power and the state ``x1_m …``, ``v1_m_s …`` at t = 0."""
         row: Dict[str, Any] = {
@@ -507,7 +510,7 @@ class Lyapunov(Display):
     running_periods: np.ndarray
     running: np.ndarray
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The running estimates as a pandas DataFrame: ``periods`` and one column
         ``lambda1_1_s …`` per exponent (1/s), a row per batch."""
         columns: Dict[str, Any] = {"periods": self.running_periods}
@@ -563,7 +566,7 @@ class Branch(Display):
             columns[k] = p[k]
         return Table(columns)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The points as a pandas DataFrame (the columns of :meth:`table`)."""
         return self.table().to_pandas()
 
@@ -585,7 +588,7 @@ class Continuation(Display):
         """Every bifurcation of every branch, each with its ``branch`` index."""
         return [dict(b, branch=j) for j, br in enumerate(self.branches) for b in br.bifurcations]
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """Every point of every branch as one pandas DataFrame: ``branch`` (index),
         ``period`` and the columns of :meth:`Branch.table`."""
         pd = _pandas()

@@ -6,9 +6,12 @@ leaves a cell empty), counts int64 (−1 where the file leaves a cell empty), te
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, Optional
+from typing import TYPE_CHECKING, Any, Dict, Optional
 
 import numpy as np
+
+if TYPE_CHECKING:  # pandas is optional: only to_pandas() needs it
+    import pandas
 
 from ._display import Display
 from ._results import Table
@@ -63,7 +66,7 @@ class Chirp(Display):
         keep = self.response["direction"] == which
         return Table({k: v[keep] for k, v in self.response.items()})
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The response as a pandas DataFrame."""
         return self.response.to_pandas()
 
@@ -100,7 +103,7 @@ class Basins(Display):
         ny, nx = len(self.settings["y_values"]), len(self.settings["x_values"])
         return self.basins[column].reshape(ny, nx)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The basins table as a pandas DataFrame."""
         return self.basins.to_pandas()
 
@@ -128,7 +131,7 @@ class Attractors(Display):
     def _from(cls, raw: Dict[str, Any]) -> "Attractors":
         return cls(Table(raw["attractors"]), Table(raw["expected_power"]), raw["settings"])
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The attractors table as a pandas DataFrame."""
         return self.attractors.to_pandas()
 
@@ -165,7 +168,7 @@ class MassRatioOptimum(Display):
         n_w = len(self.settings["omega_values"])
         return self.power_grid["average_power_w"].reshape(n_w, -1)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The optima as a pandas DataFrame."""
         return self.optimum.to_pandas()
 
@@ -203,7 +206,7 @@ class SpiceExport(Display):
         with open(path, "w") as f:
             f.write(self.netlist)
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The gap waveforms as a pandas DataFrame: ``time_s``, ``d1_m …``."""
         from ._results import _pandas
 

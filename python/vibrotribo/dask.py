@@ -28,7 +28,8 @@ imported until a sweep is submitted::
 from __future__ import annotations
 
 import math
-from typing import Any, Iterable, List, Optional
+import time
+from typing import Any, Dict, Iterable, List, Optional
 
 import numpy as np
 
@@ -38,11 +39,27 @@ from . import sweep as _serial_sweep
 
 __all__ = ["sweep", "map", "basins"]
 
+_POLL_S = 0.05
+"""How often the waiting loop looks at the futures, s."""
+
 
 def _gather(client: Any, futures: List[Any]) -> List[Any]:
     """The results of ``futures`` in order; on an interrupt or an error the futures not yet
-    done are cancelled first (the workers stop), then the exception is raised."""
+    done are cancelled first (the workers stop), then the exception is raised.
+
+    The waiting happens here, in Python, until every future is done (or one failed): a
+    Ctrl-C then lands in this loop, not inside the client's gathering coroutine, which an
+    interrupt would leave behind with a "Task exception was never retrieved"."""
     try:
+        i = 0
+        while i < len(futures):
+            f = futures[i]
+            if f.status == "error":
+                break  # gather raises its exception
+            if f.done():
+                i += 1
+            else:
+                time.sleep(_POLL_S)
         return client.gather(futures)
     except BaseException:
         client.cancel(futures, force=True)
@@ -97,7 +114,7 @@ def sweep(
         )
     cfg = _config(config)
     vals = _values(values, "values")
-    kwargs = dict(
+    kwargs: Dict[str, Any] = dict(
         transient=transient,
         recorded=recorded,
         mechanics_only=mechanics_only,
@@ -165,7 +182,7 @@ def map(  # noqa: A001 - the command's name
     returns for the same arguments."""
     cfg = _config(config)
     xs, ys = _values(x_values, "x_values"), _values(y_values, "y_values")
-    kwargs = dict(
+    kwargs: Dict[str, Any] = dict(
         transient=transient,
         recorded=recorded,
         mechanics_only=mechanics_only,
@@ -235,8 +252,8 @@ def basins(
 
     cfg = _config(config)
     nx, ny = _count(grid[0], "grid[0]", least=1), _count(grid[1], "grid[1]", least=1)
-    options = dict(cell=cell, section_tolerance=section_tolerance, match_tolerance=match_tolerance)
-    run = dict(
+    options: Dict[str, Any] = dict(cell=cell, section_tolerance=section_tolerance, match_tolerance=match_tolerance)
+    run: Dict[str, Any] = dict(
         transient=transient,
         recorded=recorded,
         mechanics_only=mechanics_only,
@@ -250,7 +267,7 @@ def basins(
                            **dict(run, transient=0, recorded=1, settle="fixed"), threads=1)
     xs = _vibrotribo.grid(float(x_from), float(x_to), int(nx)).tolist()
     ys = _vibrotribo.grid(float(y_from), float(y_to), int(ny)).tolist()
-    kwargs = dict(options, **run, threads=threads)
+    kwargs: Dict[str, Any] = dict(options, **run, threads=threads)
     futures = client.map(
         _basin_row,
         [cfg] * len(ys),

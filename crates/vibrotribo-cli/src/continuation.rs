@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use vibrotribo::ChainParams;
-use vibrotribo::branch::{BranchOptions, config_family, continue_config};
+use vibrotribo::branch::{BranchError, BranchOptions, config_family, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
-    Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
+    Bifurcation, BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions, OrbitError,
+    ShootingOptions,
 };
 
 use crate::branch_picture::Drawing;
@@ -19,6 +20,7 @@ use crate::manifest::{
     BifurcationRecord, BranchRecord, CascadeRecord, ContinueManifest, Kind, ParentRecord, to_value,
 };
 use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
+use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
 
 /// Values of the brute-force orbit diagram under a continuation's picture, by default.
 pub const DEFAULT_DIAGRAM_STEPS: usize = 200;
@@ -66,6 +68,9 @@ pub struct ContinueArgs {
     /// The mass shown in the plot (1-based; default 2, or 1 for a single mass).
     #[arg(long)]
     pub mass: Option<usize>,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 /// Runs `vibrotribo continue`.
@@ -90,25 +95,52 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         continuation: ContinuationOptions {
             doubling_depth: args.doublings,
             max_points: args.max_points,
+            shooting: ShootingOptions {
+                cancel: orbit_cancel(),
+                ..d.continuation.shooting
+            },
             ..d.continuation
         },
     };
-    let result = continue_config(&config, &args.param, args.from, args.to, None, &options)?;
+    let spinner = Progress::spinner("continuing", args.quiet);
+    let result = continue_config(&config, &args.param, args.from, args.to, None, &options);
+    spinner.finish();
+    let result = match result {
+        Err(BranchError::FirstOrbit {
+            source: OrbitError::Cancelled,
+            ..
+        }) => {
+            return Err(Interrupted {
+                what: "stopped before the first orbit was found; nothing written".into(),
+            }
+            .into());
+        }
+        other => other?,
+    };
     let family = config_family(&config, &args.param);
     let power = if args.mechanics_only {
         None
     } else {
-        Some(vibrotribo::branch::branch_powers(
-            &config,
-            &args.param,
-            &result,
-            || std::ops::ControlFlow::Continue(()),
-        ))
+        let points = result.branches.iter().map(|b| b.points.len() as u64).sum();
+        let bar = Progress::new(points, "power", args.quiet);
+        let powers = vibrotribo::branch::branch_powers(&config, &args.param, &result, || {
+            bar.inc(1);
+            if interrupted() {
+                std::ops::ControlFlow::Break(())
+            } else {
+                std::ops::ControlFlow::Continue(())
+            }
+        });
+        bar.finish();
+        Some(powers)
     };
+    // Stopped by a signal during the continuation or the power: what was computed is written,
+    // marked incomplete (the power of points not reached is left empty).
+    let complete = result.complete && !interrupted();
     print_continuation(&args.param, &result);
     if let Some(dir) = &args.out {
         create_dir(dir)?;
-        write_files(dir, &config, args, &result, power.as_deref())?;
+        write_files(dir, &config, args, &result, power.as_deref(), complete)?;
         if args.plot {
             let diagram = Diagram {
                 param: &args.param,
@@ -123,6 +155,18 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
             "  wrote {0}/branch.csv, {0}/bifurcations.csv, {0}/continue.json",
             dir.display()
         );
+    }
+    if !complete {
+        return Err(Interrupted {
+            what: match &args.out {
+                Some(dir) => format!(
+                    "the files in {} hold the branches as far as they were followed (\"complete\": false)",
+                    dir.display()
+                ),
+                None => "the branches above are as far as they were followed".into(),
+            },
+        }
+        .into());
     }
     Ok(())
 }
@@ -180,6 +224,7 @@ fn end_text(end: &BranchEnd) -> String {
         }
         BranchEnd::Collapsed { parameter } => format!("fell back onto the half-period orbit at {parameter}"),
         BranchEnd::Closed { parameter } => format!("a closed curve, back at its start at {parameter}"),
+        BranchEnd::Stopped { parameter } => format!("stopped by a signal after {parameter}"),
         other => format!("{other:?}"),
     }
 }
@@ -261,6 +306,7 @@ fn write_files(
     args: &ContinueArgs,
     result: &Continuation,
     power: Option<&[Vec<f64>]>,
+    complete: bool,
 ) -> Result<()> {
     let n = config.chain().len();
     let mut cols: Vec<String> = [
@@ -379,6 +425,7 @@ fn write_files(
         .collect();
     let manifest = ContinueManifest {
         command: Kind::Continue,
+        complete,
         param: args.param.clone(),
         from: args.from,
         to: args.to,

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
-    PeriodicOrbit, ShootingOptions, find_periodic_orbit, periodic_orbit_from_transient,
+    OrbitError, PeriodicOrbit, ShootingOptions, find_periodic_orbit, periodic_orbit_from_transient,
 };
 use vibrotribo::study::ElectricalOutcome;
 use vibrotribo::{ChainState, EventKind, Simulator, UniformSampler};
@@ -16,6 +16,7 @@ use crate::config::ConfigArgs;
 use crate::manifest::{OrbitEventRecord, PeriodicManifest, config_of, read, to_value};
 use crate::output::{create_dir, numbered, si, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
+use crate::progress::{Interrupted, Progress, orbit_cancel};
 
 /// Options of `vibrotribo periodic`.
 #[derive(Debug, clap::Args)]
@@ -39,6 +40,9 @@ pub struct PeriodicArgs {
     /// Also draw the orbit's phase portraits and its multipliers (without --out: into vibrotribo-out/periodic).
     #[arg(long)]
     pub plot: bool,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 /// Runs `vibrotribo periodic`.
@@ -51,11 +55,13 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
     config.check_periodic("periodic orbits (`periodic`)")?;
     let options = ShootingOptions {
         sim: config.sim_options().clone(),
+        cancel: orbit_cancel(),
         ..ShootingOptions::default()
     };
     let chain = config.chain();
+    let spinner = Progress::spinner("shooting", args.quiet);
     let orbit = if args.transient == 0 {
-        find_periodic_orbit(chain, config.initial_state(), args.period.unwrap_or(1), &options)?
+        find_periodic_orbit(chain, config.initial_state(), args.period.unwrap_or(1), &options)
     } else {
         periodic_orbit_from_transient(
             chain,
@@ -63,7 +69,18 @@ pub fn run(args: &PeriodicArgs) -> Result<()> {
             args.transient,
             args.period,
             &options,
-        )?
+        )
+    };
+    spinner.finish();
+    let orbit = match orbit {
+        // No orbit to write: a periodic.json holds a converged orbit or is not written.
+        Err(OrbitError::Cancelled) => {
+            return Err(Interrupted {
+                what: "stopped before the orbit was found; nothing written".into(),
+            }
+            .into());
+        }
+        other => other?,
     };
     // A single mass (against a stop) has no gap between masses to harvest from.
     let power = if args.mechanics_only {

@@ -147,3 +147,25 @@ impl Progress {
         }
     }
 }
+
+impl Progress {
+    /// A spinner with the elapsed time, labelled `what`, for a computation of unknown length;
+    /// hidden if `quiet` or not on a terminal.
+    pub fn spinner(what: &str, quiet: bool) -> Self {
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = ProgressBar::new_spinner();
+            bar.set_style(
+                ProgressStyle::with_template("{msg:>12} {spinner} {elapsed}").expect("valid template"),
+            );
+            bar.set_message(what.to_string());
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar
+        });
+        Progress { bar }
+    }
+}
+
+/// A cancel hook for the library's orbit solvers that asks them to stop after SIGINT/SIGTERM.
+pub fn orbit_cancel() -> vibrotribo::orbits::Cancel {
+    vibrotribo::orbits::Cancel::new(interrupted)
+}

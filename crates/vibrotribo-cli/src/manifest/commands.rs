@@ -287,6 +287,10 @@ pub struct CascadeRecord {
 pub struct ContinueManifest {
     /// Always [`Kind::Continue`].
     pub command: Kind,
+    /// Whether the continuation ran to its ends (`false`: stopped by a signal; the branches
+    /// so far are written).
+    #[serde(default = "finished")]
+    pub complete: bool,
     /// The continued key.
     pub param: String,
     /// Start of the range.
@@ -311,6 +315,11 @@ pub struct ContinueManifest {
     pub settings: Value,
     /// The program's version.
     pub vibrotribo_version: String,
+}
+
+/// What a manifest without a `complete` key describes: a finished job.
+fn finished() -> bool {
+    true
 }
 
 /// The air-breakdown margin at one load over the last period.

@@ -5,6 +5,7 @@ mod basins;
 mod chirp;
 mod closed_pipe_and_full_disk;
 mod composition;
+mod continue_and_periodic_stop_on_signals;
 mod excitation;
 mod export_spice_stays_in_its_run;
 mod grid_jobs_on_one_mass;

@@ -85,6 +85,9 @@ pub enum OrbitError {
     /// not converge, or the matrix is not finite).
     #[error("the Floquet multipliers could not be computed")]
     Eigenvalues,
+    /// The caller asked the search to stop ([`ShootingOptions::cancel`](super::ShootingOptions::cancel)).
+    #[error("the search for a periodic orbit was stopped")]
+    Cancelled,
 }
 
 /// `1.0e-3, 2.5e-5, …`

@@ -48,6 +48,7 @@
 //! approaching a new impact) includes the stops' gaps: the textbook orbit that never touches
 //! the stop meets it where its steady amplitude equals the gap.
 
+mod cancel;
 pub mod continuation;
 pub mod curve;
 mod error;
@@ -56,6 +57,7 @@ mod gaps;
 mod map;
 mod shooting;
 
+pub use cancel::Cancel;
 pub use continuation::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
     Crossing, CrossingKind, NordmarkScenario, cascade, continue_orbit, feigenbaum_ratios,

@@ -2,6 +2,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
+use super::cancel::{Cancel, Polled};
 use super::error::{NewtonFailure, OrbitError};
 use super::floquet::{floquet_multipliers, is_stable};
 use super::map::{MapEval, Scale, chatter_bounces, evaluate, project_closed};
@@ -26,6 +27,10 @@ pub struct ShootingOptions {
     pub sim: SimOptions,
     /// Settings of the sensitivities (grazing and simultaneity thresholds).
     pub sensitivity: SensitivityOptions,
+    /// Polled at every Newton iteration and through the transient of
+    /// [`periodic_orbit_from_transient`]: when it asks, the search stops with
+    /// [`OrbitError::Cancelled`]. Default: never.
+    pub cancel: Cancel,
 }
 
 impl Default for ShootingOptions {
@@ -36,6 +41,7 @@ impl Default for ShootingOptions {
             min_damping: 1.0 / 1024.0,
             sim: SimOptions::default(),
             sensitivity: SensitivityOptions::default(),
+            cancel: Cancel::never(),
         }
     }
 }
@@ -212,6 +218,9 @@ pub(crate) fn newton_within(
         if residual <= options.tolerance {
             return Ok(Converged { z, eval, residuals });
         }
+        if options.cancel.requested() {
+            return Err(OrbitError::Cancelled);
+        }
         let Ok(phi) = &eval.stm else {
             return Err(fail(NewtonFailure::NonSmooth, residuals));
         };
@@ -334,7 +343,11 @@ pub fn periodic_orbit_from_transient(
     let n = params.len();
     let mut sim = Simulator::new(params, initial, options.sim.clone())?;
     let t_transient = f64::from(transient_periods) * params.period();
-    sim.run_until(t_transient, &mut ())?;
+    let cancel = &options.cancel;
+    sim.run_until(t_transient, &mut Polled { inner: (), cancel })?;
+    if cancel.requested() {
+        return Err(OrbitError::Cancelled);
+    }
     let (guess, period) = match period {
         Some(p) => (sim.state(), p),
         None => {
@@ -354,7 +367,14 @@ pub fn periodic_orbit_from_transient(
                 },
             )
             .map_err(|_| ParamError::invalid("excitation period", params.period(), "must be positive"))?;
-            sim.run_until(t_transient + samples as f64 * params.period(), &mut strobe)?;
+            let mut polled = Polled {
+                inner: &mut strobe,
+                cancel,
+            };
+            sim.run_until(t_transient + samples as f64 * params.period(), &mut polled)?;
+            if cancel.requested() {
+                return Err(OrbitError::Cancelled);
+            }
             let verdict =
                 detect_period(&strobe.positions, n, &popts).map_err(|_| OrbitError::NotPeriodic {
                     max_period: popts.max_period,

@@ -120,7 +120,12 @@ where
         parent: None,
         start: Start::Orbit(state_vector(&orbit.state), from),
     }]);
+    let mut complete = true;
     while let Some(seed) = queue.pop_front() {
+        if options.shooting.cancel.requested() {
+            complete = false;
+            break;
+        }
         let problem = Problem {
             family: &family,
             period: seed.period,
@@ -132,6 +137,7 @@ where
         };
         let direction = if to > from { 1.0 } else { -1.0 };
         let (mut branch, doublings) = follow(&problem, &seed, (lo, hi), direction);
+        complete &= !matches!(branch.end, BranchEnd::Stopped { .. });
         let index = branches.len();
         // A doubled branch that came back to its parent at another period doubling was
         // followed from both ends: drop the seed at the other end.
@@ -166,10 +172,27 @@ where
         }
         branches.push(branch);
     }
+    if !complete {
+        // Period doublings whose branches were not followed have no child.
+        let followed = branches.len();
+        for b in &mut branches {
+            for bif in &mut b.bifurcations {
+                bif.child = bif.child.filter(|c| *c < followed);
+            }
+        }
+    }
     Ok(Continuation {
         parameter: name.to_string(),
         branches,
+        complete,
     })
+}
+
+/// The end of a branch stopped by the caller after the point `current`.
+fn stopped(current: &StepPoint) -> BranchEnd {
+    BranchEnd::Stopped {
+        parameter: current.described.point.parameter,
+    }
 }
 
 /// The first point of a branch and its tangent.
@@ -337,6 +360,10 @@ fn follow<F: Fn(f64) -> ChainParams>(
     // by log2(initial/min), so this bound is never reached by a healthy branch.
     let passes = opts.max_points * 64;
     for _ in 0..passes {
+        if opts.shooting.cancel.requested() {
+            branch.end = stopped(&current);
+            return (branch, doublings);
+        }
         if too_close(&problem, &current)
             && let Some((phase, point, tangent)) = move_section(&problem, &current, &t)
         {
@@ -369,6 +396,11 @@ fn follow<F: Fn(f64) -> ChainParams>(
                 ds *= 0.5;
                 if ds >= opts.min_step {
                     continue;
+                }
+                // A search stopped by the caller is not a corner of the branch.
+                if opts.shooting.cancel.requested() {
+                    branch.end = stopped(&current);
+                    return (branch, doublings);
                 }
                 // A corner the arclength corrector cannot turn (grazing): step across in
                 // the parameter, the way the branch was going.
@@ -420,6 +452,10 @@ fn follow<F: Fn(f64) -> ChainParams>(
                         t = c.tangent;
                         ds = opts.initial_step;
                         continue;
+                    }
+                    None if opts.shooting.cancel.requested() => {
+                        branch.end = stopped(&current);
+                        return (branch, doublings);
                     }
                     None => {}
                 }

@@ -338,6 +338,13 @@ pub enum BranchEnd {
         /// Parameter of the first point.
         parameter: f64,
     },
+    /// The caller asked the continuation to stop
+    /// ([`ShootingOptions::cancel`](crate::orbits::ShootingOptions::cancel), polled at every
+    /// step): the branch is cut after its last point, and no further branch is followed.
+    Stopped {
+        /// Parameter of the last point (NaN if the branch has none).
+        parameter: f64,
+    },
 }
 
 /// One branch of periodic orbits.
@@ -363,4 +370,7 @@ pub struct Continuation {
     pub parameter: String,
     /// The branches: the first, then the period-doubled ones in the order they were found.
     pub branches: Vec<Branch>,
+    /// Whether every branch found was followed to its end: `false` when the caller stopped
+    /// the continuation ([`BranchEnd::Stopped`], or period doublings left unfollowed).
+    pub complete: bool,
 }
