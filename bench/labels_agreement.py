@@ -10,8 +10,10 @@ whose long run is periodic, how often the default sweep gives the same period an
 per period, another period, `settling`, or a non-periodic label; for points whose long run is
 not periodic, how often the default sweep claims a period.
 
-Usage: bench/labels_agreement.py BINARY [POINTS] [SEED] [--csv FILE]
-(BINARY: a release build of vibrotribo; POINTS default 500; SEED default 1.)
+Usage: bench/labels_agreement.py BINARY [POINTS] [SEED] [--csv FILE] [--part I/N]
+(BINARY: a release build of vibrotribo; POINTS default 500; SEED default 1; --part I/N runs
+only the points k with k mod N = I, the same points as the whole run draws, so that N
+processes side by side cover it; their tables add up.)
 """
 
 import csv
@@ -60,6 +62,10 @@ def main():
     out_csv = sys.argv[sys.argv.index("--csv") + 1] if "--csv" in sys.argv else None
     if out_csv in args:
         args.remove(out_csv)
+    part = sys.argv[sys.argv.index("--part") + 1] if "--part" in sys.argv else "0/1"
+    if part in args:
+        args.remove(part)
+    part_i, part_n = (int(x) for x in part.split("/"))
     binary = args[0]
     n = int(args[1]) if len(args) > 1 else 500
     rng = random.Random(int(args[2]) if len(args) > 2 else 1)
@@ -69,6 +75,8 @@ def main():
         chain = "default" if k % 2 == 0 else "chatter"
         omega, rm = rng.uniform(0.3, 1.2), rng.uniform(1.0, 7.0)
         rd, mu = rng.uniform(1.0, 1.5), rng.uniform(0.3, 0.9)
+        if k % part_n != part_i:
+            continue
         auto = point(binary, chain, omega, rm, rd, mu, [])
         long = point(binary, chain, omega, rm, rd, mu, ["--settle", "fixed", "--transient", "3000"])
         v = verdict(auto, long)
@@ -86,7 +94,7 @@ def main():
                         "default_period", "label_source", "coexisting_period", "long_motion", "long_period",
                         "verdict"])
             w.writerows(rows)
-    print(f"\n{n} points:")
+    print(f"\n{sum(table.values())} points:")
     for v, c in sorted(table.items()):
         print(f"  {c:5d}  {v}")
 

@@ -15,7 +15,7 @@ sweep() {
     local mode=$1 dir=$2
     local start end
     start=$(date +%s.%N)
-    target/release/vibrotribo sweep configs/chatter.toml --param omega_ratio --from 0.3 --to 1.0 \
+    "${CARGO_TARGET_DIR:-target}"/release/vibrotribo sweep configs/chatter.toml --param omega_ratio --from 0.3 --to 1.0 \
         --steps 201 --transient 300 --recorded 128 --settle "$mode" --out "$dir" --quiet >/dev/null
     end=$(date +%s.%N)
     echo "$end - $start" | bc

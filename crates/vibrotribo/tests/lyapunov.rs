@@ -172,6 +172,40 @@ fn stable_orbits_give_the_logarithms_of_their_multipliers() {
     );
 }
 
+/// The stated error bar (one spread, the ± printed) covers the difference to ln|μ|/T on the
+/// default case's period-1 orbit, whose leading multipliers are a complex pair (two equal
+/// exponents the QR averaging splits), for short and long windows and several seeds.
+#[test]
+fn error_bars_on_a_periodic_orbit_cover_the_floquet_exponents() {
+    let params = ChainParams::default();
+    let orbit = periodic_orbit_from_transient(
+        &params,
+        &ChainState::at_rest(3),
+        200,
+        Some(1),
+        &ShootingOptions::default(),
+    )
+    .unwrap();
+    let expected = floquet_exponents(&orbit);
+    for (seed, periods) in [(1, 200), (2, 200), (1, 1000), (2, 1000), (3, 1000), (4, 1000)] {
+        let options = LyapunovOptions {
+            seed,
+            ..LyapunovOptions::default()
+        };
+        let s = spectrum_of(
+            &run_spec(params.clone(), orbit.state.clone(), 300, periods),
+            &options,
+        );
+        for (i, (got, want)) in s.exponents.iter().zip(&expected).enumerate() {
+            assert!(
+                (got - want).abs() <= s.spread[i],
+                "seed {seed}, {periods} periods, exponent {i}: {got} ± {} vs Floquet {want}",
+                s.spread[i]
+            );
+        }
+    }
+}
+
 #[test]
 fn a_chatter_orbit_has_minus_infinity_exponents_for_its_stuck_directions() {
     // Every period a chatter sequence ends in sticking: two zero multipliers.

@@ -64,8 +64,10 @@ pub struct LyapunovSpectrum {
     /// than 8 of its standard errors from 0), with the largest difference between the final exponent and
     /// the [`running`](Self::running) estimates over the second half of the window (the
     /// finite-time bias of a window whose tangent vectors are still aligning, which the
-    /// scatter of the batches does not measure); NaN with fewer than two periods, 0 for a
-    /// `−∞` exponent.
+    /// scatter of the batches does not measure); plus half the gap to a neighbouring
+    /// exponent within 1 % of it (two estimates of one exponent, such as the pair of a
+    /// complex Floquet multiplier, that the averaging splits); NaN with fewer than two
+    /// periods, 0 for a `−∞` exponent.
     pub spread: Vec<f64>,
     /// Number of `−∞` exponents: 2 per contact stuck at the same time at the worst moment of
     /// the averaged window (a stuck contact, or a chatter sequence that ends in one,
@@ -119,6 +121,34 @@ fn trending(values: &[f64]) -> bool {
     slope.abs() > 8.0 * se
 }
 
+/// Neighbouring exponents closer than this fraction of the larger modulus are taken as one
+/// exponent the run does not resolve (see [`widen_unresolved`]).
+const UNRESOLVED: f64 = 0.01;
+
+/// The spreads of `exponents` (largest first) widened by half the gap to a neighbour closer
+/// than [`UNRESOLVED`] of the larger modulus. A pair of complex Floquet multipliers gives
+/// two equal exponents, which the QR averaging splits into a larger and a smaller estimate
+/// about their common value; the split persists over the window (it does not shrink like
+/// the batch scatter), so it is part of each estimate's error, not of its scatter.
+fn widen_unresolved(exponents: &[f64], spread: &[f64]) -> Vec<f64> {
+    let half_gap = |i: usize, j: usize| {
+        let (a, b) = (exponents[i], exponents[j]);
+        let close = a.is_finite() && b.is_finite() && (a - b).abs() <= UNRESOLVED * a.abs().max(b.abs());
+        if close { (a - b).abs() / 2.0 } else { 0.0 }
+    };
+    (0..exponents.len())
+        .map(|i| {
+            let before = if i > 0 { half_gap(i - 1, i) } else { 0.0 };
+            let after = if i + 1 < exponents.len() {
+                half_gap(i, i + 1)
+            } else {
+                0.0
+            };
+            spread[i] + before.max(after)
+        })
+        .collect()
+}
+
 impl LyapunovSpectrum {
     /// Builds the spectrum from the period logs: exponents per column of the tangent basis,
     /// the last `collapsed` set to −∞, sorted largest first.
@@ -170,9 +200,11 @@ impl LyapunovSpectrum {
         let mut order: Vec<usize> = (0..dim).collect();
         order.sort_by(|&a, &b| exponents[b].total_cmp(&exponents[a]));
         let permute = |v: &[f64]| order.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+        let exponents = permute(&exponents);
+        let spread = widen_unresolved(&exponents, &permute(&spread));
         LyapunovSpectrum {
-            exponents: permute(&exponents),
-            spread: permute(&spread),
+            exponents,
+            spread,
             collapsed,
             periods: periods as u64,
             time: logs.times.iter().sum(),
@@ -275,6 +307,18 @@ mod tests {
             "{} vs {se}",
             s.spread[0]
         );
+    }
+
+    /// Two estimates within 1 % of each other carry half their gap; a distinct neighbour,
+    /// a `−∞` one or a NaN spread is left as it is.
+    #[test]
+    fn unresolved_neighbours_carry_half_their_gap() {
+        let e = [-1.3210, -1.3220, -3.5, f64::NEG_INFINITY];
+        let w = widen_unresolved(&e, &[1e-5, 2e-5, 3e-3, 0.0]);
+        assert!((w[0] - (1e-5 + 5e-4)).abs() < 1e-15, "{w:?}");
+        assert!((w[1] - (2e-5 + 5e-4)).abs() < 1e-15, "{w:?}");
+        assert_eq!(&w[2..], &[3e-3, 0.0]);
+        assert!(widen_unresolved(&[0.3, 0.298], &[f64::NAN, 0.0])[0].is_nan());
     }
 
     #[test]

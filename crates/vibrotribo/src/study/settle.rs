@@ -230,6 +230,15 @@ fn strobe_run(
 /// At most this many Newton attempts per point.
 const MAX_SHOTS: u32 = 3;
 
+/// Newton iterations a shot may take. It starts within the geometric tail of a stable orbit,
+/// where Newton's method on a smooth map converges quadratically in a few iterations; one
+/// that needs more is not near the orbit the fit sees (or meets a map that is not smooth
+/// there), and the run settles on its own instead.
+const SHOT_ITERATIONS: usize = 10;
+
+/// Smallest damping factor of a shot's line search (see [`SHOT_ITERATIONS`]).
+const SHOT_MIN_DAMPING: f64 = 1.0 / 32.0;
+
 /// Settles `params` from `initial` (see the module docs of `study/settle.rs`): runs `sim_options`'
 /// mechanics in blocks until the period test of `options` passes on the trailing returns,
 /// Newton shooting finishes a geometric approach, the returns prove irregular after
@@ -368,6 +377,8 @@ impl Shot<'_> {
             p as u32,
             &ShootingOptions {
                 sim: self.sim_options.clone(),
+                max_iterations: SHOT_ITERATIONS,
+                min_damping: SHOT_MIN_DAMPING,
                 ..ShootingOptions::default()
             },
         ) else {
