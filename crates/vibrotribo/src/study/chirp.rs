@@ -15,8 +15,8 @@ use thiserror::Error;
 use toml::Value;
 
 use super::observer::{RunObserver, Sample};
-use super::settings::Sampling;
 use super::point::PointError;
+use super::settings::Sampling;
 use super::simulate::{RunOutcome, StudyError, simulate};
 use crate::config::{Config, ConfigError};
 use crate::dynamics::{Event, EventKind, StateView};
