@@ -125,7 +125,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
 }
 
 /// What a bifurcation is, in words, with its detail.
-fn describe(kind: &BifurcationKind) -> (&'static str, String) {
+pub fn describe(kind: &BifurcationKind) -> (&'static str, String) {
     match kind {
         BifurcationKind::Fold => ("fold", String::new()),
         BifurcationKind::BranchPoint => ("branch_point", String::new()),
@@ -152,7 +152,8 @@ fn describe(kind: &BifurcationKind) -> (&'static str, String) {
     }
 }
 
-fn end_text(end: &BranchEnd) -> String {
+/// How a branch ends, in words.
+pub fn end_text(end: &BranchEnd) -> String {
     match end {
         BranchEnd::RangeEnd { parameter } => format!("range end at {parameter}"),
         BranchEnd::MaxPoints => "point limit reached".into(),
@@ -252,13 +253,13 @@ fn multipliers_text(p: &BranchPoint) -> String {
         .join(" ")
 }
 
-fn write_files(
-    dir: &Path,
+/// The columns and rows of `branch.csv`: every point of every branch, numbers written
+/// exactly (`power`: the average power along each branch, W, if computed).
+pub fn branch_table(
     config: &Config,
-    args: &ContinueArgs,
     result: &Continuation,
     power: Option<&[Vec<f64>]>,
-) -> Result<()> {
+) -> (Vec<String>, Vec<Vec<String>>) {
     let n = config.chain().len();
     let mut cols: Vec<String> = [
         "branch",
@@ -279,7 +280,7 @@ fn write_files(
         "",
     ));
     cols.extend(["min_closing_speed_m_s", "sticks", "average_power_w", "arclength"].map(String::from));
-    let mut csv = CsvFile::create(&dir.join("branch.csv"), &cols)?;
+    let mut rows = Vec::new();
     for (i, b) in result.branches.iter().enumerate() {
         for (j, p) in b.points.iter().enumerate() {
             let mut row = vec![
@@ -307,8 +308,23 @@ fn write_files(
                     .map_or(String::new(), |v| v.to_string()),
             );
             row.push(p.arclength.to_string());
-            csv.row(row)?;
+            rows.push(row);
         }
+    }
+    (cols, rows)
+}
+
+fn write_files(
+    dir: &Path,
+    config: &Config,
+    args: &ContinueArgs,
+    result: &Continuation,
+    power: Option<&[Vec<f64>]>,
+) -> Result<()> {
+    let (cols, rows) = branch_table(config, result, power);
+    let mut csv = CsvFile::create(&dir.join("branch.csv"), &cols)?;
+    for row in rows {
+        csv.row(row)?;
     }
     csv.flush()?;
     let mut bif = CsvFile::create(
@@ -419,7 +435,7 @@ fn bifurcation_json(branch: usize, f: &Bifurcation) -> serde_json::Value {
 }
 
 /// The positions of `mass` at t = kT, k = 0 … period − 1, along the orbit through `state`.
-fn section_positions(
+pub fn section_positions(
     chain: &ChainParams,
     state: &ChainState,
     period: u32,
