@@ -104,7 +104,7 @@ enum Work {
 
 /// What one point gave.
 enum Outcome {
-    Point(PointResult),
+    Point(Box<PointResult>),
     Start(Fingerprint),
 }
 
@@ -404,7 +404,7 @@ impl GridJob {
     fn run_point(&self, p: (usize, usize)) -> Result<Outcome, SweepError> {
         let keys = self.point_keys(p);
         match &self.work {
-            Work::Points(runner) => runner.run(&keys, None).map(Outcome::Point),
+            Work::Points(runner) => runner.run(&keys, None).map(|p| Outcome::Point(Box::new(p))),
             Work::Starts { starts, .. } => starts.run(&keys, None).map(Outcome::Start),
         }
     }
