@@ -77,6 +77,7 @@ def test_orbit_diagram_zoom_and_click(page, artefacts):
     page.screenshot(path=str(artefacts / "orbit.png"), full_page=True)
     # Drag a box over the middle: that region is computed anew (24 new values inside it).
     over = page.locator("#chart-orbit .u-over")
+    over.scroll_into_view_if_needed()
     box = over.bounding_box()
     x0, x1 = box["x"] + box["width"] * 0.3, box["x"] + box["width"] * 0.6
     y0, y1 = box["y"] + 5, box["y"] + box["height"] - 5
@@ -89,6 +90,7 @@ def test_orbit_diagram_zoom_and_click(page, artefacts):
         "() => Number(document.querySelector('[data-testid=\"orbit-from\"]').value) > 0.5"
     )
     wait_orbit_done(page)
+    over.scroll_into_view_if_needed()
     box = over.bounding_box()
     lo = float(page.get_by_test_id("orbit-from").input_value())
     hi = float(page.get_by_test_id("orbit-to").input_value())

@@ -215,7 +215,7 @@ fn marker_of(kind: &str) -> (&'static str, Shape, usize) {
 type Marks = (&'static str, Shape, usize, Vec<f64>, Vec<f64>);
 
 /// The positions of `mass` at t = kT, k = 0 … period − 1, along the orbit through `state`.
-fn section_positions(
+pub fn section_positions(
     chain: &ChainParams,
     state: &ChainState,
     period: u32,

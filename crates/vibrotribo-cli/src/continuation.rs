@@ -172,7 +172,7 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
 }
 
 /// What a bifurcation is, in words, with its detail.
-pub(crate) fn describe(kind: &BifurcationKind) -> (&'static str, String) {
+pub fn describe(kind: &BifurcationKind) -> (&'static str, String) {
     match kind {
         BifurcationKind::Fold => ("fold", String::new()),
         BifurcationKind::BranchPoint => ("branch_point", String::new()),
@@ -199,7 +199,8 @@ pub(crate) fn describe(kind: &BifurcationKind) -> (&'static str, String) {
     }
 }
 
-fn end_text(end: &BranchEnd) -> String {
+/// How a branch ends, in words.
+pub fn end_text(end: &BranchEnd) -> String {
     match end {
         BranchEnd::RangeEnd { parameter } => format!("range end at {parameter}"),
         BranchEnd::MaxPoints => "point limit reached".into(),
@@ -300,14 +301,13 @@ fn multipliers_text(p: &BranchPoint) -> String {
         .join(" ")
 }
 
-fn write_files(
-    dir: &Path,
+/// The columns and rows of `branch.csv`: every point of every branch, numbers written
+/// exactly (`power`: the average power along each branch, W, if computed).
+pub fn branch_table(
     config: &Config,
-    args: &ContinueArgs,
     result: &Continuation,
     power: Option<&[Vec<f64>]>,
-    complete: bool,
-) -> Result<()> {
+) -> (Vec<String>, Vec<Vec<String>>) {
     let n = config.chain().len();
     let mut cols: Vec<String> = [
         "branch",
@@ -328,7 +328,7 @@ fn write_files(
         "",
     ));
     cols.extend(["min_closing_speed_m_s", "sticks", "average_power_w", "arclength"].map(String::from));
-    let mut csv = CsvFile::create(&dir.join("branch.csv"), &cols)?;
+    let mut rows = Vec::new();
     for (i, b) in result.branches.iter().enumerate() {
         for (j, p) in b.points.iter().enumerate() {
             let mut row = vec![
@@ -356,8 +356,24 @@ fn write_files(
                     .map_or(String::new(), |v| v.to_string()),
             );
             row.push(p.arclength.to_string());
-            csv.row(row)?;
+            rows.push(row);
         }
+    }
+    (cols, rows)
+}
+
+fn write_files(
+    dir: &Path,
+    config: &Config,
+    args: &ContinueArgs,
+    result: &Continuation,
+    power: Option<&[Vec<f64>]>,
+    complete: bool,
+) -> Result<()> {
+    let (cols, rows) = branch_table(config, result, power);
+    let mut csv = CsvFile::create(&dir.join("branch.csv"), &cols)?;
+    for row in rows {
+        csv.row(row)?;
     }
     csv.flush()?;
     let mut bif = CsvFile::create(

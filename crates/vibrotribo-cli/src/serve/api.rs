@@ -11,9 +11,10 @@ use axum::response::{Html, IntoResponse, Response};
 use serde::Deserialize;
 
 use super::assets;
+use super::branches::{BranchRequest, branches as continue_branches};
 use super::cancel::Lane;
 use super::error::ApiError;
-use super::grid::{GridJob, GridRequest};
+use super::grid::{GridJob, GridKind, GridRequest};
 use super::request::{Overrides, body, configure};
 use super::run_view::{RunRequest, run_view};
 use super::schema::schema;
@@ -35,6 +36,8 @@ pub struct AppState {
     pub maps: Lane,
     /// Basin (initial-condition grid) requests.
     pub basins: Lane,
+    /// Continuation requests.
+    pub continuations: Lane,
 }
 
 /// The shared state.
@@ -106,7 +109,7 @@ pub async fn toml(State(state): State<Shared>, bytes: Bytes) -> Result<Response,
 /// `POST /api/run`: the run view (see [`run_view`]); a newer run request stops this one (409).
 pub async fn run(State(state): State<Shared>, bytes: Bytes) -> Result<Response, ApiError> {
     let request: RunRequest = body(&bytes)?;
-    let (ticket, _guard) = state.runs.take();
+    let (ticket, _guard) = state.runs.take(request.seq)?;
     let shared = Arc::clone(&state);
     let view = tokio::task::spawn_blocking(move || run_view(&shared.base, &request, ticket))
         .await
@@ -114,39 +117,46 @@ pub async fn run(State(state): State<Shared>, bytes: Bytes) -> Result<Response, 
     Ok(Json(view).into_response())
 }
 
-/// `POST /api/orbit` (one axis) and `POST /api/map` (two axes): the grid's points streamed as
-/// JSON lines.
-async fn grid(state: &Shared, bytes: &[u8], lane: fn(&AppState) -> &Lane) -> Result<Response, ApiError> {
-    let two_axes = !std::ptr::eq(lane(state), &state.orbits);
+/// `POST /api/orbit` (one axis), `POST /api/map` and `POST /api/basins` (two axes): the
+/// grid's points streamed as JSON lines. The request's generation is taken on arrival, before
+/// its grid is checked, so that it supersedes every request that arrived before it.
+async fn grid(state: &Shared, bytes: &[u8], lane: &Lane, kind: GridKind) -> Result<Response, ApiError> {
     let request: GridRequest = body(bytes)?;
-    if request.y.is_some() != two_axes {
-        return Err(ApiError::bad(if two_axes {
-            "a map needs the axes x and y"
-        } else {
-            "an orbit diagram has one axis, x (a map: POST /api/map)"
-        }));
-    }
+    let (ticket, guard) = lane.take(request.seq)?;
     let shared = Arc::clone(state);
-    let job = tokio::task::spawn_blocking(move || GridJob::new(&shared.base, &request))
+    let job = tokio::task::spawn_blocking(move || GridJob::new(&shared.base, &request, kind))
         .await
         .map_err(ApiError::failed)??;
-    let (ticket, guard) = lane(state).take();
     Ok(job.stream(ticket, guard))
 }
 
 /// `POST /api/orbit`: the orbit diagram over one parameter, as `vibrotribo sweep` computes it.
 pub async fn orbit(State(state): State<Shared>, bytes: Bytes) -> Result<Response, ApiError> {
-    grid(&state, &bytes, |s| &s.orbits).await
+    grid(&state, &bytes, &state.orbits, GridKind::Orbit).await
 }
 
 /// `POST /api/map`: average power (and motion) on a two-parameter grid, as `vibrotribo map`
 /// computes it.
 pub async fn map(State(state): State<Shared>, bytes: Bytes) -> Result<Response, ApiError> {
-    grid(&state, &bytes, |s| &s.maps).await
+    grid(&state, &bytes, &state.maps, GridKind::Map).await
 }
 
 /// `POST /api/basins`: a grid over two initial-condition keys (`run.initial_positions[i]`,
-/// `run.initial_velocities[i]`), each start run as `vibrotribo map` runs a point.
+/// `run.initial_velocities[i]`), each start fingerprinted and, when all have run, classified
+/// into attractors as `vibrotribo basins` does.
 pub async fn basins(State(state): State<Shared>, bytes: Bytes) -> Result<Response, ApiError> {
-    grid(&state, &bytes, |s| &s.basins).await
+    grid(&state, &bytes, &state.basins, GridKind::Basins).await
+}
+
+/// `POST /api/branches`: the periodic orbits continued over a parameter range, as
+/// `vibrotribo continue` computes them (see [`branches`]); a newer request stops this one
+/// (409) between its steps.
+pub async fn branches(State(state): State<Shared>, bytes: Bytes) -> Result<Response, ApiError> {
+    let request: BranchRequest = body(&bytes)?;
+    let (ticket, _guard) = state.continuations.take(request.seq)?;
+    let shared = Arc::clone(&state);
+    let view = tokio::task::spawn_blocking(move || continue_branches(&shared.base, &request, &ticket))
+        .await
+        .map_err(ApiError::failed)??;
+    Ok(Json(view).into_response())
 }

@@ -56,3 +56,13 @@ impl IntoResponse for ApiError {
         (self.status, Json(Body { error: &self.message })).into_response()
     }
 }
+
+impl From<super::cancel::Outdated> for ApiError {
+    fn from(_: super::cancel::Outdated) -> Self {
+        ApiError {
+            status: StatusCode::CONFLICT,
+            message: "outdated: a request sent after this one (a higher seq) is already being answered"
+                .into(),
+        }
+    }
+}

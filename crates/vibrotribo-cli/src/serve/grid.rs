@@ -1,6 +1,8 @@
-//! The orbit diagram and the power map: the points of a one- or two-parameter grid run by
-//! the point runner of `vibrotribo sweep` and `vibrotribo map` (same options, same checks,
-//! same limits), streamed as newline-delimited JSON as they finish, coarse to fine.
+//! The orbit diagram, the power map and the basins: the points of a one- or two-parameter
+//! grid run by the point runner of `vibrotribo sweep` and `vibrotribo map` (same options,
+//! same checks, same limits), or the starts of `vibrotribo basins` fingerprinted and, once
+//! all are in, classified into attractors as `basins` classifies them; streamed as
+//! newline-delimited JSON as they finish, coarse to fine.
 
 use std::convert::Infallible;
 use std::ops::ControlFlow;
@@ -13,6 +15,10 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use tokio::sync::mpsc;
 use vibrotribo::analysis::Periodicity;
+use vibrotribo::attractors::{
+    AttractorOptions, Classification, DEFAULT_START_PERIODS, Fingerprint, SectionScale, StartRunner,
+    classify, initial_condition_index,
+};
 use vibrotribo::config::Config;
 use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, PointResult, SettleMode};
 use vibrotribo::sweep::{Delivery, PointRunner, SweepError, grid, run_chunks};
@@ -59,6 +65,47 @@ pub struct GridRequest {
     /// Mechanics only (as `--mechanics-only`).
     #[serde(default)]
     pub mechanics_only: bool,
+    /// The client's sequence number of this request (see [`super::cancel`]).
+    #[serde(default)]
+    pub seq: Option<u64>,
+    /// Basins only: `basins --cell` (default 0.05).
+    #[serde(default)]
+    pub cell: Option<f64>,
+    /// Basins only: `basins --section-tolerance` (default 1e-3).
+    #[serde(default)]
+    pub section_tolerance: Option<f64>,
+    /// Basins only: `basins --match-tolerance` (default 3e-3).
+    #[serde(default)]
+    pub match_tolerance: Option<f64>,
+}
+
+/// What a grid computes at each of its points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridKind {
+    /// The orbit diagram: one parameter, each value run as `sweep` runs it.
+    Orbit,
+    /// The power map: two parameters, each point run as `map` runs it.
+    Map,
+    /// The basins: two initial conditions, each start fingerprinted as `basins` does.
+    Basins,
+}
+
+/// The work of a grid's points.
+enum Work {
+    /// `sweep` and `map`: the point runner.
+    Points(PointRunner),
+    /// `basins`: the start runner and the settings that classify the fingerprints.
+    Starts {
+        starts: StartRunner,
+        options: AttractorOptions,
+        scale: SectionScale,
+    },
+}
+
+/// What one point gave.
+enum Outcome {
+    Point(Box<PointResult>),
+    Start(Fingerprint),
 }
 
 /// One streamed line.
@@ -73,6 +120,9 @@ enum Line<'a> {
     },
     /// A finished point.
     Point(PointLine),
+    /// Basins, when every start has run: the classification of `basins` (grid order: x
+    /// fastest, as `basins.csv`).
+    Classes(ClassesLine),
     /// Last: how many points were delivered, whether all of them, and the time taken.
     End {
         done: usize,
@@ -98,10 +148,75 @@ struct PointLine {
     error: Option<String>,
 }
 
+/// The attractors of a basin grid and each start's: the numbers of `basins.csv` and
+/// `attractors.csv`.
+#[derive(Debug, Serialize)]
+struct ClassesLine {
+    /// The attractor of each start (1-based, as `basins.csv`'s `attractor`; null: the start
+    /// failed), x fastest.
+    labels: Vec<Option<usize>>,
+    /// The attractors in the order of their first start (`attractors.csv`'s rows).
+    attractors: Vec<AttractorLine>,
+}
+
+/// One attractor: `attractors.csv`'s columns.
+#[derive(Debug, Serialize)]
+struct AttractorLine {
+    attractor: usize,
+    period: usize,
+    starts: usize,
+    fraction: f64,
+    fraction_se: f64,
+    impacts_per_period: f64,
+    average_power_w: Option<f64>,
+    power_se_w: Option<f64>,
+    /// Positions then velocities on the section, m and m/s.
+    state: Vec<f64>,
+}
+
+impl ClassesLine {
+    fn new(c: &Classification, masses: usize) -> Self {
+        ClassesLine {
+            labels: c.labels.iter().map(|l| l.map(|a| a + 1)).collect(),
+            attractors: c
+                .attractors
+                .iter()
+                .enumerate()
+                .map(|(a, at)| {
+                    let (fraction, fraction_se) = c.fraction(a);
+                    AttractorLine {
+                        attractor: a + 1,
+                        period: at.period,
+                        starts: at.starts,
+                        fraction,
+                        fraction_se,
+                        impacts_per_period: at.impacts_per_period,
+                        average_power_w: at.power_w,
+                        power_se_w: at.power_se,
+                        state: at.points[..2 * masses].to_vec(),
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
 impl PointLine {
-    fn new((i, j): (usize, usize), (x, y): (f64, Option<f64>), r: Result<PointResult, SweepError>) -> Self {
+    fn new((i, j): (usize, usize), (x, y): (f64, Option<f64>), r: &Result<Outcome, SweepError>) -> Self {
         match r {
-            Ok(p) => PointLine {
+            Ok(Outcome::Start(f)) => PointLine {
+                i,
+                j,
+                x,
+                y,
+                strobe: Vec::new(),
+                motion: Value::Null,
+                period: Some(f.period),
+                average_power_w: f.power_w,
+                impacts_per_period: Some(f.impacts_per_period),
+                error: None,
+            },
+            Ok(Outcome::Point(p)) => PointLine {
                 i,
                 j,
                 x,
@@ -113,8 +228,8 @@ impl PointLine {
                 },
                 average_power_w: p.average_power_w,
                 impacts_per_period: Some(p.impacts_per_period.iter().sum()),
-                strobe: p.strobe,
-                error: p.electrical_error.map(|e| e.to_string()),
+                strobe: p.strobe.clone(),
+                error: p.electrical_error.as_ref().map(ToString::to_string),
             },
             Err(e) => PointLine {
                 i,
@@ -140,7 +255,7 @@ fn coarseness(k: usize) -> u32 {
 
 /// A checked grid job, ready to stream.
 pub struct GridJob {
-    runner: PointRunner,
+    work: Work,
     keys: Vec<String>,
     xs: Vec<f64>,
     ys: Vec<f64>,
@@ -148,9 +263,9 @@ pub struct GridJob {
     order: Vec<(usize, usize)>,
 }
 
-/// The point runner of `vibrotribo sweep` and `map` with their default options.
-fn runner(config: Config, request: &GridRequest) -> Result<PointRunner, ApiError> {
-    let args = RunArgs {
+/// The run settings of `vibrotribo sweep`, `map` and `basins` with their default options.
+fn run_args(request: &GridRequest) -> Result<RunArgs, ApiError> {
+    Ok(RunArgs {
         transient: request.transient,
         recorded: request.recorded,
         mechanics_only: request.mechanics_only,
@@ -162,8 +277,41 @@ fn runner(config: Config, request: &GridRequest) -> Result<PointRunner, ApiError
         quiet: true,
         allow_large: false,
         force: false,
+    })
+}
+
+/// The start runner of `vibrotribo basins` with its default options (and the request's
+/// tolerances), checked as `basins` checks its axes and configuration.
+fn starts(config: Config, request: &GridRequest) -> Result<Work, ApiError> {
+    let masses = config.chain().len();
+    config.check_uncoupled("basins").map_err(ApiError::bad)?;
+    config
+        .check_periodic("basins of attraction (`basins`)")
+        .map_err(ApiError::bad)?;
+    let y = request.y.as_ref().map_or("", |y| y.param.as_str());
+    for (axis, key) in [("x", request.x.param.as_str()), ("y", y)] {
+        initial_condition_index(key, masses).map_err(|e| ApiError::bad(format!("{axis}: {e}")))?;
+    }
+    if request.x.param == y {
+        return Err(ApiError::bad("x and y are the same key"));
+    }
+    let d = AttractorOptions::default();
+    let options = AttractorOptions {
+        period_tolerance: request.section_tolerance.unwrap_or(1e-3),
+        match_tolerance: request.match_tolerance.unwrap_or(3e-3),
+        cell: request.cell.unwrap_or(0.05),
+        ..d
     };
-    args.runner(config).map_err(|e| ApiError::bad_chain(&e))
+    let runner = run_args(request)?
+        .runner_or(config, DEFAULT_START_PERIODS)
+        .map_err(|e| ApiError::bad_chain(&e))?;
+    let starts = StartRunner::new(runner, options.clone()).map_err(ApiError::bad)?;
+    let scale = SectionScale::of(starts.point_runner().base().chain());
+    Ok(Work::Starts {
+        starts,
+        options,
+        scale,
+    })
 }
 
 /// The values of `axis`, checked as `sweep` checks `--from --to --steps`.
@@ -186,9 +334,29 @@ fn axis_values(axis: &Axis) -> Result<Vec<f64>, ApiError> {
 impl GridJob {
     /// The job of `request` on `base`, checked as `sweep` and `map` check theirs: the grid's
     /// size, every point's configuration, the memory of the points running at once.
-    pub fn new(base: &Config, request: &GridRequest) -> Result<Self, ApiError> {
+    pub fn new(base: &Config, request: &GridRequest, kind: GridKind) -> Result<Self, ApiError> {
+        if request.y.is_some() != (kind != GridKind::Orbit) {
+            return Err(ApiError::bad(if kind == GridKind::Orbit {
+                "an orbit diagram has one axis, x (a map: POST /api/map)"
+            } else {
+                "a map and the basins need the axes x and y"
+            }));
+        }
+        let tolerances = [request.cell, request.section_tolerance, request.match_tolerance];
+        if kind != GridKind::Basins && tolerances.iter().any(Option::is_some) {
+            return Err(ApiError::bad(
+                "cell, section_tolerance and match_tolerance are settings of the basins (POST /api/basins)",
+            ));
+        }
         let config = configure(base, &request.set)?;
-        let runner = runner(config, request)?;
+        let work = match kind {
+            GridKind::Basins => starts(config, request)?,
+            _ => Work::Points(
+                run_args(request)?
+                    .runner(config)
+                    .map_err(|e| ApiError::bad_chain(&e))?,
+            ),
+        };
         let xs = axis_values(&request.x)?;
         let (ys, mut keys) = (Vec::new(), vec![request.x.param.clone()]);
         let ys = match &request.y {
@@ -205,21 +373,40 @@ impl GridJob {
             .collect();
         order.sort_by_key(|&(i, j)| std::cmp::Reverse(coarseness(i).min(coarseness(j))));
         let job = GridJob {
-            runner,
+            work,
             keys,
             xs,
             ys,
             order,
         };
-        check_all(&job.runner, &job.order, |&p| job.point_keys(p)).map_err(|e| ApiError::bad_chain(&e))?;
+        // `basins` runs every start and counts a start that cannot run as failed.
+        if let Work::Points(runner) = &job.work {
+            check_all(runner, &job.order, |&p| job.point_keys(p)).map_err(|e| ApiError::bad_chain(&e))?;
+        }
         let threads = rayon::current_num_threads() as f64;
         limits::check_memory(
             "one point of the grid (transient + recorded periods)",
-            estimate_point_memory(&job.runner) * threads * 4.0,
+            estimate_point_memory(job.point_runner()) * threads * 4.0,
             false,
         )
         .map_err(|e| ApiError::bad_chain(&e))?;
         Ok(job)
+    }
+
+    fn point_runner(&self) -> &PointRunner {
+        match &self.work {
+            Work::Points(runner) => runner,
+            Work::Starts { starts, .. } => starts.point_runner(),
+        }
+    }
+
+    /// Runs the point at `(i, j)`.
+    fn run_point(&self, p: (usize, usize)) -> Result<Outcome, SweepError> {
+        let keys = self.point_keys(p);
+        match &self.work {
+            Work::Points(runner) => runner.run(&keys, None).map(|p| Outcome::Point(Box::new(p))),
+            Work::Starts { starts, .. } => starts.run(&keys, None).map(Outcome::Start),
+        }
     }
 
     fn point_keys(&self, (i, j): (usize, usize)) -> Vec<(&str, f64)> {
@@ -244,7 +431,7 @@ impl GridJob {
         let start = Line::Start {
             xs: &self.xs,
             ys: &self.ys,
-            masses: self.runner.masses(),
+            masses: self.point_runner().masses(),
         };
         if !send(&start) {
             return;
@@ -255,6 +442,9 @@ impl GridJob {
         let threads = rayon::current_num_threads();
         let (head, tail) = self.order.split_at(threads.min(self.order.len()));
         let mut done = 0;
+        // Basins: each start's fingerprint in grid order (x fastest), classified at the end.
+        let nx = self.xs.len();
+        let mut fingerprints: Vec<Option<Fingerprint>> = vec![None; self.order.len()];
         for (k, (points, chunk)) in [(head, threads), (tail, 8 * threads)].into_iter().enumerate() {
             // The head stopped early (superseded, client gone): the tail is not started.
             if k == 1 && done < head.len() {
@@ -267,7 +457,7 @@ impl GridJob {
                     if ticket.stopped() {
                         return Err(None);
                     }
-                    self.runner.run(&self.point_keys(p), None).map_err(Some)
+                    self.run_point(p).map_err(Some)
                 },
                 |d| match d {
                     Delivery::Point(&(i, j), r) => {
@@ -276,7 +466,10 @@ impl GridJob {
                             Ok(p) => Ok(p),
                             Err(Some(e)) => Err(e),
                         };
-                        let line = PointLine::new((i, j), (self.xs[i], self.ys.get(j).copied()), r);
+                        let line = PointLine::new((i, j), (self.xs[i], self.ys.get(j).copied()), &r);
+                        if let Ok(Outcome::Start(f)) = r {
+                            fingerprints[j * nx + i] = Some(f);
+                        }
                         if !send(&Line::Point(line)) || ticket.stopped() {
                             ControlFlow::Break(())
                         } else {
@@ -289,6 +482,12 @@ impl GridJob {
             );
         }
         let complete = done == self.order.len() && !ticket.stopped();
+        if let (true, Work::Starts { options, scale, .. }) = (complete, &self.work) {
+            let classes = classify(&fingerprints, scale, options);
+            if !send(&Line::Classes(ClassesLine::new(&classes, scale.masses))) {
+                return;
+            }
+        }
         send(&Line::End {
             done,
             complete,

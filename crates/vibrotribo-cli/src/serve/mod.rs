@@ -7,6 +7,7 @@
 
 mod api;
 mod assets;
+mod branches;
 mod cancel;
 mod error;
 mod grid;

@@ -29,6 +29,9 @@ pub struct RunRequest {
     /// The overrides of the server's configuration.
     #[serde(default)]
     pub set: Overrides,
+    /// The client's sequence number of this request (see [`super::cancel`]).
+    #[serde(default)]
+    pub seq: Option<u64>,
 }
 
 /// The samples of a run (every `stride`-th sample of its grid, and its last): time, s; positions x_i, m;

@@ -40,6 +40,7 @@ pub fn router(state: AppState) -> Router {
         .route("/api/orbit", post(api::orbit))
         .route("/api/map", post(api::map))
         .route("/api/basins", post(api::basins))
+        .route("/api/branches", post(api::branches))
         .fallback(api::not_found)
         .with_state(Arc::new(state))
 }
@@ -90,6 +91,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         orbits: Lane::default(),
         maps: Lane::default(),
         basins: Lane::default(),
+        continuations: Lane::default(),
     };
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)

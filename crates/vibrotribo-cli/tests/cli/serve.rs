@@ -425,3 +425,245 @@ fn sigterm_stops_the_server_cleanly() {
         .unwrap();
     assert!(rest.contains("stopped"), "{rest:?}");
 }
+
+/// The answer of `path` read as a stream: the status and a reader at the start of the body.
+fn open_stream(server: &Server, path: &str, body: &Value) -> (u16, BufReader<TcpStream>) {
+    let mut stream = TcpStream::connect(&server.addr).unwrap();
+    let body = body.to_string();
+    write!(
+        stream,
+        "POST {path} HTTP/1.0\r\nHost: {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+        server.addr,
+        body.len()
+    )
+    .unwrap();
+    let mut reader = BufReader::new(stream);
+    let mut status = String::new();
+    reader.read_line(&mut status).unwrap();
+    loop {
+        let mut header = String::new();
+        reader.read_line(&mut header).unwrap();
+        if header.trim().is_empty() {
+            break;
+        }
+    }
+    (status.split(' ').nth(1).unwrap().parse().unwrap(), reader)
+}
+
+fn next_line(reader: &mut BufReader<TcpStream>) -> Value {
+    let mut line = String::new();
+    reader.read_line(&mut line).unwrap();
+    serde_json::from_str(&line).unwrap_or_else(|_| panic!("not a JSON line: {line:?}"))
+}
+
+#[test]
+fn a_request_sent_earlier_but_arriving_later_never_supersedes_the_newest() {
+    let server = Server::start(&[]);
+    let orbit = |seq: u64| {
+        json!({"x": {"param": "excitation.omega_ratio", "from": 0.5, "to": 1.1, "steps": 60},
+               "transient": 400, "recorded": 20, "mechanics_only": true, "seq": seq})
+    };
+    // The newest request (seq 20) is under way: its first point has arrived.
+    let (status, mut newest) = open_stream(&server, "/api/orbit", &orbit(20));
+    assert_eq!(status, 200);
+    assert_eq!(next_line(&mut newest)["kind"], "start");
+    assert_eq!(next_line(&mut newest)["kind"], "point");
+    // An older request (seq 10) reaches the server now: refused, for both lanes' kinds.
+    let (status, text) = server.request("POST", "/api/orbit", &orbit(10).to_string());
+    assert_eq!(status, 409, "{text}");
+    assert!(text.contains("outdated"), "{text}");
+    // The newest runs to its end, every value delivered.
+    let mut points = 1;
+    let end = loop {
+        let line = next_line(&mut newest);
+        match line["kind"].as_str() {
+            Some("point") => points += 1,
+            Some("end") => break line,
+            other => panic!("unexpected line {other:?}"),
+        }
+    };
+    assert_eq!(end["complete"], true, "the newest was stopped: {end}");
+    assert_eq!(points, 60);
+    // A request sent later (seq 30) does supersede a running one (seq 25).
+    let (_, mut older) = open_stream(&server, "/api/orbit", &orbit(25));
+    assert_eq!(next_line(&mut older)["kind"], "start");
+    let (_, mut newer) = open_stream(&server, "/api/orbit", &orbit(30));
+    assert_eq!(next_line(&mut newer)["kind"], "start");
+    let end = loop {
+        let line = next_line(&mut older);
+        if line["kind"] == "end" {
+            break line;
+        }
+    };
+    assert_eq!(end["complete"], false, "{end}");
+    // The run view's lane orders by seq too.
+    let view = server.post("/api/run", &json!({"seq": 5}));
+    assert!(view["average_power_w"].is_number());
+    let (status, text) = server.request("POST", "/api/run", &json!({"seq": 4}).to_string());
+    assert_eq!(status, 409, "{text}");
+}
+
+/// `continue`'s branch.csv (header and rows, as text) for `args`.
+fn continue_branch_csv(args: &[&str]) -> (Vec<String>, Vec<Vec<String>>) {
+    let dir = tempdir();
+    let mut all = vec!["continue", "--out", dir.path().to_str().unwrap()];
+    all.extend_from_slice(args);
+    let o = vibrotribo(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    read_csv(&dir.path().join("branch.csv"))
+}
+
+#[test]
+fn branches_are_continue_branch_csv_bit_for_bit() {
+    let server = Server::start(&[]);
+    let (header, rows) = continue_branch_csv(&[
+        "--param",
+        "mass_ratio",
+        "--from",
+        "2.6",
+        "--to",
+        "3.0",
+        "--mechanics-only",
+    ]);
+    let view = server.post(
+        "/api/branches",
+        &json!({"param": "mass_ratio", "from": 2.6, "to": 3.0, "mechanics_only": true}),
+    );
+    let strings = |v: &Value| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(strings(&view["columns"]), header);
+    let api_rows: Vec<Vec<String>> = view["rows"].as_array().unwrap().iter().map(strings).collect();
+    assert!(!rows.is_empty());
+    assert_eq!(api_rows, rows, "the API's branch is not continue's branch.csv");
+    // The drawn points are the rows' points, in order, with their stability.
+    let drawn: Vec<(String, String)> = view["branches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|b| b["points"].as_array().unwrap().iter())
+        .map(|p| (float(&p["param"]).to_string(), p["stable"].to_string()))
+        .collect();
+    let listed: Vec<(String, String)> = rows.iter().map(|r| (r[2].clone(), r[3].clone())).collect();
+    assert_eq!(drawn, listed);
+    // The section of a period-P orbit at t = 0 is the branch's state: x_i of branch.csv.
+    let first = &view["branches"][0]["points"][0]["sections"];
+    let x1: f64 = rows[0][header.iter().position(|h| h == "x1_m").unwrap()]
+        .parse()
+        .unwrap();
+    assert_eq!(float(&first[0][0]).to_bits(), x1.to_bits());
+    // The Neimark–Sacker point `continue` lists is marked.
+    assert!(
+        view["bifurcations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|b| b["kind"] == "neimark_sacker"),
+        "{}",
+        view["bifurcations"]
+    );
+}
+
+#[test]
+fn basins_are_the_basins_commands_classification_bit_for_bit() {
+    let server = Server::start(&[]);
+    let dir = tempdir();
+    let set = ["oscillator.masses=[0.09,0.12,0.09]", "gap_ratio=1.09"];
+    let o = vibrotribo(&[
+        "basins",
+        "-q",
+        "--set",
+        set[0],
+        "--set",
+        set[1],
+        "--x",
+        "run.initial_positions[1]",
+        "--x-from",
+        "-0.02",
+        "--x-to",
+        "0.018",
+        "--y",
+        "run.initial_velocities[1]",
+        "--y-from",
+        "-3",
+        "--y-to",
+        "3",
+        "--grid",
+        "5x6",
+        "--transient",
+        "300",
+        "--recorded",
+        "32",
+        "--mechanics-only",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines = server.lines(
+        "/api/basins",
+        &json!({"set": {"oscillator.masses": "[0.09,0.12,0.09]", "gap_ratio": "1.09"},
+                "x": {"param": "run.initial_positions[1]", "from": -0.02, "to": 0.018, "steps": 5},
+                "y": {"param": "run.initial_velocities[1]", "from": -3, "to": 3, "steps": 6},
+                "transient": 300, "recorded": 32, "mechanics_only": true}),
+    );
+    let start = &lines[0];
+    let classes = lines
+        .iter()
+        .find(|l| l["kind"] == "classes")
+        .unwrap_or_else(|| panic!("no classification in {:?}", lines.last()));
+    let (_, basins) = read_csv(&dir.path().join("basins.csv"));
+    let (at_header, attractors) = read_csv(&dir.path().join("attractors.csv"));
+    assert_eq!(basins.len(), 30);
+    let xs = start["xs"].as_array().unwrap();
+    let ys = start["ys"].as_array().unwrap();
+    let labels = classes["labels"].as_array().unwrap();
+    for (k, row) in basins.iter().enumerate() {
+        let (x, y) = (float(&xs[k % 5]), float(&ys[k / 5]));
+        assert_eq!(
+            (x.to_string(), y.to_string()),
+            (row[0].clone(), row[1].clone()),
+            "start {k}"
+        );
+        let label = labels[k].as_u64().map_or(String::new(), |a| a.to_string());
+        assert_eq!(label, row[2], "start {k} at ({x}, {y})");
+    }
+    let api = classes["attractors"].as_array().unwrap();
+    assert_eq!(api.len(), attractors.len());
+    assert!(api.len() >= 2, "Fig. 7's two coexisting orbits: {api:?}");
+    let cell = |row: &[String], name: &str| row[at_header.iter().position(|h| h == name).unwrap()].clone();
+    let text = |v: &Value| match v {
+        Value::Null => String::new(),
+        Value::Number(n) if n.is_u64() => n.to_string(),
+        v => float(v).to_string(),
+    };
+    for (a, row) in api.iter().zip(&attractors) {
+        for name in [
+            "attractor",
+            "period",
+            "starts",
+            "fraction",
+            "fraction_se",
+            "impacts_per_period",
+            "average_power_w",
+            "power_se_w",
+        ] {
+            assert_eq!(
+                text(&a[name]),
+                cell(row, name),
+                "attractor {}: {name}",
+                a["attractor"]
+            );
+        }
+        let state: Vec<String> = a["state"].as_array().unwrap().iter().map(text).collect();
+        assert_eq!(
+            state,
+            row[8..].to_vec(),
+            "attractor {}: section state",
+            a["attractor"]
+        );
+    }
+}

@@ -6,8 +6,9 @@
 const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
   "#17becf", "#bcbd22", "#7f7f7f"];
 
-// The state the URL carries: the overrides and the grid views' forms.
-const state = { set: {}, orbit: null, map: null, basins: null };
+// The state the URL carries: the overrides, the grid views' forms, the orbit diagram's zoomed
+// region and whether its continuation branches are shown.
+const state = { set: {}, orbit: null, map: null, basins: null, orbitRange: null, branches: false };
 let schema = null;
 let lastRun = null;
 const busy = new Map();
@@ -27,6 +28,14 @@ function setBusy(what, text) {
 }
 
 // ---- API ----------------------------------------------------------------------------------
+
+// A request's sequence number: the page's clock in microseconds, increasing with each request,
+// so that the server never lets a request sent earlier supersede one sent later.
+let lastSeq = 0;
+function nextSeq() {
+  lastSeq = Math.max(lastSeq + 1, Math.floor((performance.timeOrigin + performance.now()) * 1000));
+  return lastSeq;
+}
 
 async function post(path, body, signal) {
   const r = await fetch(path, {
@@ -217,7 +226,7 @@ async function computeRun() {
   const seq = ++runSeq;
   setBusy("run", "computing the run");
   try {
-    const r = await post("/api/run", { set: state.set }, abort.signal);
+    const r = await post("/api/run", { set: state.set, seq: nextSeq() }, abort.signal);
     const view = await r.json();
     if (seq !== runSeq) return;
     lastRun = view;
@@ -303,6 +312,61 @@ let orbitAbort = null;
 let orbitChart = null;
 let orbitPoints = [];
 let orbitRange = null;
+let orbitBranches = null;
+let branchesAbort = null;
+
+// Bifurcation kinds: legend name and colour.
+const BIFURCATIONS = {
+  fold: ["fold", "#ff7f0e"], branch_point: ["branch point", "#9467bd"],
+  period_doubling: ["period doubling", "#2ca02c"], neimark_sacker: ["Neimark–Sacker", "#e377c2"],
+  grazing: ["grazing", "#8c564b"], sticking: ["sticking", "#bcbd22"],
+  sequence_change: ["sequence change", "#17becf"], other: ["other", "#7f7f7f"],
+};
+
+// The branches as uPlot series: a line per section point and run of equal stability (stable
+// solid, unstable dashed), then the bifurcations, a point series per kind.
+function branchSeries(mass) {
+  const out = [];
+  if (!orbitBranches) return out;
+  let stableNamed = false, unstableNamed = false;
+  for (const b of orbitBranches.branches) {
+    const pts = b.points;
+    for (let k = 0; k < b.period; k++) {
+      let start = 0;
+      while (start < pts.length) {
+        const stable = pts[start].stable;
+        let end = start;
+        while (end + 1 < pts.length && pts[end + 1].stable === stable) end++;
+        const stop = Math.min(end + 1, pts.length - 1);
+        const xs = [], ys = [];
+        for (let j = start; j <= stop; j++) {
+          const y = (pts[j].sections[mass] || [])[k];
+          if (y != null) { xs.push(pts[j].param); ys.push(y); }
+        }
+        const named = stable ? stableNamed : unstableNamed;
+        if (stable) stableNamed = true; else unstableNamed = true;
+        out.push({
+          label: named ? "" : (stable ? "stable branch" : "unstable branch"),
+          stroke: stable ? "#000" : "#d62728", width: 2, dash: stable ? undefined : [6, 4],
+          paths: uPlot.paths.linear(), points: { show: false }, data: [xs, ys], kind: "branch",
+        });
+        start = end + 1;
+      }
+    }
+  }
+  const kinds = new Map();
+  for (const f of orbitBranches.bifurcations) {
+    const [label, color] = BIFURCATIONS[f.kind] || BIFURCATIONS.other;
+    if (!kinds.has(f.kind)) kinds.set(f.kind, { label, color, xs: [], ys: [] });
+    const m = kinds.get(f.kind);
+    for (const y of f.sections[mass] || []) { m.xs.push(f.param); m.ys.push(y); }
+  }
+  for (const m of kinds.values()) {
+    out.push({ label: m.label, stroke: m.color, fill: m.color, paths: uPlot.paths.points(),
+      points: { show: false, size: 11, width: 0 }, data: [m.xs, m.ys], kind: "bifurcation" });
+  }
+  return out;
+}
 
 function motionClass(p) {
   if (p.error && !p.strobe.length) return "failed";
@@ -328,11 +392,13 @@ function orbitSeries() {
 function drawOrbit() {
   const el = document.getElementById("chart-orbit");
   const groups = orbitSeries();
+  const mass = Math.max(1, parseInt(document.querySelector("#orbit-form [name=mass]").value, 10) || 1);
+  const overlay = branchSeries(mass - 1);
   const series = [{}].concat(groups.map((g) => ({
     label: g.label, stroke: g.color, fill: g.color, paths: uPlot.paths.points(),
     points: { show: false, size: 3, width: 0 },
-  })));
-  const data = [null].concat(groups.map((g) => g.data));
+  })), overlay.map(({ data, kind, ...rest }) => rest));
+  const data = [null].concat(groups.map((g) => g.data), overlay.map((o) => o.data));
   const param = state.orbit ? state.orbit.param : "";
   const range = orbitRange;
   if (orbitChart) orbitChart.destroy();
@@ -346,6 +412,9 @@ function drawOrbit() {
     hooks: { setSelect: [onOrbitSelect] },
   }, data, el);
   el.dataset.points = String(orbitPoints.length);
+  el.dataset.branchLines = String(overlay.filter((o) => o.kind === "branch").length);
+  el.dataset.bifurcations = String(overlay.filter((o) => o.kind === "bifurcation")
+    .reduce((n, o) => n + o.data[0].length, 0));
   attachOrbitClick(el);
 }
 
@@ -360,6 +429,7 @@ function onOrbitSelect(u) {
   form.elements.to.value = String(x1);
   orbitRange = { x0, x1, y0, y1 };
   computeOrbit(false);
+  if (state.branches) computeBranches();
 }
 
 let clickBound = null;
@@ -383,10 +453,55 @@ function attachOrbitClick(el) {
   });
 }
 
+// The continuation branches over the orbit diagram's range (POST /api/branches, what
+// `vibrotribo continue` computes), drawn over its points.
+async function computeBranches() {
+  const f = formValues(document.getElementById("orbit-form"));
+  state.branches = true;
+  state.orbit = f;
+  saveUrl();
+  updateCommand();
+  if (branchesAbort) branchesAbort.abort();
+  const abort = branchesAbort = new AbortController();
+  const progress = document.getElementById("branches-progress");
+  progress.textContent = "continuing…";
+  progress.dataset.state = "busy";
+  setBusy("branches", "continuation");
+  try {
+    const r = await post("/api/branches", {
+      set: state.set, param: f.param, from: Number(f.from), to: Number(f.to), seq: nextSeq(),
+    }, abort.signal);
+    const view = await r.json();
+    if (abort !== branchesAbort) return;
+    orbitBranches = view;
+    const stable = view.rows.filter((row) => row[3] === "true").length;
+    progress.textContent = `${view.branches.length} branch(es), ${view.rows.length} points `
+      + `(${stable} stable), ${view.bifurcations.length} bifurcation(s)`;
+    drawOrbit();
+  } catch (e) {
+    if (e.name !== "AbortError" && abort === branchesAbort) progress.textContent = "error: " + e.message;
+  } finally {
+    if (abort === branchesAbort) { setBusy("branches", null); progress.dataset.state = "idle"; }
+  }
+}
+
+function hideBranches() {
+  if (branchesAbort) branchesAbort.abort();
+  branchesAbort = null;
+  orbitBranches = null;
+  state.branches = false;
+  setBusy("branches", null);
+  document.getElementById("branches-progress").textContent = "";
+  saveUrl();
+  updateCommand();
+  drawOrbit();
+}
+
 async function computeOrbit(whole) {
   const form = document.getElementById("orbit-form");
   const f = formValues(form);
   if (whole) orbitRange = null;
+  state.orbitRange = orbitRange;
   state.orbit = f;
   saveUrl();
   updateCommand();
@@ -397,6 +512,7 @@ async function computeOrbit(whole) {
     x: { param: f.param, from: Number(f.from), to: Number(f.to), steps: parseInt(f.steps, 10) },
     transient: f.transient === "" ? null : parseInt(f.transient, 10),
     recorded: f.recorded === "" ? null : parseInt(f.recorded, 10),
+    seq: nextSeq(),
   };
   const progress = document.getElementById("orbit-progress");
   progress.textContent = "computing…";
@@ -504,10 +620,12 @@ async function computeGrid(view, path, formId, key, progressId, onDone) {
     y: { param: f.y, from: Number(f.y_from), to: Number(f.y_to), steps: parseInt(f.y_steps, 10) },
     transient: f.transient === "" ? null : parseInt(f.transient, 10),
     recorded: f.recorded === "" ? null : parseInt(f.recorded, 10),
+    seq: nextSeq(),
   };
   const progress = document.getElementById(progressId);
   progress.textContent = "computing…";
   view.cells = [];
+  view.classes = null;
   view.xKey = f.x; view.yKey = f.y;
   let total = 0, last = 0;
   setBusy(key, key);
@@ -525,6 +643,8 @@ async function computeGrid(view, path, formId, key, progressId, onDone) {
         setBusy(key, `${key} ${view.cells.length}/${total}`);
         const now = performance.now();
         if (now - last > 200) { last = now; view.draw(); }
+      } else if (line.kind === "classes") {
+        view.classes = line;
       } else if (line.kind === "end") {
         progress.textContent = `${line.done} of ${total} points in ${line.elapsed_s.toFixed(2)} s`
           + (line.complete ? "" : " (stopped)");
@@ -551,28 +671,38 @@ const mapView = gridView("chart-map", (c, view) => {
   return heatColor(hi > lo ? (c.average_power_w - lo) / (hi - lo) : 0.5);
 });
 
-// Where a start ends: its motion, period and average power (3 significant digits).
-function attractorOf(c) {
-  const power = c.average_power_w == null ? "" : " " + c.average_power_w.toPrecision(3) + " W";
-  return motionClass({ ...c, masses: 1 }) + power;
+// While the starts run, each is shown by its fingerprint's period (grey shades); when all
+// have run, the server's classification (the attractors of `vibrotribo basins`) colours them.
+function provisionalColor(c) {
+  if (c.error || c.period == null) return "#fff";
+  return c.period === 0 ? "#777" : ["#bbb", "#999", "#ddd", "#aaa"][(c.period - 1) % 4];
 }
-const basinColors = new Map();
-const basinsView = gridView("chart-basins", (c) => {
-  const a = attractorOf(c);
-  if (!basinColors.has(a)) basinColors.set(a, COLORS[basinColors.size % COLORS.length]);
-  return basinColors.get(a);
+
+function attractorName(a) {
+  const kind = a.period === 0 ? "non-periodic" : `period ${a.period}`;
+  const power = a.average_power_w == null ? "" : `, ${a.average_power_w.toPrecision(4)} W`;
+  return `A${a.attractor}: ${kind}, ${a.impacts_per_period.toFixed(2)} impacts/T${power}`;
+}
+
+const basinsView = gridView("chart-basins", (c, view) => {
+  if (!view.classes) return provisionalColor(c);
+  const label = view.classes.labels[c.j * view.xs.length + c.i];
+  return label == null ? "#fff" : COLORS[(label - 1) % COLORS.length];
 });
 
 function basinsLegend(view) {
-  const counts = new Map();
-  for (const c of view.cells) counts.set(attractorOf(c), (counts.get(attractorOf(c)) || 0) + 1);
   const el = document.getElementById("basins-legend");
   el.textContent = "";
-  for (const [a, n] of counts) {
+  el.dataset.attractors = view.classes ? String(view.classes.attractors.length) : "";
+  if (!view.classes) {
+    el.textContent = "stopped before every start ran: not classified";
+    return;
+  }
+  for (const a of view.classes.attractors) {
     const s = document.createElement("span");
     const i = document.createElement("i");
-    i.style.background = basinColors.get(a);
-    s.append(i, `${a}: ${(100 * n / view.cells.length).toFixed(1)} %`);
+    i.style.background = COLORS[(a.attractor - 1) % COLORS.length];
+    s.append(i, `${attractorName(a)} (basin ${(100 * a.fraction).toFixed(1)} ± ${(100 * a.fraction_se).toFixed(1)} %)`);
     el.appendChild(s);
   }
 }
@@ -607,6 +737,20 @@ function command() {
     if (m.recorded) map.push("--recorded", m.recorded);
     lines.push(map.concat(["--out", "map"]).join(" "));
   }
+  if (state.basins) {
+    const b = state.basins;
+    const basins = ["vibrotribo", "basins"].concat(base.slice(2), sets, ["--x", quote(b.x), "--x-from",
+      b.x_from, "--x-to", b.x_to, "--y", quote(b.y), "--y-from", b.y_from, "--y-to", b.y_to,
+      "--grid", `${b.x_steps}x${b.y_steps}`]);
+    if (b.transient) basins.push("--transient", b.transient);
+    if (b.recorded) basins.push("--recorded", b.recorded);
+    lines.push(basins.concat(["--out", "basins"]).join(" "));
+  }
+  if (state.branches && state.orbit) {
+    const o = state.orbit;
+    lines.push(["vibrotribo", "continue"].concat(base.slice(2), sets, ["--param", quote(o.param),
+      "--from", o.from, "--to", o.to, "--out", "continue"]).join(" "));
+  }
   return lines.join(" && ");
 }
 
@@ -632,17 +776,77 @@ async function exportToml() {
   }
 }
 
-function exportCsv() {
-  if (!lastRun) return;
+function csvText(header, rows) {
+  const cell = (v) => {
+    const t = v == null ? "" : String(v);
+    return /[",\n]/.test(t) ? '"' + t.replace(/"/g, '""') + '"' : t;
+  };
+  return [header, ...rows].map((r) => r.map(cell).join(",")).join("\n") + "\n";
+}
+
+// The run view's samples.
+function runCsv() {
+  if (!lastRun) return null;
   const d = lastRun.samples;
   const cols = [["time_s", d.t]];
   d.x.forEach((c, i) => cols.push([`x${i + 1}_m`, c]));
   d.v.forEach((c, i) => cols.push([`v${i + 1}_m_s`, c]));
   d.gaps.forEach((c, i) => cols.push([`d${i + 1}_m`, c]));
   cols.push(["y_m", d.base], ["v_v", d.voltage], ["p_w", d.power]);
-  const rows = [cols.map((c) => c[0]).join(",")];
-  for (let j = 0; j < d.t.length; j++) rows.push(cols.map((c) => c[1][j] ?? "").join(","));
-  download("run-view.csv", "text/csv", rows.join("\n") + "\n");
+  const rows = d.t.map((_, j) => cols.map((c) => c[1][j]));
+  return csvText(cols.map((c) => c[0]), rows);
+}
+
+// The orbit diagram: one row per value and recorded period, the positions on the section.
+function orbitCsv() {
+  if (orbitPoints.length === 0 || !state.orbit) return null;
+  const n = orbitPoints[0].masses;
+  const header = [state.orbit.param, "period_index"].concat([...Array(n).keys()].map((i) => `x${i + 1}_m`),
+    ["motion", "average_power_w"]);
+  const rows = [];
+  for (const p of [...orbitPoints].sort((a, b) => a.i - b.i)) {
+    for (let k = 0; k * n < p.strobe.length; k++) {
+      rows.push([p.x, k].concat(p.strobe.slice(k * n, k * n + n), [motionClass(p), p.average_power_w]));
+    }
+  }
+  return csvText(header, rows);
+}
+
+// The continuation branches: `branch.csv` of `vibrotribo continue`, cell for cell.
+function branchesCsv() {
+  return orbitBranches ? csvText(orbitBranches.columns, orbitBranches.rows) : null;
+}
+
+// A grid view (map or basins): one row per point, x fastest.
+function gridCsv(view, basins) {
+  if (view.cells.length === 0) return null;
+  const header = [view.xKey, view.yKey, "period", "impacts_per_period", "average_power_w"];
+  if (basins) header.push("attractor");
+  const cells = [...view.cells].sort((a, b) => a.j - b.j || a.i - b.i);
+  const rows = cells.map((c) => {
+    const row = [c.x, c.y, c.period, c.impacts_per_period, c.average_power_w];
+    if (basins) row.push(view.classes ? view.classes.labels[c.j * view.xs.length + c.i] : null);
+    return row;
+  });
+  return csvText(header, rows);
+}
+
+const CSV_EXPORTS = {
+  run: ["run-view.csv", runCsv],
+  orbit: ["orbit-diagram.csv", orbitCsv],
+  branches: ["branch.csv", branchesCsv],
+  map: ["map.csv", () => gridCsv(mapView, false)],
+  basins: ["basins.csv", () => gridCsv(basinsView, true)],
+};
+
+function exportCsv(which) {
+  const [name, make] = CSV_EXPORTS[which];
+  const text = make();
+  if (text == null) {
+    document.getElementById("run-error").textContent = `nothing to export: compute the ${which} view first`;
+    return;
+  }
+  download(name, "text/csv", text);
 }
 
 // ---- start --------------------------------------------------------------------------------
@@ -657,6 +861,7 @@ async function main() {
   fillForm(document.getElementById("orbit-form"), state.orbit);
   fillForm(document.getElementById("map-form"), state.map);
   fillForm(document.getElementById("basins-form"), state.basins);
+  orbitRange = state.orbitRange;
   document.getElementById("orbit-form").addEventListener("submit", (e) => {
     e.preventDefault();
     orbitRange = null;
@@ -669,11 +874,15 @@ async function main() {
   });
   document.getElementById("basins-form").addEventListener("submit", (e) => {
     e.preventDefault();
-    basinColors.clear();
     computeGrid(basinsView, "/api/basins", "basins-form", "basins", "basins-progress", basinsLegend);
   });
   document.getElementById("export-toml").addEventListener("click", exportToml);
-  document.getElementById("export-csv").addEventListener("click", exportCsv);
+  document.getElementById("export-csv").addEventListener("click", () => exportCsv("run"));
+  for (const which of ["orbit", "branches", "map", "basins"]) {
+    document.getElementById(`export-${which}-csv`).addEventListener("click", () => exportCsv(which));
+  }
+  document.getElementById("orbit-branches").addEventListener("click", computeBranches);
+  document.getElementById("orbit-branches-hide").addEventListener("click", hideBranches);
   document.getElementById("export-command-button").addEventListener("click", () => {
     updateCommand();
     document.getElementById("export-command").select();
@@ -685,6 +894,7 @@ async function main() {
   updateCommand();
   await computeRun();
   if (state.orbit) computeOrbit(false);
+  if (state.orbit && state.branches) computeBranches();
   if (state.map) computeGrid(mapView, "/api/map", "map-form", "map", "map-progress", mapLegend);
   if (state.basins) {
     computeGrid(basinsView, "/api/basins", "basins-form", "basins", "basins-progress", basinsLegend);
