@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 use vibrotribo::branch::{BranchOptions, config_family, continue_config};
 use vibrotribo::config::Config;
-use vibrotribo::orbits::ContinuationOptions;
+use vibrotribo::orbits::{Cancel, ContinuationOptions, ShootingOptions};
 
 use super::cancel::Ticket;
 use super::error::ApiError;
@@ -100,8 +100,9 @@ pub struct BranchesView {
     pub bifurcations: Vec<BifurcationView>,
 }
 
-/// The options of `request`, checked as `continue` checks its own.
-fn options(request: &BranchRequest) -> Result<BranchOptions, ApiError> {
+/// The options of `request`, checked as `continue` checks its own; the continuation stops at
+/// its next step once `ticket` is stopped.
+fn options(request: &BranchRequest, ticket: &Ticket) -> Result<BranchOptions, ApiError> {
     if request.period == Some(0) {
         return Err(ApiError::bad("period must be at least 1"));
     }
@@ -121,15 +122,22 @@ fn options(request: &BranchRequest) -> Result<BranchOptions, ApiError> {
         continuation: ContinuationOptions {
             doubling_depth: request.doublings.unwrap_or(d.continuation.doubling_depth),
             max_points,
+            shooting: ShootingOptions {
+                cancel: {
+                    let ticket = ticket.clone();
+                    Cancel::new(move || ticket.stopped())
+                },
+                ..d.continuation.shooting
+            },
             ..d.continuation
         },
     })
 }
 
 /// The continuation of `request` on `base`, as `vibrotribo continue` computes it; 409 when
-/// `ticket` is stopped (checked between the continuation and each later step).
+/// `ticket` is stopped (checked at every continuation step and between the later steps).
 pub fn branches(base: &Config, request: &BranchRequest, ticket: &Ticket) -> Result<BranchesView, ApiError> {
-    let options = options(request)?;
+    let options = options(request, ticket)?;
     let config = configure(base, &request.set)?;
     config.check_uncoupled("continue").map_err(ApiError::bad)?;
     config
@@ -139,8 +147,11 @@ pub fn branches(base: &Config, request: &BranchRequest, ticket: &Ticket) -> Resu
         return Err(ApiError::superseded());
     }
     let key = request.param.as_str();
-    let result =
-        continue_config(&config, key, request.from, request.to, None, &options).map_err(ApiError::bad)?;
+    let result = match continue_config(&config, key, request.from, request.to, None, &options) {
+        Ok(result) => result,
+        Err(_) if ticket.stopped() => return Err(ApiError::superseded()),
+        Err(e) => return Err(ApiError::bad(e)),
+    };
     if ticket.stopped() {
         return Err(ApiError::superseded());
     }
