@@ -7,12 +7,11 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use vibrotribo::config::Config;
-use vibrotribo::orbits::Continuation;
+use vibrotribo::orbits::{BifurcationKind, Continuation};
 use vibrotribo::study::PointOptions;
 use vibrotribo::sweep::{PointRunner, grid};
 use vibrotribo::{ChainParams, ChainState, Simulator};
 
-use crate::continuation::{Diagram, describe};
 use crate::manifest::{ContinueManifest, config_of, read};
 use crate::output::{column, read_csv};
 use crate::plot::{self, Figure, Legend, Series, Shape, both};
@@ -389,4 +388,46 @@ fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Leg
     } else {
         Legend::UpperRight
     }
+}
+
+/// What a bifurcation is, in words, with its detail.
+pub fn describe(kind: &BifurcationKind) -> (&'static str, String) {
+    match kind {
+        BifurcationKind::Fold => ("fold", String::new()),
+        BifurcationKind::BranchPoint => ("branch_point", String::new()),
+        BifurcationKind::PeriodDoubling => ("period_doubling", String::new()),
+        BifurcationKind::NeimarkSacker { angle } => ("neimark_sacker", format!("angle {angle} rad")),
+        BifurcationKind::Grazing { contact, appears } => (
+            "grazing",
+            format!(
+                "contact {}: impact {}",
+                contact + 1,
+                if *appears { "appears" } else { "disappears" }
+            ),
+        ),
+        BifurcationKind::Sticking { contact, onset } => (
+            "sticking",
+            format!(
+                "contact {}: sticking {}",
+                contact + 1,
+                if *onset { "begins" } else { "ends" }
+            ),
+        ),
+        BifurcationKind::SequenceChange => ("sequence_change", String::new()),
+        _ => ("other", format!("{kind:?}")),
+    }
+}
+
+/// The brute-force orbit diagram under a picture of branches.
+pub struct Diagram<'a> {
+    /// The parameter's key.
+    pub param: &'a str,
+    /// Its range.
+    pub range: (f64, f64),
+    /// The mass shown, 0-based.
+    pub mass: usize,
+    /// Transient periods of each value (from the configured initial state).
+    pub transient: u64,
+    /// Values of the parameter.
+    pub steps: usize,
 }

@@ -15,6 +15,7 @@ use vibrotribo::orbits::{
 };
 
 use crate::branch_picture::Drawing;
+pub use crate::branch_picture::{Diagram, describe};
 use crate::config::ConfigArgs;
 use crate::manifest::{
     BifurcationRecord, BranchRecord, CascadeRecord, ContinueManifest, Kind, ParentRecord, to_value,
@@ -169,34 +170,6 @@ pub fn run(args: &ContinueArgs) -> Result<()> {
         .into());
     }
     Ok(())
-}
-
-/// What a bifurcation is, in words, with its detail.
-pub fn describe(kind: &BifurcationKind) -> (&'static str, String) {
-    match kind {
-        BifurcationKind::Fold => ("fold", String::new()),
-        BifurcationKind::BranchPoint => ("branch_point", String::new()),
-        BifurcationKind::PeriodDoubling => ("period_doubling", String::new()),
-        BifurcationKind::NeimarkSacker { angle } => ("neimark_sacker", format!("angle {angle} rad")),
-        BifurcationKind::Grazing { contact, appears } => (
-            "grazing",
-            format!(
-                "contact {}: impact {}",
-                contact + 1,
-                if *appears { "appears" } else { "disappears" }
-            ),
-        ),
-        BifurcationKind::Sticking { contact, onset } => (
-            "sticking",
-            format!(
-                "contact {}: sticking {}",
-                contact + 1,
-                if *onset { "begins" } else { "ends" }
-            ),
-        ),
-        BifurcationKind::SequenceChange => ("sequence_change", String::new()),
-        _ => ("other", format!("{kind:?}")),
-    }
 }
 
 /// How a branch ends, in words.
@@ -484,20 +457,6 @@ fn bifurcation_record(branch: usize, f: &Bifurcation) -> BifurcationRecord {
             .copied()
             .collect(),
     }
-}
-
-/// The brute-force orbit diagram under a picture of branches.
-pub struct Diagram<'a> {
-    /// The parameter's key.
-    pub param: &'a str,
-    /// Its range.
-    pub range: (f64, f64),
-    /// The mass shown, 0-based.
-    pub mass: usize,
-    /// Transient periods of each value (from the configured initial state).
-    pub transient: u64,
-    /// Values of the parameter.
-    pub steps: usize,
 }
 
 /// The branches (stable solid, unstable dashed; every point of a period-P orbit on the

@@ -20,6 +20,7 @@ mod load_sweep;
 mod lyapunov;
 mod manifest;
 mod map;
+mod mass_ratio_picture;
 mod merge;
 mod merit;
 mod optimize;

@@ -2,12 +2,12 @@
 //! and `vibrotribo optimize-mass-ratio` (the optimal mass ratio R_mo(Ω) and the paper's
 //! quadratic fit of it, seed Fig. 16).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
-use vibrotribo::analysis::{QuadraticFit, fit_quadratic};
+use vibrotribo::analysis::fit_quadratic;
 use vibrotribo::config::Param;
 
 use crate::config::ConfigArgs;
@@ -19,10 +19,11 @@ use crate::job::{
 use crate::limits;
 use crate::manifest::{
     Axis, FitManifest, FitRecord, Kind, MapManifest, PaperFitRecord, SettleRecord, ShardRecord,
-    base_motion_of, read, to_value,
+    base_motion_of, to_value,
 };
-use crate::output::{CsvFile, check_out_dir, column, create_dir, numbers, read_csv, write_json};
-use crate::plot::{self, Figure, Series};
+pub use crate::mass_ratio_picture::plot_optimal_mass_ratio;
+use crate::mass_ratio_picture::plot_optimize_mass_ratio;
+use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
 use crate::progress::Interrupted;
 use vibrotribo::sweep::{Cell, PointColumns, grid};
 
@@ -316,54 +317,6 @@ pub const PAPER_FIT: [f64; 3] = vibrotribo::study::PAPER_MASS_RATIO_FIT;
 /// The paper's fit evaluated at Ω = `w`.
 pub fn paper_fit(w: f64) -> f64 {
     vibrotribo::study::paper_mass_ratio_fit(w)
-}
-
-/// Draws the optima of an `optimize-mass-ratio` directory with their fit and the paper's
-/// (`optimal_mass_ratio.png`/`.svg`), over the Ω range of `power_grid.csv`.
-pub fn plot_optimize_mass_ratio(dir: &Path) -> Result<()> {
-    let m: FitManifest = read(&dir.join("fit.json"))?;
-    let (h, rows) = read_csv(&dir.join("power_grid.csv"))?;
-    let omegas = numbers(&rows, column(&h, "omega_ratio")?);
-    let (Some(&w_from), Some(&w_to)) = (omegas.first(), omegas.last()) else {
-        bail!("{}: power_grid.csv holds no point", dir.display());
-    };
-    // The fit of the optima, as the command made it (the file holds its coefficients only).
-    let fit = fit_quadratic(&m.omega_ratio, &m.optimal_mass_ratio).ok();
-    crate::plot::both(dir, "optimal_mass_ratio", |path| {
-        plot_optimal_mass_ratio(
-            path,
-            &m.omega_ratio,
-            &m.optimal_mass_ratio,
-            fit.as_ref(),
-            (w_from, w_to),
-        )
-    })
-}
-
-/// Draws the optima (`ws`, `rs`), the paper's fit and `fit` over `[w_from, w_to]` to `path`.
-pub fn plot_optimal_mass_ratio(
-    path: &std::path::Path,
-    ws: &[f64],
-    rs: &[f64],
-    fit: Option<&QuadraticFit>,
-    (w_from, w_to): (f64, f64),
-) -> Result<()> {
-    let fine = grid(w_from, w_to, 100);
-    let paper: Vec<f64> = fine.iter().map(|&w| paper_fit(w)).collect();
-    let ours: Vec<f64> = fine
-        .iter()
-        .map(|&w| fit.map_or(f64::NAN, |f| f.eval(w)))
-        .collect();
-    let fig = Figure::new("Optimal mass ratio R_mo(Ω)", "Ω = ω/Ω1", "R_mo = m2/m1");
-    plot::phase_portrait(
-        path,
-        &fig,
-        &[
-            Series::new("paper's fit", &fine, &paper),
-            Series::new("fit to vibrotribo's optima", &fine, &ours),
-        ],
-        Some(Series::new("vibrotribo optima", ws, rs)),
-    )
 }
 
 /// The maximum of `values` on the equally spaced `grid`, refined by the parabola through the

@@ -39,7 +39,7 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         }
         Some(Kind::LoadSweep) => crate::load_sweep::plot_load_sweep(dir),
         Some(Kind::Periodic) => crate::periodic::plot_periodic(dir),
-        Some(Kind::OptimizeMassRatio) => crate::map::plot_optimize_mass_ratio(dir),
+        Some(Kind::OptimizeMassRatio) => crate::mass_ratio_picture::plot_optimize_mass_ratio(dir),
         Some(Kind::Optimize) => crate::optimize::plot_convergence(dir),
         None => bail!(
             "{} holds no vibrotribo results (expected the manifest of a command: summary.json beside trajectory.csv, sweep.json, map.json, basins.json, attractors.json, chirp.json, continue.json, lyapunov.json, load_sweep.json, periodic.json, fit.json beside optimum.csv, or optimize.json)",

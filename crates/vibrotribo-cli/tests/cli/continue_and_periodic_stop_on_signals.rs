@@ -11,6 +11,16 @@ use super::util::*;
 
 /// Runs the binary, sends `signal` after `after`, and waits for it.
 fn interrupted(args: &[&str], after: Duration, signal: &str) -> (ExitStatus, String) {
+    let (status, err) = run_and_signal(args, after, signal);
+    assert!(
+        !status.success(),
+        "finished before the signal: make the run longer"
+    );
+    (status, err)
+}
+
+/// Runs the binary, sends `signal` after `after` (if it is still running), and waits for it.
+fn run_and_signal(args: &[&str], after: Duration, signal: &str) -> (ExitStatus, String) {
     let child = Command::new(env!("CARGO_BIN_EXE_vibrotribo"))
         .args(args)
         .stdout(Stdio::piped())
@@ -19,19 +29,29 @@ fn interrupted(args: &[&str], after: Duration, signal: &str) -> (ExitStatus, Str
         .unwrap();
     std::thread::sleep(after);
     let pid = child.id().to_string();
-    assert!(
-        Command::new("kill")
-            .args([signal, &pid])
-            .status()
-            .unwrap()
-            .success()
-    );
+    // A child that has already exited (a zombie until waited for) ignores the signal.
+    Command::new("kill").args([signal, &pid]).status().unwrap();
     let o = child.wait_with_output().unwrap();
-    assert!(
-        !o.status.success(),
-        "finished before the signal: make the run longer"
-    );
     (o.status, String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// `continue` with `args` stopped by `signal` after its first orbit and before its end: the
+/// delay adapts to the machine's speed (shorter when the run ended first, longer when the
+/// signal came before the first orbit was written).
+fn continue_interrupted(args: &[&str], dir: &Path, signal: &str) -> (ExitStatus, String) {
+    let mut after = Duration::from_millis(800);
+    for _ in 0..12 {
+        let _ = std::fs::remove_dir_all(dir);
+        let (status, err) = run_and_signal(args, after, signal);
+        if status.success() {
+            after /= 2;
+        } else if !dir.join("continue.json").exists() && err.contains("interrupted") {
+            after = after * 3 / 2;
+        } else {
+            return (status, err);
+        }
+    }
+    panic!("no delay stopped `continue` between its first orbit and its end (last {after:?})");
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -72,7 +92,7 @@ fn continue_stopped_by_a_signal_writes_its_branches_marked_incomplete() {
         let config = config_file("chatter.toml");
         let args = long_continuation(config.to_str().unwrap(), d);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        let (status, err) = interrupted(&args, Duration::from_secs(4), signal);
+        let (status, err) = continue_interrupted(&args, &dir, signal);
         assert_eq!(status.code(), Some(code), "{signal}: {err}");
         assert!(err.contains("interrupted"), "{err}");
         let m = json(&dir.join("continue.json"));

@@ -69,7 +69,7 @@
 //! order v''·∫τ²δF, far below the tolerance.
 //!
 //! Measured on the paper's default case (exact V_oc, 100 kΩ, electrical rtol 1e-10, 20
-//! periods; `tests/coupling_checks.rs`): the energy identity W_base = ΔE + D + L + E_load + ΔU
+//! periods; `tests/suite/coupling_checks.rs`): the energy identity W_base = ΔE + D + L + E_load + ΔU
 //! closes to −7.5e-10 J at the default tolerance, 6.8e-12 of W = 111 J and 2.9e-7 of the
 //! electrical terms E_load + |ΔU| = 2.6 mJ, and the residual shrinks with the tolerance:
 //! −9.2e-8, −7.5e-10, 8.7e-11, −1.4e-11 J at 1e-10, 1e-11, 1e-12, 1e-13 m (with the
@@ -90,7 +90,7 @@
 //! ending at a stick, release or chatter point) the force is also matched pointwise at the
 //! window's end, where the engine decides: on every mass the installed force there is within
 //! the **force tolerance** `K_min·tol` (the weakest spring stretched by the position
-//! tolerance; 9e-10 N on `tests/coupling_events.rs`'s four-mass stack) of the force of the
+//! tolerance; 9e-10 N on `tests/suite/coupling_events.rs`'s four-mass stack) of the force of the
 //! solver's charge, wherever a release may hide at its end: a window that only has a contact
 //! stuck is tested only where the engine's contact force at its end is within the summed force
 //! error on the masses of zero (beyond that its sign is the true force's). Such a window keeps its force polynomial's terms down to a quarter of that
@@ -98,7 +98,7 @@
 //! if its end force stays off after three sweeps, down to 1e-9 periods (`CONSTANT_BELOW`),
 //! where the window itself bounds the error in time. A release then comes within the force
 //! tolerance over the contact force's rate of the zero of the true contact force (≤ 1.5e-11 s
-//! in `tests/coupling_events.rs`; it was up to 4.7e-8 s; notes/coupled-event-accuracy.md).
+//! in `tests/suite/coupling_events.rs`; it was up to 4.7e-8 s; notes/coupled-event-accuracy.md).
 //! After two windows of length zero at one instant the next is not held to the end test (trials
 //! that differ in the force's derivatives at the start could undo each other's stick and
 //! release there).
@@ -112,7 +112,7 @@
 //! ([`Simulator::driven`](crate::Simulator::driven)): under a motion other than the sine the
 //! engine adds each interval's base forces `k_i y + c_i y'` to the window's electrostatic
 //! force polynomial and switches them at the interval ends inside a window, so the windows
-//! and their tolerances are those above. `tests/coupling_base_motion.rs` checks the energy
+//! and their tolerances are those above. `tests/suite/coupling_base_motion.rs` checks the energy
 //! identity under band-limited random input (6e-12 of W_base on the default chain) and under
 //! a recorded ground acceleration (1.2e-10 of W_base), where the one-way run misses it by the
 //! electrical terms (1e-3 and 5e-2 of W_base).

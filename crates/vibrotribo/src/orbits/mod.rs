@@ -44,7 +44,7 @@
 //! saltation matrices of `sensitivity` (a gap `h` with explicit time dependence
 //! `∂h/∂t = ±Y'`, a reset of one cluster only), and the single-mass impact oscillator's
 //! (1,1) orbits, multipliers and period doubling agree with their closed form
-//! (`tests/stops.rs`). The grazing gap minimum watched during continuation (a branch
+//! (`tests/suite/stops.rs`). The grazing gap minimum watched during continuation (a branch
 //! approaching a new impact) includes the stops' gaps: the textbook orbit that never touches
 //! the stop meets it where its steady amplitude equals the gap.
 

@@ -160,7 +160,7 @@ impl Simulator {
         let remaining = flight / (1.0 - mu);
         // First-order effect of the changing acceleration on the remaining flights
         // Σ τ_n² j/a, with a safety factor of 4 (checked against an independent bounce-by-bounce
-        // integration in tests/special_cases.rs).
+        // integration in tests/suite/special_cases.rs).
         let error = 4.0 * jerk / a * flight * flight / (1.0 - mu * mu);
         // Resolving the next bounce individually cannot time it better than the gap's
         // rounding (about two ulps of the positions) over the rebound speed; below that, the

@@ -5,8 +5,7 @@
 //! map's own dynamics, and every point of branches on random chains re-simulated by the
 //! engine: it returns to itself after its period and never closes a gap below zero.
 
-#[path = "common/impact_oscillator.rs"]
-mod impact_oscillator;
+use crate::common::impact_oscillator;
 
 use impact_oscillator::ImpactOscillator;
 use vibrotribo::orbits::{

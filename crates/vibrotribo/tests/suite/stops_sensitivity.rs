@@ -3,7 +3,7 @@
 //! space or moving with the base, over 1–2 periods with impacts against the stops, sticking
 //! to them, releases and chatter jumps in the interval.
 
-mod common;
+use crate::common;
 
 use common::fd::{FdComparison, compare_with_fd};
 use common::{Lcg, random_chain};

@@ -135,7 +135,7 @@ fn the_default_case_is_multistable_and_each_attractor_is_a_stable_orbit_by_shoot
 
 #[test]
 fn a_hyperchaotic_attractor_is_one_non_periodic_attractor() {
-    // Fig. 14's chain at R_m = 6.54, Ω = 0.72: λ1 = 3.3, λ2 = 1.1 1/s (tests/lyapunov.rs).
+    // Fig. 14's chain at R_m = 6.54, Ω = 0.72: λ1 = 3.3, λ2 = 1.1 1/s (tests/suite/lyapunov.rs).
     let c = config(&[
         ("oscillator.masses", array(&[0.05, 0.327, 0.05])),
         ("omega_ratio", toml::Value::Float(0.72)),

@@ -4,7 +4,7 @@
 //! negative anywhere the simulator saw no event (nothing missed), and (b) every impact the
 //! simulator reports is where the brute-force search finds the gap crossing.
 
-mod common;
+use crate::common;
 
 use common::{ClusterOde, integrate, integrate_to};
 use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator, Trajectory};

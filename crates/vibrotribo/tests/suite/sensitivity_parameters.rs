@@ -9,7 +9,7 @@
 //!   velocities λ times larger when the initial velocities are λ times larger, so
 //!   `∂z/∂λ + Φ (0, v₀) = (0, v(PT))`.
 
-mod common;
+use crate::common;
 
 use common::{Lcg, random_chain};
 use nalgebra::DVector;

@@ -2,7 +2,7 @@
 //! as such, and near grazing Φ stays exact but grows like 1/(closing speed), which finite
 //! differences confirm only with steps below the distance to grazing.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

@@ -2,7 +2,7 @@
 //! default tolerance against a reference computed with a 1e5 times tighter one, for loads
 //! from 1 kΩ (stiff) to 10 GΩ (not stiff), and convergence under halving the tolerance.
 
-mod common;
+use crate::common;
 use common::period_stats;
 use vibrotribo::electrical::{ChargeOptions, HarvesterParams, Load, PeriodStats, Rectifier};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};

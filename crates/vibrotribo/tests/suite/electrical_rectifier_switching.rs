@@ -3,7 +3,7 @@
 //! spanned the bridge's switching, where the current changes by orders of magnitude between
 //! the stage points and the error estimate does not see it.
 
-mod common;
+use crate::common;
 use common::period_stats;
 use vibrotribo::electrical::{ChargeOptions, HarvesterParams, Load, Rectifier};
 use vibrotribo::{ChainParams, ChainState, SimOptions, Simulator, Trajectory};

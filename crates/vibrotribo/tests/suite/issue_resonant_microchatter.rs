@@ -5,7 +5,7 @@
 //! (≈ 0.1 m here), while the closed forms sum them from terms a hundred times larger (the top
 //! mass is driven at 0.997 of its natural frequency with 0.36 % damping: an 8 m forced
 //! amplitude, cancelled by the free motion early on). The tolerances now scale with the size
-//! of the terms. Found by a stress variant of `tests/reliability.rs` (zero or light damping,
+//! of the terms. Found by a stress variant of `tests/suite/reliability.rs` (zero or light damping,
 //! μ up to 1).
 
 use vibrotribo::{

@@ -2,7 +2,7 @@
 //! sticking and release of clusters (including all three masses), simultaneous impacts, and
 //! the paper's symmetric R_m = 1 case.
 
-mod common;
+use crate::common;
 
 use common::grazing_pair;
 

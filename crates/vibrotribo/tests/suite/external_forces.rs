@@ -5,7 +5,7 @@
 //! gap and resolved by Newton's law), contact forces computed by hand from Newton's second
 //! law, and finite differences of the flow map for the state-transition matrix.
 
-mod common;
+use crate::common;
 
 use common::Lcg;
 use common::fd::{compare_with_fd, compare_with_fd_prepared};
@@ -641,7 +641,7 @@ fn first_zero(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 
 /// Φ of runs with constant forces (through `flow_map`) and with polynomial forces set before
 /// the run (through the `Sensitivity` observer) against Richardson-extrapolated central
-/// differences of the flow map (tests/common/fd.rs), on random chains with impacts, sticking
+/// differences of the flow map (tests/suite/common/fd.rs), on random chains with impacts, sticking
 /// and chatter; the same acceptance as the tests without forces.
 #[test]
 fn stm_with_external_forces_matches_finite_differences() {

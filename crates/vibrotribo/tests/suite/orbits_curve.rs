@@ -5,8 +5,7 @@
 //! impact-free orbit where its steady amplitude equals the gap; every point of a curve a true
 //! orbit of the engine.
 
-#[path = "common/impact_oscillator.rs"]
-mod impact_oscillator;
+use crate::common::impact_oscillator;
 
 use impact_oscillator::{ImpactOscillator, OneOne};
 use vibrotribo::config::Config;

@@ -4,7 +4,7 @@
 //! saltation determinants μ² of the impacts), and a two-trajectory (Benettin) estimate from
 //! the exact flow alone.
 
-mod common;
+use crate::common;
 
 use common::Lcg;
 use vibrotribo::lyapunov::{LyapunovError, LyapunovOptions, LyapunovSpectrum};

@@ -6,6 +6,7 @@ pub mod balance;
 pub mod base_motion;
 pub mod electrostatics;
 pub mod fd;
+pub mod impact_oscillator;
 pub mod quadrature;
 
 use ode_solvers::{DVector, Dop853, OutputType, System};
@@ -100,7 +101,7 @@ impl System<f64, DVector<f64>> for ClusterOde {
 /// ends exactly at its `x_end`.
 ///
 /// Any system in the same autonomous form (time as the last state component, appended here)
-/// can be integrated: [`ClusterOde`], or the coupled equations of tests/coupling_events.rs.
+/// can be integrated: [`ClusterOde`], or the coupled equations of tests/suite/coupling_events.rs.
 pub fn integrate<O: System<f64, DVector<f64>> + Clone>(
     ode: O,
     t0: f64,
@@ -301,7 +302,7 @@ pub fn grazing_pair(eps: f64) -> (ChainParams, ChainState, f64) {
     (params, initial, wn)
 }
 
-/// Four masses that stick and release (tests/events_vs_bruteforce.rs): 40–90 g, gaps 4–8 mm,
+/// Four masses that stick and release (tests/suite/events_vs_bruteforce.rs): 40–90 g, gaps 4–8 mm,
 /// μ = 0.3, A = 50 mm, Ω = 0.55.
 pub fn four_mass_stack() -> ChainParams {
     ChainParams {

@@ -3,7 +3,7 @@
 //! t = 3.5e-7 s): the velocities were equalized one contact at a time, so that equalizing the
 //! next contact undid the previous one, and a resting cluster of the group was merged to its
 //! own centre-of-mass velocity only afterwards. Found by a stress variant of
-//! `tests/reliability.rs` (masses from 1 g to 1 kg, gaps down to 1e-8 m); the whole group now
+//! `tests/suite/reliability.rs` (masses from 1 g to 1 kg, gaps down to 1e-8 m); the whole group now
 //! takes one velocity.
 
 use vibrotribo::{
@@ -68,7 +68,7 @@ fn check(params: ChainParams, velocities: Vec<f64>, periods: f64) {
         "{} events; momentum {:e}, energy {:e}, smallest gap {:e} m",
         inv.events, inv.worst_momentum, inv.worst_energy, inv.worst_gap
     );
-    // 256 ulps, as in tests/reliability.rs; positions here stay below 0.1 m.
+    // 256 ulps, as in tests/suite/reliability.rs; positions here stay below 0.1 m.
     let tol = 256.0 * f64::EPSILON;
     assert!(inv.worst_momentum < tol && inv.worst_energy < tol);
     assert!(inv.worst_gap > -tol * 0.1, "overlap {:e} m", inv.worst_gap);

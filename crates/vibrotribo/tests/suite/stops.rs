@@ -4,8 +4,7 @@
 //! time between them; sticking to a stop moving with the base with its closed-form release
 //! time; no mass ever beyond a stop.
 
-#[path = "common/impact_oscillator.rs"]
-mod impact_oscillator;
+use crate::common::impact_oscillator;
 
 use impact_oscillator::{ImpactOscillator, OneOne};
 use vibrotribo::orbits::{

@@ -185,7 +185,7 @@ impl Lcg {
 /// run from that start is on.
 #[test]
 fn impact_oscillator_with_an_orbit_beside_an_irregular_attractor() {
-    let base = Config::from_toml_str(include_str!("../../../configs/impact_oscillator.toml")).unwrap();
+    let base = Config::from_toml_str(include_str!("../../../../configs/impact_oscillator.toml")).unwrap();
     let c = config(base, &[("excitation.omega_ratio", float(3.05))]);
     let params = c.chain();
     let (a, v) = (

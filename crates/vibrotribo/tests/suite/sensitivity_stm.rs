@@ -3,7 +3,7 @@
 //! sticking, releases and chatter jumps), the matrix exponential of the linear system when
 //! nothing touches, and finite differences of event times.
 
-mod common;
+use crate::common;
 
 use common::fd::{compare_with_fd, run_with, signature};
 use common::{Lcg, random_chain};

@@ -4,7 +4,7 @@
 //! **Static equilibrium.** With the base at rest the coupled chain settles where every spring
 //! balances the electrostatic forces on its mass. The test computes that point on its own,
 //! from the field energy of the parallel-plate stack written out in
-//! tests/common/electrostatics.rs (docs/MODEL.md §2):
+//! tests/suite/common/electrostatics.rs (docs/MODEL.md §2):
 //!
 //! ```text
 //! freestanding:        U = [Q² d₀ + (Q + σS)² D₁ + (σS − Q)² D₂] / (2ε₀S)
@@ -34,7 +34,7 @@ use vibrotribo::electrical::{
 use vibrotribo::study::{RunObserver, Sample, Sampling, simulate};
 use vibrotribo::{ChainParams, ChainState, Event, Flow, SimOptions, Simulator, StateView};
 
-mod common;
+use crate::common;
 use common::balance::Balance;
 use common::base_motion::Base;
 use common::electrostatics::{VACUUM_PERMITTIVITY, electrostatic_forces, equilibrium_charge, field_energy};
@@ -218,7 +218,7 @@ fn static_equilibrium_contact_separation() {
 // Energy balance over a coupled run.
 // ---------------------------------------------------------------------------------------
 //
-// **The identity.** With E = Σ ½ m_i v_i² + ½ k_i (x_i − y)² as in tests/excitation_energy.rs
+// **The identity.** With E = Σ ½ m_i v_i² + ½ k_i (x_i − y)² as in tests/suite/excitation_energy.rs
 // (whose derivation this extends), the electrostatic force F_i on mass i adds Σ F_i v_i to
 // dE/dt. The gap force G_k acts as +G_k on mass k and −G_k on mass k + 1, and
 // D_k = δ_k − (x_{k+1} − x_k), so Σ F_i v_i = Σ G_k (v_k − v_{k+1}) = Σ G_k dD_k/dt. Along
@@ -230,11 +230,11 @@ fn static_equilibrium_contact_separation() {
 // with E_load = ∫ V I dt the energy that left the transducer's terminals (V the generator's
 // voltage, I = dQ/dt; `ElectricalOutcome::terminal_energy_j`, the charge solver's
 // collocation quadrature of V·I) and ΔU = U(Q, D₁, D₂)(end) − U(start) (U written out in
-// tests/common/electrostatics.rs, the charge taken from the run's samples at t = 0 and at the
+// tests/suite/common/electrostatics.rs, the charge taken from the run's samples at t = 0 and at the
 // end). For a resistor E_load is ∫ V²/R dt, what the solver books per period as the load's
 // energy; for the rectifier it is the storage side's energy ∫ V_s I_out dt (what the periods
 // book) plus the bridge's losses, which the periods leave out.
-// W_base, D_damping and L_events are measured as in tests/excitation_energy.rs: Gauss–Legendre
+// W_base, D_damping and L_events are measured as in tests/suite/excitation_energy.rs: Gauss–Legendre
 // quadrature of the closed-form flow, kinetic-energy jumps at events.
 //
 // In one-way mode the masses feel no force, so W_base = ΔE + D + L alone; the load's energy
@@ -381,7 +381,7 @@ fn energy_balance_two_way_resistor() {
 
 /// Energy balance of the chatter case in its sticking regime (masses 0.05/0.15/0.05 kg, gaps
 /// 5 mm, Ω = 0.4, 100 kΩ, 5 periods from rest: impacts, chatter, sticks and releases), where
-/// a two-way run can loop at a release (tests/issue_coupled_stick_release_loop.rs): the
+/// a two-way run can loop at a release (tests/suite/issue_coupled_stick_release_loop.rs): the
 /// work of the base is ΔE + D + L + E_load + ΔU to 1e-8 of it and to 1e-5 of the electrical
 /// terms.
 #[test]
@@ -567,7 +567,7 @@ fn energy_balance_two_way_against_the_electrical_terms() {
 /// (a Riemann sum on a 1 µs grid of a force error that, inside the ~1 µs layer, is still there
 /// pointwise: only its impulse and first moment per window are matched), so the probe checks
 /// that what it sees is at most that resolution, 2e-8 J (30× below the old error). A
-/// diagnostic (about 10 s): `cargo test --test coupling_checks -- --ignored --nocapture
+/// diagnostic (about 10 s): `cargo test --test suite coupling_checks -- --ignored --nocapture
 /// force_error`.
 #[test]
 #[ignore = "diagnostic, ~10 s"]

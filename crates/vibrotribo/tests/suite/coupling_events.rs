@@ -4,8 +4,8 @@
 //!
 //! - **An independent integrator of the coupled equations.** From the start of every window
 //!   of the coupled run (the simulator's state and the solver's charge there), Dop853
-//!   (tests/common) integrates the chain under the electrostatic force written out in
-//!   tests/common/electrostatics.rs together with the circuit (R dQ/dt = V for a resistor,
+//!   (tests/suite/common) integrates the chain under the electrostatic force written out in
+//!   tests/suite/common/electrostatics.rs together with the circuit (R dQ/dt = V for a resistor,
 //!   Q constant in open circuit, Q = Q_eq(D) in short circuit; the bridge is not written
 //!   out), and its gaps are sampled on a grid: no open gap may go below −tol where the coupled
 //!   run saw no event (nothing missed), and its state at the window's end must be the run's
@@ -20,15 +20,15 @@
 //!   release) and not before it.
 //! - **A closed form.** In open circuit the force is constant; two masses with equal k/m
 //!   then have a relative motion r(t) = s(1 − cos ω_n t) + a sin ω_n t, whose grazing is
-//!   known exactly (tests/special_cases.rs's grazing pair, with the electrostatic pull).
-//! - **Conservation at events** (tests/reliability.rs): momentum kept, kinetic energy never
+//!   known exactly (tests/suite/special_cases.rs's grazing pair, with the electrostatic pull).
+//! - **Conservation at events** (tests/suite/reliability.rs): momentum kept, kinetic energy never
 //!   gained.
 //!
 //! The one-way accuracy of the stored flow (gaps ≥ −1e-12 δ as in
-//! tests/events_vs_bruteforce.rs), which two-way runs once missed
+//! tests/suite/events_vs_bruteforce.rs), which two-way runs once missed
 //! (notes/coupled-event-accuracy.md), is met again: [`coupled_stored_flow_gaps`].
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 
@@ -239,7 +239,7 @@ fn scan_stored_flow(traj: &Trajectory, deltas: &[f64], grid: usize) -> (f64, f64
 }
 
 /// The coupled equations of motion, written here: per cluster (top position s, m; velocity,
-/// m/s), then for a resistor q = Q/σS; time last (the autonomous form of tests/common).
+/// m/s), then for a resistor q = Q/σS; time last (the autonomous form of tests/suite/common).
 #[derive(Clone)]
 struct CoupledOde {
     chain: ChainParams,
@@ -589,7 +589,7 @@ fn chatter_case(omega_ratio: f64) -> ChainParams {
 }
 
 /// The scenarios with sticking and chatter: the chatter case in its chattering (Ω = 0.6) and
-/// sticking (Ω = 0.4) regimes, and tests/events_vs_bruteforce.rs's four-mass stack.
+/// sticking (Ω = 0.4) regimes, and tests/suite/events_vs_bruteforce.rs's four-mass stack.
 fn sticking_scenarios() -> Vec<(&'static str, ChainParams, f64)> {
     vec![
         ("chatter case, Ω = 0.6", chatter_case(0.6), 6.0),
@@ -614,7 +614,7 @@ fn start_charge(h: &HarvesterParams, chain: &ChainParams) -> f64 {
 const SCAN_GRID: usize = 16;
 
 /// How long before or after the true zero of its contact force a release may come, s (one-way:
-/// 1e-12 s against the closed form, tests/special_cases.rs).
+/// 1e-12 s against the closed form, tests/suite/special_cases.rs).
 const RELEASE_TIME: f64 = 1e-9;
 
 /// Runs each sticking scenario with `load` and checks the events (see the module docs):
@@ -768,7 +768,7 @@ fn four_mass_stack_against_the_integrator() {
     check_against_the_integrator("four masses", &common::four_mass_stack(), 3.0, 4);
 }
 
-/// tests/special_cases.rs's grazing pair (two undamped masses with equal k/m) in
+/// tests/suite/special_cases.rs's grazing pair (two undamped masses with equal k/m) in
 /// contact-separation mode, open circuit, Q = −0.2 σS: the electrostatic force G on the gap is
 /// constant, and the relative motion r = x₂ − x₁ from rest with speed v₀ is
 /// r(t) = s(1 − cos ω_n t) + a sin ω_n t, s = −G(1/m₁ + 1/m₂)/ω_n², a = v₀/ω_n, whose
@@ -812,13 +812,13 @@ fn grazing_pair_in_open_circuit_against_the_closed_form() {
             continue;
         }
         let e = first.unwrap_or_else(|| panic!("ε = {eps}: contact missed"));
-        // The one-way test's tolerances (tests/special_cases.rs).
+        // The one-way test's tolerances (tests/suite/special_cases.rs).
         common::assert_grazing_contact(&e, eps, t_expected, v_expected);
     }
 }
 
 /// The one-way accuracy of the stored flow in two-way runs: every gap of the stored flow ≥ −1e-12
-/// of its δ (tests/events_vs_bruteforce.rs's criterion; one-way runs of these chains reach
+/// of its δ (tests/suite/events_vs_bruteforce.rs's criterion; one-way runs of these chains reach
 /// −2.7e-13 δ at worst; notes/coupled-event-accuracy.md §2 explains what makes two-way runs
 /// reach it). Measured: the twelve runs at −1.5e-14 … −3.8e-13 δ. Also prints each run's latest
 /// release after the zero of its contact force (asserted in the main checks).

@@ -2,7 +2,7 @@
 //! the code: the harmonic run itself (a one-harmonic multisine must equal it bit for bit, a
 //! record of it sampled 200 times a period must reproduce it within the spline's error), an
 //! independent fixed-step RK4 integrator written here (two harmonics, impacts by bisection
-//! and Newton's law, as in tests/external_forces.rs), and the refusals' reasons.
+//! and Newton's law, as in tests/suite/external_forces.rs), and the refusals' reasons.
 
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -1,7 +1,7 @@
 //! The closed-form flow against an independent high-accuracy integrator (Dop853 at
 //! rtol 1e-13), in every damping regime, for free masses and for a stuck cluster.
 
-mod common;
+use crate::common;
 
 use common::{ClusterOde, integrate};
 use vibrotribo::{ChainParams, ChainState, Excitation, Frequency, SimOptions, Simulator, Trajectory};

@@ -3,7 +3,7 @@
 //! paper's default case, the decay and growth of perturbations measured by direct
 //! simulation, and the error reports.
 
-mod common;
+use crate::common;
 
 use common::Lcg;
 use nalgebra::{Complex, DMatrix, DVector};

@@ -3,7 +3,7 @@
 //! `StdRng`, seeded from a fixed `SEED` and the case's index, so any failure can be rerun alone
 //! (failures are reported by index). A CI-sized sample
 //! runs with the other tests; the full size (10⁴ cases each) with
-//! `cargo test --release -p vibrotribo --test reliability -- --ignored`.
+//! `cargo test --release -p vibrotribo --test suite reliability -- --ignored`.
 //!
 //! **Grazing with a known answer.** Two masses whose relative coordinate r = x₂ − x₁ is known in
 //! closed form, so that the gap d = δ − r has its minimum −εδ at a known time t*:
@@ -36,7 +36,7 @@
 //! rounded to a few ulps at an impact, which moves E by a few ulps of Σ m v²; 256 leaves a wide
 //! margin for impulses resolved over several pairwise iterations).
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

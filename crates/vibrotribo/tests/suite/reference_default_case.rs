@@ -1,7 +1,7 @@
 //! The paper's default case against `tests/data/reference/` (an independent adaptive integrator
 //! with event functions at rtol 1e-11, whose impact times are good to about 1e-9 s).
 
-mod common;
+use crate::common;
 
 use common::{read_csv, reference_dir};
 use vibrotribo::{ChainParams, ChainState, EventKind, EventLog, SimOptions, Simulator, Trajectory};

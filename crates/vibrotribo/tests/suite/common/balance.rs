@@ -1,5 +1,5 @@
 //! The energy balance of a coupled run, observed from outside the coupling code (used by
-//! tests/coupling_checks.rs under the sine and tests/coupling_base_motion.rs under random and
+//! tests/suite/coupling_checks.rs under the sine and tests/suite/coupling_base_motion.rs under random and
 //! recorded base motion): the base's work W and the damping D by Gauss–Legendre quadrature of
 //! the closed-form flow against the base displacement on its own pieces, the energy lost at
 //! events L, the chain's energy E, and the charge and gaps of every sample.

@@ -5,15 +5,15 @@
 //! W_base = ΔE + D_damping + L_events + E_load + ΔU
 //! ```
 //!
-//! derived in tests/coupling_checks.rs (the electrostatic force does −dU/dt − V·I of work on
-//! the masses) from tests/excitation_energy.rs's mechanical balance, which holds for any base
+//! derived in tests/suite/coupling_checks.rs (the electrostatic force does −dU/dt − V·I of work on
+//! the masses) from tests/suite/excitation_energy.rs's mechanical balance, which holds for any base
 //! displacement y(t): E = Σ ½ m_i v_i² + ½ k_i (x_i − y)², W_base = ∫ Σ f_i y' dt with
 //! f_i = −k_i (x_i − y) − c_i (v_i − y'), D = ∫ Σ c_i (v_i − y')² dt, L the energy jumps at
 //! events. Nothing here comes from the coupling code: W and D are Gauss–Legendre
 //! quadratures of the closed-form flow against the base displacement evaluated on its own
-//! pieces (tests/common/base_motion.rs; each flow piece split at the knots), E_load is the
+//! pieces (tests/suite/common/base_motion.rs; each flow piece split at the knots), E_load is the
 //! charge solver's ∫V·I dt, ΔU the field energy of the plates written out in
-//! tests/common/electrostatics.rs at the charges and gaps of the first and last samples.
+//! tests/suite/common/electrostatics.rs at the charges and gaps of the first and last samples.
 //!
 //! The one-way run of the same case closes the mechanical balance alone and misses the full
 //! identity by E_load + ΔU, far outside the tolerance: the check can fail.
@@ -22,12 +22,12 @@ use vibrotribo::Simulator;
 use vibrotribo::config::{Config, apply_overrides};
 use vibrotribo::study::{Sampling, simulate};
 
-mod common;
+use crate::common;
 use common::balance::Balance;
 use common::base_motion::Base;
 use common::electrostatics::field_energy;
 
-/// Relative tolerance of the full identity, of |W_base| (tests/coupling_checks.rs's, under
+/// Relative tolerance of the full identity, of |W_base| (tests/suite/coupling_checks.rs's, under
 /// the sine, at the default coupling tolerance 1e-11 m).
 const TOLERANCE: f64 = 1e-8;
 
