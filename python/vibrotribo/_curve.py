@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Dict, List, Optional
+from typing import TYPE_CHECKING, Any, Dict, List, Optional
 
 import numpy as np
 
 from ._display import Display
 from ._results import _pandas
+
+if TYPE_CHECKING:
+    import pandas
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -61,7 +64,7 @@ class Curve(Display):
         """The second key along the curve."""
         return self.points["parameter2"]
 
-    def to_pandas(self):
+    def to_pandas(self) -> "pandas.DataFrame":
         """The points as a pandas DataFrame with the columns of ``curve.csv``: the two keys
         by name, ``period``, ``kind``, ``condition``, ``multiplier_K_re``/``_im``,
         ``x1_m …``, ``v1_m_s …``, ``impacts_per_period_K``, ``gap_minimum_m``,
