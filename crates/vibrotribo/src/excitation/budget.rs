@@ -25,7 +25,7 @@ pub struct WorkBudget {
     /// Build beyond [`MAX_PIECE_EVALUATIONS`] (the command line's `--allow-large`).
     pub allow_large: bool,
     /// Set (by a signal handler, another thread) to stop a build in progress: it then
-    /// returns [`SignalError::Stopped`]. Read every [`POLL_INTERVALS`] intervals.
+    /// returns [`SignalError::Stopped`]. Read every 64 intervals.
     pub stop: Option<Arc<AtomicBool>>,
 }
 

@@ -118,7 +118,7 @@ impl HarmonicPieces {
 
     /// [`new`](Self::new) within `budget`: refused before it starts if harmonics × intervals
     /// exceed what it allows ([`WorkBudget::check`]), stopped ([`SignalError::Stopped`]) when
-    /// its stop flag is set (read every [`POLL_INTERVALS`] intervals).
+    /// its stop flag is set (read every 64 intervals).
     pub fn new_within(
         harmonics: &[Harmonic],
         end: f64,
