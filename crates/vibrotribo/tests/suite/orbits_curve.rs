@@ -251,8 +251,8 @@ fn grazing_curve_is_where_the_steady_amplitude_equals_the_gap() {
             p.parameter,
             p.parameter2
         );
-        // The grazing orbit touches the stop with zero speed: with the stop 1 nm higher it is
-        // an impact-free orbit of the engine, with the stop 1 nm lower it hits it.
+        // The grazing orbit touches the stop with zero speed: with the stop raised by 1 nm it is
+        // an impact-free orbit of the engine, lowered by 1 nm it hits it.
         let above = config(p.parameter, p.parameter2 + 1e-9);
         assert_true_orbit(&above, p, curve.period);
         assert_eq!(
