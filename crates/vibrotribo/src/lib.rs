@@ -39,7 +39,10 @@
 //!   parameters; matrices are [`nalgebra`]'s, re-exported here. [`orbits`] finds periodic
 //!   orbits by shooting (stable or not), their Floquet multipliers, and continues them in a
 //!   parameter through folds, period doublings (cascades included), Neimark–Sacker points,
-//!   grazings and the onset of sticking. [`lyapunov`] computes all 2N Lyapunov exponents
+//!   grazings and the onset of sticking; [`branch`] runs that continuation from a
+//!   configuration and a key (what `vibrotribo continue` and Python's `continue_` call), and
+//!   [`curve`] follows a located fold, period doubling, Neimark–Sacker point or grazing in a
+//!   second key. Long searches stop through [`orbits::Cancel`]. [`lyapunov`] computes all 2N Lyapunov exponents
 //!   through impacts, sticking and chatter, with a batch-means error bar. [`attractors`]
 //!   finds the attractors that starts end on (by their stroboscopic sets), their basin
 //!   fractions and powers, and follows them across a parameter.
