@@ -20,7 +20,7 @@ use crate::config::ConfigArgs;
 use crate::manifest::{
     BifurcationRecord, BranchRecord, CascadeRecord, ContinueManifest, Kind, ParentRecord, to_value,
 };
-use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
+use crate::output::{CsvFile, create_dir, csv_text, multipliers_text, numbered, write_json};
 use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
 
 /// Values of the brute-force orbit diagram under a continuation's picture, by default.
@@ -266,14 +266,6 @@ fn print_continuation(param: &str, result: &Continuation) {
     }
 }
 
-fn multipliers_text(p: &BranchPoint) -> String {
-    p.multipliers
-        .iter()
-        .map(|m| format!("{}{:+}i", m.re, m.im))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 /// The columns and rows of `branch.csv`: every point of every branch, numbers written
 /// exactly (`power`: the average power along each branch, W, if computed).
 pub fn branch_table(
@@ -383,14 +375,14 @@ fn write_files(
                 contact,
                 csv_text(&detail),
                 f.child.map_or(String::new(), |c| c.to_string()),
-                csv_text(&multipliers_text(&f.point)),
+                csv_text(&multipliers_text(&f.point.multipliers)),
                 f.crossing.map_or(String::new(), |c| c.kind.name().to_string()),
                 f.crossing
                     .and_then(|c| c.nordmark)
                     .map_or(String::new(), |n| n.name().to_string()),
                 f.after
                     .as_ref()
-                    .map_or(String::new(), |a| csv_text(&multipliers_text(a))),
+                    .map_or(String::new(), |a| csv_text(&multipliers_text(&a.multipliers))),
             ])?;
             listed.push(bifurcation_record(i, f));
         }

@@ -8,10 +8,10 @@ use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 use vibrotribo::config::Config;
 use vibrotribo::curve::{ConfigCurve, CurveConfigOptions, CurveRequest, curve_config, curve_powers};
-use vibrotribo::orbits::curve::{Codim2Kind, CurveEnd, CurveKind, CurveOptions, CurvePoint};
+use vibrotribo::orbits::curve::{Codim2Kind, CurveEnd, CurveKind, CurveOptions};
 
 use crate::config::ConfigArgs;
-use crate::output::{CsvFile, create_dir, csv_text, numbered, write_json};
+use crate::output::{CsvFile, create_dir, csv_text, multipliers_text, numbered, write_json};
 
 /// Options of `vibrotribo curve`.
 #[derive(Debug, clap::Args)]
@@ -223,14 +223,6 @@ fn print_curve(r: &ConfigCurve) {
     }
 }
 
-fn multipliers_text(p: &CurvePoint) -> String {
-    p.multipliers
-        .iter()
-        .map(|m| format!("{}{:+}i", m.re, m.im))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 fn write_files(
     dir: &Path,
     config: &Config,
@@ -272,7 +264,7 @@ fn write_files(
             c.kind.name().to_string(),
             p.condition.to_string(),
             p.multipliers.first().map_or(0.0, |m| m.norm()).to_string(),
-            csv_text(&multipliers_text(p)),
+            csv_text(&multipliers_text(&p.multipliers)),
         ];
         for k in 0..2 * n {
             let m = p.multipliers.get(k);
@@ -313,7 +305,7 @@ fn write_files(
             p.point.parameter2.to_string(),
             p.precision.to_string(),
             contact.map_or(String::new(), |k| k.to_string()),
-            csv_text(&multipliers_text(&p.point)),
+            csv_text(&multipliers_text(&p.point.multipliers)),
         ])?;
         records.push(Codim2Record {
             kind: p.kind.name(),

@@ -167,6 +167,16 @@ pub fn numbered(prefix: &str, n: usize, suffix: &str) -> Vec<String> {
     (1..=n).map(|i| format!("{prefix}{i}{suffix}")).collect()
 }
 
+/// Complex multipliers as text, `re±imi` each, space-separated, numbers written exactly (a
+/// CSV cell after [`csv_text`]).
+pub fn multipliers_text(multipliers: &[vibrotribo::nalgebra::Complex<f64>]) -> String {
+    multipliers
+        .iter()
+        .map(|m| format!("{}{:+}i", m.re, m.im))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// A text field for CSV: quoted (with quotes doubled) if it holds a comma, quote or newline
 /// (the library's [`Cell`] text).
 pub fn csv_text(text: &str) -> String {
