@@ -53,6 +53,7 @@ mod locate;
 mod nordmark;
 mod phase;
 mod types;
+pub(in crate::orbits) use types::check_path;
 
 pub use branch::continue_orbit;
 pub use cascade::{cascade, feigenbaum_ratios};

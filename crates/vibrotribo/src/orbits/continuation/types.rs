@@ -63,21 +63,7 @@ impl Default for ContinuationOptions {
 impl ContinuationOptions {
     /// Checks the options.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_positive("initial_step", self.initial_step)?;
-        check_positive("min_step", self.min_step)?;
-        check_positive("max_step", self.max_step)?;
-        check(
-            "max_step",
-            self.max_step,
-            self.min_step <= self.initial_step && self.initial_step <= self.max_step,
-            "must satisfy min_step ≤ initial_step ≤ max_step",
-        )?;
-        check(
-            "max_points",
-            self.max_points as f64,
-            self.max_points >= 2,
-            "must be at least 2",
-        )?;
+        check_path(self.initial_step, self.min_step, self.max_step, self.max_points)?;
         check(
             "max_branches",
             self.max_branches as f64,
@@ -95,6 +81,32 @@ impl ContinuationOptions {
         check_positive("parameter_step", self.parameter_step)?;
         self.shooting.validate()
     }
+}
+
+/// Checks the step lengths and point budget that every pseudo-arclength path shares (a
+/// branch, a bifurcation curve): positive steps with `min_step ≤ initial_step ≤ max_step`
+/// and at least two points.
+pub(in crate::orbits) fn check_path(
+    initial_step: f64,
+    min_step: f64,
+    max_step: f64,
+    max_points: usize,
+) -> Result<(), ParamError> {
+    check_positive("initial_step", initial_step)?;
+    check_positive("min_step", min_step)?;
+    check_positive("max_step", max_step)?;
+    check(
+        "max_step",
+        max_step,
+        min_step <= initial_step && initial_step <= max_step,
+        "must satisfy min_step ≤ initial_step ≤ max_step",
+    )?;
+    check(
+        "max_points",
+        max_points as f64,
+        max_points >= 2,
+        "must be at least 2",
+    )
 }
 
 /// One periodic orbit on a branch.

@@ -3,6 +3,7 @@
 use nalgebra::Complex;
 use thiserror::Error;
 
+use super::super::continuation::check_path;
 use super::super::error::NewtonFailure;
 use super::super::shooting::ShootingOptions;
 use crate::error::{ParamError, check, check_positive};
@@ -102,21 +103,7 @@ impl Default for CurveOptions {
 impl CurveOptions {
     /// Checks the options.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_positive("initial_step", self.initial_step)?;
-        check_positive("min_step", self.min_step)?;
-        check_positive("max_step", self.max_step)?;
-        check(
-            "max_step",
-            self.max_step,
-            self.min_step <= self.initial_step && self.initial_step <= self.max_step,
-            "must satisfy min_step ≤ initial_step ≤ max_step",
-        )?;
-        check(
-            "max_points",
-            self.max_points as f64,
-            self.max_points >= 2,
-            "must be at least 2",
-        )?;
+        check_path(self.initial_step, self.min_step, self.max_step, self.max_points)?;
         check_positive("tolerance", self.tolerance)?;
         check(
             "corrector_iterations",
