@@ -16,7 +16,7 @@ use vibrotribo::response::{
 use vibrotribo::sweep::{PointRunner, grid};
 
 use crate::config::ConfigArgs;
-use crate::manifest::{BandResponseManifest, BandwidthRecord, Kind, base_motion_of, to_value};
+use crate::manifest::{BandResponseManifest, Kind, base_motion_of, to_value};
 use crate::output::{check_out_dir, create_dir, write_json};
 use crate::progress::{Interrupted, Progress, interrupted};
 use crate::response::{PointArgs, band_text, write_rows};
@@ -38,7 +38,7 @@ pub struct BandResponseArgs {
     #[arg(long)]
     pub steps: usize,
     /// Width of the band, Hz (default: the configured f_high_hz − f_low_hz).
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, allow_negative_numbers = true, value_name = "HZ")]
     pub width: Option<f64>,
     /// Seeds per centre: excitation.seed, excitation.seed + 1, … (the power is their mean,
     /// with its standard error).
@@ -98,7 +98,7 @@ pub fn run(args: &BandResponseArgs) -> Result<()> {
     })?;
     bar.finish();
     let elapsed = started.elapsed().as_secs_f64();
-    let bandwidth = BandwidthRecord::of(r.bandwidth());
+    let bandwidth = r.summary().bandwidth;
     println!(
         "vibrotribo band-response: {} Hz band at {} m/s² RMS, centres {} to {} Hz ({} values) × {} seeds in {elapsed:.2} s",
         plan.width_hz,
@@ -113,7 +113,7 @@ pub fn run(args: &BandResponseArgs) -> Result<()> {
         create_dir(dir)?;
         write_rows(&dir.join("response.csv"), &band_table(&r))?;
         write_rows(&dir.join("seeds.csv"), &band_seed_table(&r))?;
-        let m = manifest(args, &runner, &r, bandwidth, elapsed)?;
+        let m = manifest(args, &runner, &r, elapsed)?;
         write_json(&dir.join("band_response.json"), &to_value(&m)?)?;
         println!(
             "  wrote {0}/response.csv, {0}/seeds.csv, {0}/band_response.json",
@@ -160,7 +160,6 @@ fn manifest(
     args: &BandResponseArgs,
     runner: &PointRunner,
     r: &BandResponse,
-    bandwidth: Option<BandwidthRecord>,
     elapsed: f64,
 ) -> Result<BandResponseManifest> {
     let o = runner.options();
@@ -169,15 +168,9 @@ fn manifest(
         from: args.from,
         to: args.to,
         steps: args.steps,
-        centres_hz: r.plan.centres_hz.clone(),
-        width_hz: r.plan.width_hz,
-        rms_acceleration: r.plan.rms_acceleration,
-        seeds: r.plan.seeds.clone(),
         transient_periods: o.transient_periods,
         recorded_periods: o.recorded_periods,
-        bandwidth,
-        failed: r.results.iter().filter(|x| x.is_err()).count(),
-        complete: r.complete,
+        summary: r.summary(),
         wall_time_s: elapsed,
         settings: serde_json::to_value(runner.base().table())?,
         base_motion: base_motion_of(runner.base()),

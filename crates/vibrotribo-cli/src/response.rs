@@ -12,8 +12,8 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use vibrotribo::orbits::ShootingOptions;
 use vibrotribo::response::{
-    BranchSeeding, DEFAULT_MAX_SEEDS, FrequencyResponse, ResponseOptions, ResponseStep, Rows, branch_table,
-    frequency_response, response_table,
+    BandwidthRecord, BranchSeeding, DEFAULT_MAX_SEEDS, FrequencyResponse, ResponseOptions, ResponseStep,
+    Rows, branch_table, frequency_response, response_table,
 };
 use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP, Direction, SettleMode};
 use vibrotribo::sweep::{PointRunner, grid};
@@ -22,10 +22,7 @@ use crate::config::ConfigArgs;
 use crate::continuation::end_text;
 use crate::job::{RunArgs, estimate_point_memory};
 use crate::limits;
-use crate::manifest::{
-    BandwidthRecord, BifurcationPoint, BranchFailureRecord, Kind, ResponseBranchRecord, ResponseManifest,
-    SeedingRecord, SettleRecord, SweepRecord, base_motion_of, to_value,
-};
+use crate::manifest::{Kind, ResponseManifest, SettleRecord, base_motion_of, to_value};
 use crate::output::{CsvFile, check_out_dir, create_dir, si, write_json};
 use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
 
@@ -203,7 +200,7 @@ pub fn run(args: &ResponseArgs) -> Result<()> {
         if args.branches {
             write_rows(&dir.join("branches.csv"), &branch_table(&r))?;
         }
-        let m = manifest(args, &runner, &r, elapsed)?;
+        let m = manifest(args, &runner, &r, options.branches.as_ref(), elapsed)?;
         write_json(&dir.join("response.json"), &to_value(&m)?)?;
         println!(
             "  wrote {0}/response.csv{1}, {0}/response.json",
@@ -319,39 +316,10 @@ fn manifest(
     args: &ResponseArgs,
     runner: &PointRunner,
     r: &FrequencyResponse,
+    seeding: Option<&BranchSeeding>,
     elapsed: f64,
 ) -> Result<ResponseManifest> {
     let o = runner.options();
-    let sweep = |d: Direction| SweepRecord {
-        done: r.sweep(d).done(),
-        failed: r.sweep(d).failed(),
-        bandwidth: BandwidthRecord::of(r.sweep_bandwidth(d)),
-    };
-    let branches = r
-        .branches
-        .iter()
-        .enumerate()
-        .map(|(i, b)| ResponseBranchRecord {
-            branch: i,
-            seed_sweep: b.seed.direction.as_str().to_string(),
-            seed_at: b.seed.value,
-            towards: b.towards,
-            period: b.period,
-            points: b.points.len(),
-            stable_points: b.points.iter().filter(|p| p.stable).count(),
-            bifurcations: b
-                .bifurcations
-                .iter()
-                .map(|f| BifurcationPoint {
-                    kind: f.kind.name().to_string(),
-                    at: f.parameter,
-                })
-                .collect(),
-            end: b.end.name().to_string(),
-            end_at: b.end.parameter(),
-            bandwidth: BandwidthRecord::of(b.bandwidth()),
-        })
-        .collect();
     Ok(ResponseManifest {
         command: Kind::Response,
         param: args.param.clone(),
@@ -363,26 +331,7 @@ fn manifest(
         recorded_periods: o.recorded_periods,
         period_tolerance: o.period_tolerance,
         settle: SettleRecord::of(o),
-        bandwidth: BandwidthRecord::of(r.bandwidth()),
-        up: sweep(Direction::Up),
-        down: sweep(Direction::Down),
-        seeding: args.branches.then(|| SeedingRecord {
-            max_seeds: args.branch_seeds,
-            match_tolerance: vibrotribo::response::DEFAULT_MATCH_TOLERANCE,
-            seeds_skipped: r.seeds_skipped,
-            failures: r
-                .branch_failures
-                .iter()
-                .map(|f| BranchFailureRecord {
-                    seed_sweep: f.seed.direction.as_str().to_string(),
-                    seed_at: f.seed.value,
-                    towards: f.towards,
-                    error: format!("{:#}", anyhow::Error::from(f.error.clone())),
-                })
-                .collect(),
-        }),
-        branches,
-        complete: r.complete,
+        summary: r.summary(seeding),
         wall_time_s: elapsed,
         settings: serde_json::to_value(runner.base().table())?,
         base_motion: base_motion_of(runner.base()),

@@ -5,7 +5,9 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::manifest::{BandResponseManifest, BandwidthRecord, ResponseManifest, read};
+use vibrotribo::response::BandwidthRecord;
+
+use crate::manifest::{BandResponseManifest, ResponseManifest, read};
 use crate::output::{column, numbers, read_csv};
 use crate::plot::{self, Figure, Legend, Series, Shape, both};
 
@@ -72,7 +74,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
     let down = numbers(&rows, column(&h, "power_down_w")?);
     // Each branch as two series, its stable and its unstable points (NaN breaks a line).
     let mut branches: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = Vec::new();
-    if !m.branches.is_empty() {
+    if !m.summary.branches.is_empty() {
         let (bh, brows) = read_csv(&dir.join("branches.csv"))?;
         let (bc, pc, sc, wc) = (
             column(&bh, "branch")?,
@@ -80,7 +82,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
             column(&bh, "stable")?,
             column(&bh, "power_w")?,
         );
-        for b in &m.branches {
+        for b in &m.summary.branches {
             let rows: Vec<&Vec<String>> = brows.iter().filter(|r| r[bc] == b.branch.to_string()).collect();
             let value = |r: &Vec<String>, c: usize| r[c].parse().unwrap_or(f64::NAN);
             let xs: Vec<f64> = rows.iter().map(|r| value(r, pc)).collect();
@@ -98,7 +100,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
             branches.push((xs, pick(true), pick(false)));
         }
     }
-    let marks = BandMarks::of(m.bandwidth.as_ref(), (m.from, m.to));
+    let marks = BandMarks::of(m.summary.bandwidth.as_ref(), (m.from, m.to));
     let mut lines = vec![
         Series::new("up sweep", &x, &up).colour(0),
         Series::new("down sweep", &x, &down).dashed().colour(1),
@@ -121,7 +123,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
         ..Figure::new(
             format!(
                 "Frequency response: {}",
-                crate::response::band_text(m.bandwidth.as_ref(), "")
+                crate::response::band_text(m.summary.bandwidth.as_ref(), "")
             ),
             m.param.clone(),
             "average power P (W)",
@@ -145,7 +147,7 @@ pub fn plot_band_response(dir: &Path) -> Result<()> {
     let (sh, srows) = read_csv(&dir.join("seeds.csv"))?;
     let sx = numbers(&srows, column(&sh, "centre_hz")?);
     let sy = numbers(&srows, column(&sh, "power_w")?);
-    let marks = BandMarks::of(m.bandwidth.as_ref(), (m.from, m.to));
+    let marks = BandMarks::of(m.summary.bandwidth.as_ref(), (m.from, m.to));
     let lines = [
         Series::new("mean over the seeds", &x, &mean).colour(0),
         Series::new("± standard error", &x, &high).dashed().colour(0),
@@ -165,9 +167,9 @@ pub fn plot_band_response(dir: &Path) -> Result<()> {
         ..Figure::new(
             format!(
                 "Response to band-limited noise: {} Hz band, {} m/s² RMS, {} seeds",
-                m.width_hz,
-                m.rms_acceleration,
-                m.seeds.len()
+                m.summary.width_hz,
+                m.summary.rms_acceleration,
+                m.summary.seeds.len()
             ),
             "centre frequency of the band (Hz)",
             "average power P (W)",

@@ -33,6 +33,7 @@
 mod band;
 mod branches;
 mod error;
+mod summary;
 mod sweeps;
 mod table;
 
@@ -45,6 +46,10 @@ pub use branches::{
     DEFAULT_MAX_SEEDS, ResponseBranch, ResponseBranchPoint,
 };
 pub use error::ResponseError;
+pub use summary::{
+    BandSummary, BandwidthRecord, BifurcationRecord, BranchFailureRecord, BranchRecord, ResponseSummary,
+    SeedingRecord, SweepRecord,
+};
 pub use sweeps::{
     FrequencyResponse, ResponseHook, ResponseOptions, ResponseStep, ResponseSweep, frequency_response,
 };
