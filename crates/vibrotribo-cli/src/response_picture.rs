@@ -64,6 +64,26 @@ impl BandMarks {
     }
 }
 
+/// The upper corner for the legend over the less power: the one whose side (the outer 40 %
+/// of the range) holds the smaller largest power of `curves` (each as x and y).
+fn legend_corner(curves: &[(&[f64], &[f64])], (from, to): (f64, f64)) -> Legend {
+    let side_max = |inside: &dyn Fn(f64) -> bool| {
+        curves
+            .iter()
+            .flat_map(|(x, y)| x.iter().zip(y.iter()))
+            .filter(|(x, y)| inside(**x) && y.is_finite())
+            .fold(f64::NEG_INFINITY, |m, (_, y)| m.max(*y))
+    };
+    let span = to - from;
+    let left = side_max(&|x| x <= from + 0.4 * span);
+    let right = side_max(&|x| x >= to - 0.4 * span);
+    if right < left {
+        Legend::UpperRight
+    } else {
+        Legend::UpperLeft
+    }
+}
+
 /// `response.png/.svg` of a `response` directory: the up sweep (solid) and the down sweep
 /// (dashed), the branches (stable solid, unstable dashed) and the overall peak and band.
 pub fn plot_response(dir: &Path) -> Result<()> {
@@ -119,7 +139,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
     }
     lines.push(marks.lines());
     let figure = Figure {
-        legend: Legend::UpperLeft,
+        legend: legend_corner(&[(&x, &up), (&x, &down)], (m.from, m.to)),
         ..Figure::new(
             format!(
                 "Frequency response: {}",
@@ -163,7 +183,7 @@ pub fn plot_band_response(dir: &Path) -> Result<()> {
         edges,
     ];
     let figure = Figure {
-        legend: Legend::UpperLeft,
+        legend: legend_corner(&[(&x, &high), (&sx, &sy)], (m.from, m.to)),
         ..Figure::new(
             format!(
                 "Response to band-limited noise: {} Hz band, {} m/s² RMS, {} seeds",
