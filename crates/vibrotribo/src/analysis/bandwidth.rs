@@ -77,10 +77,10 @@ pub fn envelope(branches: &[&[(f64, f64)]]) -> Result<Vec<(f64, f64)>, AnalysisE
                 continue;
             }
             let (lo, hi) = (f.min(g), f.max(g));
-            for j in index(lo)..index(hi) {
-                let x = frequencies[j];
+            let (first, end) = (index(lo), index(hi));
+            for (j, &x) in frequencies[first..end].iter().enumerate() {
                 if x > lo {
-                    raise(&mut out, j, p + (q - p) * (x - f) / (g - f));
+                    raise(&mut out, first + j, p + (q - p) * (x - f) / (g - f));
                 }
             }
         }

@@ -18,7 +18,7 @@
 //!
 //! [`band_response`] moves the band of a band-limited random base motion across
 //! frequencies at a fixed width and RMS acceleration and averages the power over several
-//! seeds, with its standard error (see [`band`](self::BandPlan)).
+//! seeds, with its standard error ([`BandPlan`]).
 //!
 //! ## Bandwidth
 //!

@@ -89,7 +89,7 @@ fn sweep_cells(result: Option<&Result<PointResult, SweepError>>) -> [Cell; 6] {
 }
 
 /// `response.csv` of a frequency response: one row per value in increasing order, `param`
-/// (the value) and then, for each of [`SWEEP_COLUMNS`], the up sweep's column beside the down
+/// (the value) and then, for each quantity of a sweep, the up sweep's column beside the down
 /// sweep's: `power_up_w, power_down_w, power_se_up_w, power_se_down_w, period_up,
 /// period_down, impacts_per_period_up, impacts_per_period_down, motion_up, motion_down,
 /// error_up, error_down`.
