@@ -8,7 +8,7 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use vibrotribo::response::{
     BandOptions, BandPlan, BandResponse, DEFAULT_BAND_SEEDS, ResponseError, band_response, band_seed_table,
     band_table,
@@ -19,7 +19,8 @@ use crate::config::ConfigArgs;
 use crate::manifest::{BandResponseManifest, Kind, base_motion_of, to_value};
 use crate::output::{check_out_dir, create_dir, write_json};
 use crate::progress::{Interrupted, Progress, interrupted};
-use crate::response::{PointArgs, band_text, write_rows};
+use crate::response::{PointArgs, check_range, write_rows};
+use crate::response_picture::band_text;
 
 /// Options of `vibrotribo band-response`.
 #[derive(Debug, clap::Args)]
@@ -59,12 +60,7 @@ pub struct BandResponseArgs {
 
 /// Runs `vibrotribo band-response`.
 pub fn run(args: &BandResponseArgs) -> Result<()> {
-    if args.steps == 0 {
-        bail!("--steps must be at least 1");
-    }
-    if !(args.from.is_finite() && args.to.is_finite()) || (args.steps > 1 && args.from >= args.to) {
-        bail!("--from and --to must be finite, --from below --to");
-    }
+    check_range(args.from, args.to, args.steps)?;
     crate::job::set_threads(args.threads)?;
     let runner = args.run.runner(args.input.load_within(args.run.allow_large)?)?;
     let plan = BandPlan::new(

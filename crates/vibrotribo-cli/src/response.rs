@@ -23,8 +23,9 @@ use crate::continuation::end_text;
 use crate::job::{RunArgs, estimate_point_memory};
 use crate::limits;
 use crate::manifest::{Kind, ResponseManifest, SettleRecord, base_motion_of, to_value};
-use crate::output::{CsvFile, check_out_dir, create_dir, si, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
 use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
+use crate::response_picture::band_text;
 
 /// The run settings of each value (or run) of `response` and `band-response`.
 #[derive(Debug, clap::Args)]
@@ -128,6 +129,17 @@ pub struct ResponseArgs {
     pub plot: bool,
 }
 
+/// Refuses `--from`, `--to`, `--steps` that make no increasing grid.
+pub fn check_range(from: f64, to: f64, steps: usize) -> Result<()> {
+    if steps == 0 {
+        bail!("--steps must be at least 1");
+    }
+    if !(from.is_finite() && to.is_finite()) || (steps > 1 && from >= to) {
+        bail!("--from and --to must be finite, --from below --to (the values run from --from to --to)");
+    }
+    Ok(())
+}
+
 /// Writes `rows` to `path`, each cell as its CSV field.
 pub fn write_rows(path: &Path, rows: &Rows) -> Result<()> {
     let mut f = CsvFile::create(path, &rows.names)?;
@@ -139,12 +151,7 @@ pub fn write_rows(path: &Path, rows: &Rows) -> Result<()> {
 
 /// Runs `vibrotribo response`.
 pub fn run(args: &ResponseArgs) -> Result<()> {
-    if args.steps == 0 {
-        bail!("--steps must be at least 1");
-    }
-    if !(args.from.is_finite() && args.to.is_finite()) || (args.steps > 1 && args.from >= args.to) {
-        bail!("--from and --to must be finite, --from below --to (the up sweep runs from --from to --to)");
-    }
+    check_range(args.from, args.to, args.steps)?;
     if args.branch_seeds == 0 {
         bail!("--branch-seeds must be at least 1");
     }
@@ -228,23 +235,6 @@ pub fn run(args: &ResponseArgs) -> Result<()> {
         .into());
     }
     Ok(())
-}
-
-/// A peak and band in words.
-pub fn band_text(b: Option<&BandwidthRecord>, unit: &str) -> String {
-    let Some(b) = b else {
-        return "no power".into();
-    };
-    let edge = |e: Option<f64>, side: &str| e.map_or(format!("beyond the {side} end"), |x| format!("{x:.5}"));
-    format!(
-        "peak {} at {:.5}{unit}; half-power band {} to {}{}",
-        si(b.peak_power_w, "W"),
-        b.peak_at,
-        edge(b.lower, "lower"),
-        edge(b.upper, "upper"),
-        b.width
-            .map_or(String::new(), |w| format!(" (width {w:.5}{unit})"))
-    )
 }
 
 fn print_response(r: &FrequencyResponse, elapsed: f64) {

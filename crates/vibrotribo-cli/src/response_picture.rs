@@ -8,8 +8,25 @@ use anyhow::Result;
 use vibrotribo::response::BandwidthRecord;
 
 use crate::manifest::{BandResponseManifest, ResponseManifest, read};
-use crate::output::{column, numbers, read_csv};
+use crate::output::{column, numbers, read_csv, si};
 use crate::plot::{self, Figure, Legend, Series, Shape, both};
+
+/// A peak and band in words.
+pub fn band_text(b: Option<&BandwidthRecord>, unit: &str) -> String {
+    let Some(b) = b else {
+        return "no power".into();
+    };
+    let edge = |e: Option<f64>, side: &str| e.map_or(format!("beyond the {side} end"), |x| format!("{x:.5}"));
+    format!(
+        "peak {} at {:.5}{unit}; half-power band {} to {}{}",
+        si(b.peak_power_w, "W"),
+        b.peak_at,
+        edge(b.lower, "lower"),
+        edge(b.upper, "upper"),
+        b.width
+            .map_or(String::new(), |w| format!(" (width {w:.5}{unit})"))
+    )
+}
 
 /// The half-power line (from the lower to the upper edge, or across the range where an edge
 /// is missing) and the marks of the peak and the edges.
@@ -143,7 +160,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
         ..Figure::new(
             format!(
                 "Frequency response: {}",
-                crate::response::band_text(m.summary.bandwidth.as_ref(), "")
+                band_text(m.summary.bandwidth.as_ref(), "")
             ),
             m.param.clone(),
             "average power P (W)",
