@@ -287,13 +287,24 @@ fn paragraph(drive: &str, r: &Redesign) -> String {
                 si(*load, "Ω"),
                 e.breakdown_ratio,
                 best / p,
-                if best < p {
-                    format!(
-                        " — less, so a search of {} designs stops short of the optimum, which is at least the paper's design at that load",
-                        r.evaluations
-                    )
-                } else {
-                    String::new()
+                {
+                    // Two noisy estimates differ significantly when their difference
+                    // exceeds twice its standard error.
+                    let se = |e: &Evaluation| e.standard_error.unwrap_or(0.0);
+                    let noise = 2.0 * (se(&r.best).powi(2) + se(e).powi(2)).sqrt();
+                    if (best - p).abs() <= noise {
+                        format!(
+                            " — a difference within the noise of the two estimates (twice its standard error, {})",
+                            si(noise, "W")
+                        )
+                    } else if best < p {
+                        format!(
+                            " — less, so a search of {} designs stops short of the optimum, which is at least the paper's design at that load",
+                            r.evaluations
+                        )
+                    } else {
+                        String::new()
+                    }
                 },
                 best / paper
             )
@@ -498,4 +509,51 @@ fn bandwidth_paragraph(r: &Redesign, paper: Option<Band>, best: Option<Band>) ->
         p.text(),
         b.text()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn redesign(unit: [f64; 4], ratio: f64) -> Redesign {
+        let base = Config::default();
+        let variables: Vec<Variable> = VARY.iter().map(|v| Variable::parse(&base, v).unwrap()).collect();
+        let best = Evaluation {
+            values: variables.iter().zip(unit).map(|(v, u)| v.value(u)).collect(),
+            objective: Some(1.0),
+            breakdown_ratio: ratio,
+            ..Evaluation::default()
+        };
+        Redesign {
+            paper: Evaluation::default(),
+            paper_best_load: None,
+            expected: best.clone(),
+            best,
+            variables,
+            best_unit: unit.to_vec(),
+            evaluations: 10,
+            design: base,
+            starts: 3,
+        }
+    }
+
+    /// What binds is read off the optimum: the breakdown ratio at its limit, a key at an
+    /// end of its range, or nothing.
+    #[test]
+    fn binding_follows_the_optimum() {
+        let free = binding(&redesign([0.5, 0.5, 0.5, 0.5], 0.5));
+        assert!(free.starts_with("nothing binds"), "{free}");
+        let air = binding(&redesign([0.5, 0.5, 0.5, 0.5], 0.899));
+        assert!(
+            air.starts_with("air breakdown") && air.ends_with(" binds"),
+            "{air}"
+        );
+        let both = binding(&redesign([0.0, 0.5, 0.5, 1.0], 0.899));
+        assert!(
+            both.contains("lower end of oscillator.gaps")
+                && both.contains("upper end of harvester.load_resistance")
+                && both.ends_with(" bind"),
+            "{both}"
+        );
+    }
 }
