@@ -218,13 +218,36 @@ pub(super) fn design(ctx: &mut Ctx) -> Result<()> {
     let record = with_record(|path| redesign(&record_config(path)?, &sizes))?;
     let (paper_band, best_band) = bandwidths(ctx, &sine, &sizes)?;
     let (periods, transient) = sizes.periods;
+    let paper_config = Config::default();
+    let paper = paper_config.chain();
     ctx.extras.push(format!(
-        "**The paper's device re-optimised.** Its gaps δ₁ = δ₂ (5–40 mm), mass ratio R_m (1.2–4), stiffness k of every spring (60–240 N/m) and load R (1–1000 GΩ) searched together with every air gap kept below {LIMIT} of breakdown (`vibrotribo optimize`: a particle swarm, then Nelder–Mead; each design a run of {periods} periods, {transient} of them transient), the drive held at the paper's frequency in hertz (5.570 Hz, its Ω = 0.70 for the paper's design), so that a softer or heavier design meets the same vibration. {} {}",
+        "**The paper's device re-optimised.** Its {} searched together with every air gap kept below {LIMIT} of breakdown (`vibrotribo optimize`: a particle swarm, then Nelder–Mead; each design a run of {periods} periods, {transient} of them transient), the drive held at the paper's frequency in hertz ({:.3} Hz, its Ω = {:.2} for the paper's design), so that a softer or heavier design meets the same vibration. {} {}",
+        ranges(&sine.variables),
+        paper.omega() / std::f64::consts::TAU,
+        paper.omega_ratio(),
         paragraph("the sine", &sine),
         paragraph("the recorded vibration (`configs/record_default.toml`)", &record),
     ));
     ctx.extras.push(bandwidth_paragraph(&sine, paper_band, best_band));
     Ok(())
+}
+
+/// The searched ranges of [`VARY`] in words: gaps in mm, the load in GΩ.
+fn ranges(variables: &[Variable]) -> String {
+    // Rounded to 1e-6 of the unit shown, so that 0.005 m reads 5 mm, not 5.000000000000001.
+    let shown = |x: f64| (x * 1e6).round() / 1e6;
+    let range = |i: usize, scale: f64| {
+        variables.get(i).map_or(String::new(), |v| {
+            format!("{}–{}", shown(v.lo * scale), shown(v.hi * scale))
+        })
+    };
+    format!(
+        "gaps δ₁ = δ₂ ({} mm), mass ratio R_m ({}), stiffness k of every spring ({} N/m) and load R ({} GΩ)",
+        range(0, 1e3),
+        range(1, 1.0),
+        range(2, 1.0),
+        range(3, 1e-9)
+    )
 }
 
 /// What binds at the optimum: the breakdown limit, the ends of the ranges.
