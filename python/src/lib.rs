@@ -1,5 +1,5 @@
 //! The extension module `vibrotribo._vibrotribo`: Python bindings of vibrotribo's run layer
-//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation, Lyapunov spectra, chirps, basins and attractors, the optimal mass ratio, ngspice netlists). The Python
+//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation, Lyapunov spectra, chirps, basins and attractors, the optimal mass ratio, design optimisation, frequency responses, ngspice netlists). The Python
 //! package `vibrotribo` (python/vibrotribo/) wraps what this returns into result objects;
 //! nothing here computes: it converts arguments, releases the GIL while the library runs,
 //! watches for Ctrl-C at the library's checkpoints, and converts results to numpy arrays.
@@ -18,6 +18,7 @@ mod lyapunov;
 mod mass_ratio;
 mod optimize;
 mod orbits;
+mod response;
 mod simulate;
 mod spice;
 mod sweep;
@@ -67,6 +68,8 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_GRID_POINTS", vibrotribo::study::limits::MAX_GRID_POINTS)?;
     m.add("MAX_MEMORY_BYTES", vibrotribo::study::limits::MAX_MEMORY_BYTES)?;
     m.add_function(wrap_pyfunction!(optimize::optimize, m)?)?;
+    m.add_function(wrap_pyfunction!(response::response, m)?)?;
+    m.add_function(wrap_pyfunction!(response::band_response, m)?)?;
     m.add_function(wrap_pyfunction!(grid, m)?)?;
     m.add_function(wrap_pyfunction!(log_spaced, m)?)?;
     m.add("OrbitNotFound", m.py().get_type::<orbits::OrbitNotFound>())?;

@@ -243,29 +243,20 @@ fn points_to_py<'py>(
 
 /// What happens at a bifurcation, as a dict: `kind` and its details (contacts 1-based).
 fn kind_to_py<'py>(py: Python<'py>, kind: &BifurcationKind, d: &Bound<'py, PyDict>) -> PyResult<()> {
-    let name = match kind {
-        BifurcationKind::Fold => "fold",
-        BifurcationKind::BranchPoint => "branch_point",
-        BifurcationKind::PeriodDoubling => "period_doubling",
-        BifurcationKind::NeimarkSacker { angle } => {
-            d.set_item("angle", angle)?;
-            "neimark_sacker"
-        }
+    match kind {
+        BifurcationKind::NeimarkSacker { angle } => d.set_item("angle", angle)?,
         BifurcationKind::Grazing { contact, appears } => {
             d.set_item("contact", contact + 1)?;
             d.set_item("appears", appears)?;
-            "grazing"
         }
         BifurcationKind::Sticking { contact, onset } => {
             d.set_item("contact", contact + 1)?;
             d.set_item("onset", onset)?;
-            "sticking"
         }
-        BifurcationKind::SequenceChange => "sequence_change",
-        _ => "other",
-    };
+        _ => {}
+    }
     let _ = py;
-    d.set_item("kind", name)
+    d.set_item("kind", kind.name())
 }
 
 /// Why a branch ended, as a dict: `reason` and its details.

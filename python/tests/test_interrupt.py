@@ -69,3 +69,38 @@ def test_the_gil_is_released_while_computing():
     during = [x for x in ticks if started < x < ended]
     # With the GIL held the other thread could not run at all during the run.
     assert len(during) > 10, f"{len(during)} ticks in {ended - started:.3f} s"
+
+
+RESPONSE_CHILD = textwrap.dedent(
+    """
+    import signal, sys
+    import vibrotribo as vt
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    print("start", flush=True)
+    try:
+        # Two sweeps of 2000 values: minutes of work.
+        vt.response(vt.Config(), vt.grid(0.5, 1.0, 2000), recorded=200)
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+        sys.exit(0)
+    print("finished", flush=True)
+    sys.exit(1)
+    """
+)
+
+
+def test_sigint_stops_a_frequency_response():
+    """Both sweeps (one on a thread of its own) stop at their next value and the call raises
+    KeyboardInterrupt."""
+    p = subprocess.Popen([sys.executable, "-c", RESPONSE_CHILD], stdout=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline().strip() == "start"
+        time.sleep(1.0)
+        os.kill(p.pid, signal.SIGINT)
+        line = p.stdout.readline().strip()
+        p.wait(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert line == "interrupted", line
+    assert p.returncode == 0

@@ -115,6 +115,15 @@ PARITY = {
         "--particles": "particles", "--swarm-iterations": "swarm_iterations",
         "--local-iterations": "local_iterations", "--out": None, "--resume": None, "-q": None,
     }),
+    "response": (vt.response, {
+        "<CONFIG>": "config", "--param": "param", "--from": "values", "--to": "values",
+        "--steps": "values", "--branches": "branches", "--branch-seeds": "branch_seeds",
+        "--out": None, "--plot": None, **RUN,
+    }),
+    "band-response": (vt.band_response, {
+        "<CONFIG>": "config", "--from": "centres_hz", "--to": "centres_hz", "--steps": "centres_hz",
+        "--width": "width", "--seeds": "seeds", "--out": None, "--plot": None, **RUN,
+    }),
     "lyapunov": (vt.lyapunov, {
         "<CONFIG>": "config", "--periods": "periods", "--transient": "transient", "--seed": "seed",
         "--batches": "batches", "--out": None, "--plot": None, "-q": None,
@@ -319,3 +328,32 @@ def test_periodic_power_equals_the_file(cli, tmp_path):
     assert o.average_power_w is not None
     assert_bits(np.array([o.average_power_w]), np.array([m["average_power_w"]]), "average power on the orbit")
     assert vt.periodic(vt.Config(), mechanics_only=True).average_power_w is None
+
+
+def test_response_equals_the_files(cli, tmp_path):
+    sets = ["--set", "excitation.amplitude=0.002"]
+    cli_run(cli, "response", *sets, "--from", "0.7", "--to", "0.8", "--steps", "3", "--branches",
+            "--branch-seeds", "2", "--out", tmp_path, "-q")
+    r = vt.response(vt.Config(excitation__amplitude=0.002), vt.grid(0.7, 0.8, 3), branches=True, branch_seeds=2)
+    compare_tables([r.response, r.branches], tmp_path, ["response.csv", "branches.csv"])
+    m = read_json(tmp_path / "response.json")
+    for k in ("bandwidth", "up", "down", "seeding", "branches", "complete"):
+        assert r.summary[k] == m[k], k
+    assert r.bandwidth is not None and r.branches.rows > 0
+
+
+def test_band_response_equals_the_files(cli, tmp_path):
+    noise = tmp_path / "noise.toml"
+    noise.write_text(
+        "[excitation]\nkind = \"random\"\nrms_acceleration = 20.0\nf_low_hz = 4.0\nf_high_hz = 8.0\n"
+        "seed = 1\nomega_ratio = 0.7\n[run]\nperiods = 16\ntransient_periods = 6\nstart_relative_to_base = true\n"
+    )
+    out = tmp_path / "out"
+    cli_run(cli, "band-response", noise, "--from", "4", "--to", "8", "--steps", "3", "--seeds", "2",
+            "--out", out, "-q")
+    r = vt.band_response(vt.Config(noise), vt.grid(4, 8, 3), seeds=2, threads=2)
+    compare_tables([r.response, r.seeds], out, ["response.csv", "seeds.csv"])
+    m = read_json(out / "band_response.json")
+    for k in ("centres_hz", "width_hz", "rms_acceleration", "seeds", "bandwidth", "failed", "complete"):
+        assert r.summary[k] == m[k], k
+    assert r.seeds.rows == 6

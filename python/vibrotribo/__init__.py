@@ -50,7 +50,7 @@ from ._results import (
     Sweep,
     Table,
 )
-from ._studies import Attractors, Basins, Chirp, MassRatioOptimum, SpiceExport
+from ._studies import Attractors, BandResponse, Basins, Chirp, MassRatioOptimum, Response, SpiceExport
 from ._curve import Curve
 from ._vibrotribo import Config, OrbitNotFound, __version__, grid, log_spaced
 
@@ -76,6 +76,10 @@ __all__ = [
     "attractors",
     "Attractors",
     "optimize",
+    "response",
+    "Response",
+    "band_response",
+    "BandResponse",
     "optimize_mass_ratio",
     "MassRatioOptimum",
     "export_spice",
@@ -644,6 +648,82 @@ def optimize(
         swarm_iterations=_count(swarm_iterations, "swarm_iterations"),
         local_iterations=_count(local_iterations, "local_iterations"),
     )
+
+
+def response(
+    config: ConfigLike,
+    values: Iterable[float],
+    *,
+    param: str = "excitation.omega_ratio",
+    branches: bool = False,
+    branch_seeds: int = 8,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    settle: SettleMode = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    allow_large: bool = False,
+) -> Response:
+    """The frequency response of ``vibrotribo response``: average power against ``param``
+    over ``values`` (increasing; ``values=vt.grid(from, to, steps)``) from an up sweep (the
+    values in order) and a down sweep (in reverse), each value started from the final state
+    of the one before, so that coexisting motions show as hysteresis; with ``branches`` the
+    branches of periodic orbits through the periodic motions the sweeps found are followed
+    by continuation (at most ``branch_seeds`` seeds), with the power on every point. The peak
+    and the half-power band of each sweep, each branch and their envelope are in
+    ``summary`` (:class:`Response`). The same numbers as the command's files. Ctrl-C raises
+    ``KeyboardInterrupt``."""
+    raw = _vibrotribo.response(
+        _config(config),
+        _values(values, "values"),
+        param=param,
+        branches=branches,
+        branch_seeds=_count(branch_seeds, "branch_seeds", least=1),
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
+        period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        allow_large=allow_large,
+    )
+    return Response._from(raw)
+
+
+def band_response(
+    config: ConfigLike,
+    centres_hz: Iterable[float],
+    *,
+    width: Optional[float] = None,
+    seeds: int = 8,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    settle: SettleMode = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    threads: Optional[int] = None,
+    allow_large: bool = False,
+) -> BandResponse:
+    """The response to band-limited random input of ``vibrotribo band-response``: the
+    configuration's flat-spectrum noise (``excitation.kind = "random"`` with
+    ``rms_acceleration``, ``f_low_hz``, ``f_high_hz``) moved to the band ``width`` Hz wide
+    (default: the configured one) centred on each of ``centres_hz`` (increasing), at the same
+    RMS acceleration, run with ``seeds`` seeds from ``excitation.seed`` on; the power is the
+    mean over the seeds with its standard error, and the peak and half-power band of the mean
+    are in ``summary`` (:class:`BandResponse`). The same numbers as the command's files."""
+    raw = _vibrotribo.band_response(
+        _config(config),
+        _values(centres_hz, "centres_hz"),
+        width=width,
+        seeds=_count(seeds, "seeds", least=1),
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
+        period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        threads=_count(threads, "threads", least=1),
+        allow_large=allow_large,
+    )
+    return BandResponse._from(raw)
 
 
 def optimize_mass_ratio(

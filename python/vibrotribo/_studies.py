@@ -1,5 +1,6 @@
 """Result objects of the studies beside sweeps and orbits: the chirp experiment, basins of
-attraction, the attractor census, the optimal mass ratio and the ngspice export. Columns
+attraction, the attractor census, the optimal mass ratio, the frequency responses and the
+ngspice export. Columns
 carry the names of the command line's CSV files; numbers are float64 (NaN where the file
 leaves a cell empty), counts int64 (−1 where the file leaves a cell empty), text str."""
 
@@ -16,7 +17,7 @@ if TYPE_CHECKING:  # pandas is optional: only to_pandas() needs it
 from ._display import Display
 from ._results import Table
 
-__all__ = ["Chirp", "Basins", "Attractors", "MassRatioOptimum", "SpiceExport"]
+__all__ = ["Chirp", "Basins", "Attractors", "MassRatioOptimum", "Response", "BandResponse", "SpiceExport"]
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -134,6 +135,86 @@ class Attractors(Display):
     def to_pandas(self) -> "pandas.DataFrame":
         """The attractors table as a pandas DataFrame."""
         return self.attractors.to_pandas()
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Response(Display):
+    """The frequency response of :func:`vibrotribo.response` (``vibrotribo response``).
+
+    Attributes:
+        response: ``response.csv``: ``param`` (the value, increasing), then each sweep's
+            column beside the other's: ``power_up_w``, ``power_down_w`` (average power, W),
+            ``power_se_up_w``, ``power_se_down_w`` (its batch-means standard error, W),
+            ``period_up``, ``period_down`` (excitation periods, 0: not periodic),
+            ``impacts_per_period_up``, ``impacts_per_period_down``, ``motion_up``,
+            ``motion_down``, ``error_up``, ``error_down``.
+        branches: ``branches.csv`` (empty without ``branches=True``): ``branch``, ``period``,
+            ``param``, ``stable``, ``power_w`` (W), ``max_abs_multiplier``,
+            ``impacts_per_period``, a row per point along each branch.
+        summary: what ``response.json`` records of the result: ``bandwidth`` (the envelope's
+            ``peak_at``, ``peak_power_w``, ``lower``, ``upper``, ``width``; None edges run
+            past the range), ``up`` and ``down`` (``done``, ``failed``, ``bandwidth``),
+            ``seeding`` and ``branches`` (each ``branch``, ``seed_sweep``, ``seed_at``,
+            ``towards``, ``period``, ``points``, ``stable_points``, ``bifurcations``, ``end``,
+            ``end_at``, ``bandwidth``) with ``branches=True``, ``complete``.
+        settings: the key, values, periods and the configuration's settings.
+    """
+
+    response: Table
+    branches: Table
+    summary: Dict[str, Any]
+    settings: Dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def _from(cls, raw: Dict[str, Any]) -> "Response":
+        return cls(Table(raw["response"]), Table(raw["branches"]), raw["summary"], raw["settings"])
+
+    @property
+    def bandwidth(self) -> Optional[Dict[str, Any]]:
+        """The peak and half-power band of the envelope of both sweeps and the stable branch
+        points (``peak_at``, ``peak_power_w``, ``lower``, ``upper``, ``width``), or None."""
+        return self.summary["bandwidth"]
+
+    def to_pandas(self) -> "pandas.DataFrame":
+        """The response table as a pandas DataFrame."""
+        return self.response.to_pandas()
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class BandResponse(Display):
+    """The response to band-limited random input of :func:`vibrotribo.band_response`
+    (``vibrotribo band-response``).
+
+    Attributes:
+        response: ``response.csv``: ``centre_hz``, ``f_low_hz``, ``f_high_hz`` (Hz),
+            ``power_w`` (the mean over the seeds, W), ``power_se_w`` (its standard error,
+            W), ``runs`` (seeds with a power), ``power_min_w``, ``power_max_w``.
+        seeds: ``seeds.csv``: ``centre_hz``, ``seed``, ``power_w``, ``power_se_w`` (the
+            run's batch-means standard error), ``error``, a row per run.
+        summary: what ``band_response.json`` records of the result: ``centres_hz``,
+            ``width_hz``, ``rms_acceleration``, ``seeds``, ``bandwidth`` (Hz), ``failed``,
+            ``complete``.
+        settings: the periods and the configuration's settings.
+    """
+
+    response: Table
+    seeds: Table
+    summary: Dict[str, Any]
+    settings: Dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def _from(cls, raw: Dict[str, Any]) -> "BandResponse":
+        return cls(Table(raw["response"]), Table(raw["seeds"]), raw["summary"], raw["settings"])
+
+    @property
+    def bandwidth(self) -> Optional[Dict[str, Any]]:
+        """The peak and half-power band of the mean power against the centre frequency, Hz,
+        or None."""
+        return self.summary["bandwidth"]
+
+    def to_pandas(self) -> "pandas.DataFrame":
+        """The response table as a pandas DataFrame."""
+        return self.response.to_pandas()
 
 
 @dataclass(frozen=True, eq=False, repr=False)

@@ -280,6 +280,34 @@ def optimize(
     swarm_iterations: int = ...,
     local_iterations: int = ...,
 ) -> Dict[str, Any]: ...
+def response(
+    config: Any,
+    values: List[float],
+    *,
+    param: str = ...,
+    branches: bool = ...,
+    branch_seeds: int = ...,
+    transient: Optional[int] = ...,
+    recorded: Optional[int] = ...,
+    period_tolerance: float = ...,
+    settle: SettleMode = ...,
+    settle_cap: int = ...,
+    allow_large: bool = ...,
+) -> Dict[str, Any]: ...
+def band_response(
+    config: Any,
+    centres_hz: List[float],
+    *,
+    width: Optional[float] = ...,
+    seeds: int = ...,
+    transient: Optional[int] = ...,
+    recorded: Optional[int] = ...,
+    period_tolerance: float = ...,
+    settle: SettleMode = ...,
+    settle_cap: int = ...,
+    threads: Optional[int] = ...,
+    allow_large: bool = ...,
+) -> Dict[str, Any]: ...
 def optimize_mass_ratio(
     config: Any,
     *,

@@ -390,32 +390,23 @@ fn emptier_upper_corner(points: impl Iterator<Item = (f64, f64)> + Clone) -> Leg
     }
 }
 
-/// What a bifurcation is, in words, with its detail.
+/// What a bifurcation is ([`BifurcationKind::name`]), with its detail in words.
 pub fn describe(kind: &BifurcationKind) -> (&'static str, String) {
-    match kind {
-        BifurcationKind::Fold => ("fold", String::new()),
-        BifurcationKind::BranchPoint => ("branch_point", String::new()),
-        BifurcationKind::PeriodDoubling => ("period_doubling", String::new()),
-        BifurcationKind::NeimarkSacker { angle } => ("neimark_sacker", format!("angle {angle} rad")),
-        BifurcationKind::Grazing { contact, appears } => (
-            "grazing",
-            format!(
-                "contact {}: impact {}",
-                contact + 1,
-                if *appears { "appears" } else { "disappears" }
-            ),
+    let detail = match kind {
+        BifurcationKind::NeimarkSacker { angle } => format!("angle {angle} rad"),
+        BifurcationKind::Grazing { contact, appears } => format!(
+            "contact {}: impact {}",
+            contact + 1,
+            if *appears { "appears" } else { "disappears" }
         ),
-        BifurcationKind::Sticking { contact, onset } => (
-            "sticking",
-            format!(
-                "contact {}: sticking {}",
-                contact + 1,
-                if *onset { "begins" } else { "ends" }
-            ),
+        BifurcationKind::Sticking { contact, onset } => format!(
+            "contact {}: sticking {}",
+            contact + 1,
+            if *onset { "begins" } else { "ends" }
         ),
-        BifurcationKind::SequenceChange => ("sequence_change", String::new()),
-        _ => ("other", format!("{kind:?}")),
-    }
+        _ => String::new(),
+    };
+    (kind.name(), detail)
 }
 
 /// The brute-force orbit diagram under a picture of branches.

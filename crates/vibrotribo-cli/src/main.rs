@@ -7,6 +7,7 @@
 mod stdout;
 
 mod attractors;
+mod band_response;
 mod basins;
 mod branch_picture;
 mod chirp;
@@ -30,6 +31,8 @@ mod plot;
 mod plots;
 mod progress;
 mod reproduce;
+mod response;
+mod response_picture;
 mod serve;
 mod simulate;
 mod sweep;
@@ -73,6 +76,13 @@ enum Command {
     Map(map::MapArgs),
     /// The optimal mass ratio R_mo(Ω) and its quadratic fit (the paper's Fig. 16).
     OptimizeMassRatio(map::OptimizeArgs),
+    /// Frequency response: power against a parameter (Ω) from an up and a down sweep (side
+    /// by side, a thread each) and the branches between them, with the peak and the
+    /// half-power bandwidth.
+    Response(response::ResponseArgs),
+    /// Response to band-limited random input: power against the centre frequency of the
+    /// band (fixed width and RMS acceleration), the mean over seeds, with the bandwidth.
+    BandResponse(band_response::BandResponseArgs),
     /// Optimise a design over several keys (particle swarm, then Nelder–Mead) for average or
     /// expected power or power per mass, under breakdown and displacement constraints.
     Optimize(optimize::OptimizeArgs),
@@ -118,6 +128,8 @@ fn default_out(command: &mut Command) {
         Command::Lyapunov(a) => ("lyapunov", &mut a.out, a.plot),
         Command::Basins(a) => ("basins", &mut a.out, a.plot),
         Command::Attractors(a) => ("attractors", &mut a.out, a.plot),
+        Command::Response(a) => ("response", &mut a.out, a.plot),
+        Command::BandResponse(a) => ("band-response", &mut a.out, a.plot),
         _ => return,
     };
     if plot && out.is_none() {
@@ -133,8 +145,8 @@ fn default_out(command: &mut Command) {
 /// Options of `vibrotribo plot`.
 #[derive(Debug, clap::Args)]
 struct PlotArgs {
-    /// A directory written by `simulate`, `sweep`, `map`, `chirp`, `lyapunov`, `basins` or
-    /// `attractors` with `--out`.
+    /// A directory written by a command with `--out` (`simulate`, `sweep`, `map`, `chirp`,
+    /// `lyapunov`, `basins`, `attractors`, `response`, `band-response`, …).
     dir: std::path::PathBuf,
     /// PSD of this mass only (1-based; default: every mass).
     #[arg(long)]
@@ -159,6 +171,8 @@ fn run() -> anyhow::Result<()> {
         Command::Map(args) => map::run(&args),
         Command::OptimizeMassRatio(args) => map::optimize(&args),
         Command::Optimize(args) => optimize::run(&args),
+        Command::Response(args) => response::run(&args),
+        Command::BandResponse(args) => band_response::run(&args),
         Command::Lyapunov(args) => lyapunov::run(&args),
         Command::Basins(args) => basins::run(&args),
         Command::Attractors(args) => attractors::run(&args),

@@ -16,8 +16,10 @@ use vibrotribo::study::{PointOptions, SettleMode};
 use vibrotribo::sweep::Continuation;
 
 mod commands;
+mod response;
 
 pub use commands::*;
+pub use response::*;
 
 /// What an output directory holds: the command that wrote it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -49,6 +51,11 @@ pub enum Kind {
     OptimizeMassRatio,
     /// `vibrotribo optimize` (`optimize.json`, which names no command).
     Optimize,
+    /// `vibrotribo response` (`response.json`).
+    Response,
+    /// `vibrotribo band-response` (`band_response.json`).
+    #[serde(rename = "band-response")]
+    BandResponse,
 }
 
 /// The manifests that name no command, by file name, with a data file that must sit beside.
@@ -62,13 +69,15 @@ const NAMED_MANIFESTS: [(&str, &str, Kind); 6] = [
 ];
 
 /// The manifests that name their command, by file name.
-const COMMAND_MANIFESTS: [(&str, Kind); 6] = [
+const COMMAND_MANIFESTS: [(&str, Kind); 8] = [
     ("sweep.json", Kind::Sweep),
     ("map.json", Kind::Map),
     ("basins.json", Kind::Basins),
     ("attractors.json", Kind::Attractors),
     ("chirp.json", Kind::Chirp),
     ("continue.json", Kind::Continue),
+    ("response.json", Kind::Response),
+    ("band_response.json", Kind::BandResponse),
 ];
 
 /// The kind field every command manifest opens with.

@@ -174,18 +174,6 @@ fn is_kind(b: &BifurcationKind, kind: CurveKind) -> bool {
     )
 }
 
-fn kind_text(b: &BifurcationKind) -> &'static str {
-    match b {
-        BifurcationKind::Fold => "fold",
-        BifurcationKind::BranchPoint => "branch_point",
-        BifurcationKind::PeriodDoubling => "period_doubling",
-        BifurcationKind::NeimarkSacker { .. } => "neimark_sacker",
-        BifurcationKind::Grazing { .. } => "grazing",
-        BifurcationKind::Sticking { .. } => "sticking",
-        _ => "sequence_change",
-    }
-}
-
 /// The bifurcation of `request.kind` nearest `near` on the branch of `config` (with `key2 =
 /// from2`) through the orbit found at `near`, followed both ways over the window, and the
 /// curve it lies on, continued in `key2` from `from2` to `to2`.
@@ -270,7 +258,7 @@ pub fn curve_config(
             period: request.period,
             found: found
                 .iter()
-                .map(|(f, p)| format!("{} at {:.8} (period {p})", kind_text(&f.kind), f.parameter))
+                .map(|(f, p)| format!("{} at {:.8} (period {p})", f.kind.name(), f.parameter))
                 .collect(),
         });
     };

@@ -51,7 +51,9 @@
 //!   run's own energy per cycle against them.
 //! - **Design.** [`optimize`] maximises average power, expected power over random starts or
 //!   power per mass over any numeric configuration keys, under air-breakdown and
-//!   displacement constraints (argmin's particle swarm, then Nelder–Mead).
+//!   displacement constraints (argmin's particle swarm, then Nelder–Mead). [`response`] gives
+//!   the power against frequency from up and down sweeps and the branches between them, or
+//!   against the centre of a random input's band, with the peak and the half-power bandwidth.
 //!
 //! The engine alone, ten periods of the paper's default case:
 //!
@@ -99,6 +101,8 @@ pub mod orbits;
 mod random;
 #[cfg(feature = "config")]
 pub mod report;
+#[cfg(feature = "config")]
+pub mod response;
 pub mod sensitivity;
 pub mod study;
 #[cfg(feature = "config")]

@@ -9,6 +9,7 @@ use super::chatter::figs_20_25;
 use super::configurations::figs_5_6;
 use super::context::{Budget, Ctx};
 use super::coupling::coupling;
+use super::design::design;
 use super::dynamics::dynamics;
 use super::extras::extras;
 use super::mass_ratio::{fig_13, fig_17, figs_14_16, figs_18_19};
@@ -72,7 +73,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         failures: std::sync::Mutex::new(Vec::new()),
     };
     let started = Instant::now();
-    let steps: [(&str, Step); 13] = [
+    let steps: [(&str, Step); 14] = [
         ("Figs. 5–6: mass configurations", figs_5_6),
         ("Figs. 7–11: asymmetric spacing R_δ", figs_7_11),
         ("Fig. 12: symmetric spacing δ", fig_12),
@@ -89,6 +90,10 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         ("beyond the paper: loads and V_oc model", extras),
         ("beyond the paper: real vibration (record, noise)", vibration),
         ("beyond the paper: two-way coupling", coupling),
+        (
+            "beyond the paper: the device re-optimised under the breakdown limit",
+            design,
+        ),
     ];
     for (what, step) in steps {
         let t0 = Instant::now();

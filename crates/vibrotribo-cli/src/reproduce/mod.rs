@@ -4,7 +4,7 @@
 //! the numbers of this run.
 //!
 //! One file per group of figures (`configurations`, `spacing`, `mass_ratio`, `chatter`,
-//! `orbits`, `dynamics`, `extras`, `vibration`, `coupling`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
+//! `orbits`, `dynamics`, `extras`, `vibration`, `coupling`, `design`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
 //! `report` writes REPORT.md.
 
 mod chatter;
@@ -12,6 +12,7 @@ mod command;
 mod configurations;
 mod context;
 mod coupling;
+mod design;
 mod draw;
 mod dynamics;
 mod extras;

@@ -2,12 +2,13 @@
 //! verdict written as a constant.
 
 /// The source of every file of `reproduce`, by name.
-const SOURCES: [(&str, &str); 15] = [
+const SOURCES: [(&str, &str); 16] = [
     ("chatter.rs", include_str!("chatter.rs")),
     ("command.rs", include_str!("command.rs")),
     ("configurations.rs", include_str!("configurations.rs")),
     ("context.rs", include_str!("context.rs")),
     ("coupling.rs", include_str!("coupling.rs")),
+    ("design.rs", include_str!("design.rs")),
     ("draw.rs", include_str!("draw.rs")),
     ("dynamics.rs", include_str!("dynamics.rs")),
     ("extras.rs", include_str!("extras.rs")),

@@ -61,12 +61,17 @@ struct Cell {
 }
 
 pub(super) fn vibration(ctx: &mut Ctx) -> Result<()> {
-    // The configurations read the record from a file: a scratch copy, removed at the end.
+    with_record(|record_path| study(ctx, record_path))
+}
+
+/// `f` with the record written to a scratch file (configurations read the record from a
+/// file), removed afterwards.
+pub(super) fn with_record<T>(f: impl FnOnce(&std::path::Path) -> Result<T>) -> Result<T> {
     let scratch = std::env::temp_dir().join(format!("vibrotribo-reproduce-{}", std::process::id()));
     crate::output::create_dir(&scratch)?;
     let record_path = scratch.join("rjob_vertical_acceleration.csv");
     std::fs::write(&record_path, RECORD).with_context(|| record_path.display().to_string())?;
-    let result = study(ctx, &record_path);
+    let result = f(&record_path);
     let _ = std::fs::remove_dir_all(&scratch);
     result
 }

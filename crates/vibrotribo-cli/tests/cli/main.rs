@@ -22,6 +22,7 @@ mod optimize;
 mod periodic_orbits;
 mod plot_dir_draws_every_kind;
 mod plot_skips_empty_figures;
+mod response;
 mod resume_checks_files;
 mod serve;
 mod sizes_refused_before_allocation;

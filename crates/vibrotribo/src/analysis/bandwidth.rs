@@ -2,10 +2,10 @@
 //! over the branches of up and down sweeps (or continuation) taken together.
 //!
 //! The response at each frequency is the largest power any branch reaches there (the
-//! envelope a designer can hope for when the device may sit on any coexisting orbit); the
-//! peak is the envelope's largest sample, and the half-power band is the interval around it
-//! where the envelope stays at or above half the peak, its edges interpolated linearly between
-//! samples. Frequencies are in the caller's unit (Ω, or Hz for the centre frequency of a
+//! envelope a designer can hope for when the device may sit on any coexisting orbit), each
+//! branch interpolated linearly between its own samples; the peak is the envelope's largest
+//! sample, and the half-power band is the interval around it where the envelope stays at or
+//! above half the peak, its edges interpolated linearly between samples. Frequencies are in the caller's unit (Ω, or Hz for the centre frequency of a
 //! random input's band).
 
 use super::AnalysisError;
@@ -32,11 +32,15 @@ impl Bandwidth {
     }
 }
 
-/// The envelope of the `branches`, each a list of `(frequency, power)` samples, on the union
-/// of their frequencies (sorted; a frequency no branch has at a given point takes the
-/// branches' samples there, not interpolations).
+/// The envelope of the `branches`, each a list of `(frequency, power)` samples in order
+/// along the branch: at every frequency any branch has a sample at (sorted, each once), the
+/// largest power of any branch there, a branch counting wherever a pair of its consecutive
+/// samples spans the frequency (its power interpolated linearly between them). Branches
+/// sampled on different frequencies (sweeps on a grid, continuation points between) thus
+/// combine without a branch dropping out between its own samples. A non-finite power breaks
+/// its branch there; a branch may fold back in frequency.
 pub fn envelope(branches: &[&[(f64, f64)]]) -> Result<Vec<(f64, f64)>, AnalysisError> {
-    let mut all: Vec<(f64, f64)> = Vec::new();
+    let mut frequencies: Vec<f64> = Vec::new();
     for b in branches {
         for (i, &(f, p)) in b.iter().enumerate() {
             if !f.is_finite() {
@@ -47,21 +51,38 @@ pub fn envelope(branches: &[&[(f64, f64)]]) -> Result<Vec<(f64, f64)>, AnalysisE
                 });
             }
             if p.is_finite() {
-                all.push((f, p));
+                frequencies.push(f);
             }
         }
     }
-    if all.is_empty() {
+    if frequencies.is_empty() {
         return Err(AnalysisError::Empty {
             what: "frequency response",
         });
     }
-    all.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut out: Vec<(f64, f64)> = Vec::with_capacity(all.len());
-    for (f, p) in all {
-        match out.last_mut() {
-            Some(last) if last.0 == f => last.1 = last.1.max(p),
-            _ => out.push((f, p)),
+    frequencies.sort_by(f64::total_cmp);
+    frequencies.dedup();
+    let mut out: Vec<(f64, f64)> = frequencies.iter().map(|&f| (f, f64::NEG_INFINITY)).collect();
+    let raise = |out: &mut Vec<(f64, f64)>, k: usize, p: f64| out[k].1 = out[k].1.max(p);
+    let index = |f: f64| frequencies.partition_point(|&x| x < f);
+    for b in branches {
+        for (&(f, p), k) in b.iter().zip(0..) {
+            if p.is_finite() {
+                raise(&mut out, index(f), p);
+            }
+            let Some(&(g, q)) = b.get(k + 1) else {
+                continue;
+            };
+            if !(p.is_finite() && q.is_finite()) || f == g {
+                continue;
+            }
+            let (lo, hi) = (f.min(g), f.max(g));
+            let (first, end) = (index(lo), index(hi));
+            for (j, &x) in frequencies[first..end].iter().enumerate() {
+                if x > lo {
+                    raise(&mut out, first + j, p + (q - p) * (x - f) / (g - f));
+                }
+            }
         }
     }
     Ok(out)

@@ -40,3 +40,39 @@ fn envelope_of_hysteresis() {
     assert!(half_power_bandwidth(&[]).is_err());
     assert!(half_power_bandwidth(&[&[(f64::NAN, 1.0)]]).is_err());
 }
+
+/// Branches sampled on different frequencies: each counts between its own samples (linear
+/// interpolation), so a lower branch sampled in between does not make the envelope dip.
+#[test]
+fn envelope_of_branches_on_different_grids() {
+    // The upper branch, a tent 0..2 peaking at 1 with power 10, sampled at 0, 1, 2; a lower
+    // one at power 1 sampled at 0.25, 0.5, …, 1.75.
+    let upper = [(0.0, 0.0), (1.0, 10.0), (2.0, 0.0)];
+    let lower: Vec<(f64, f64)> = (1..8).map(|i| (0.25 * i as f64, 1.0)).collect();
+    let env = vibrotribo::analysis::envelope(&[&upper, &lower]).unwrap();
+    for &(f, p) in &env {
+        let tent = 10.0 * (1.0 - (f - 1.0).abs());
+        // The lower branch only counts within its own span.
+        let floor = if (0.25..=1.75).contains(&f) { 1.0 } else { 0.0 };
+        let want = tent.max(floor);
+        assert!((p - want).abs() < 1e-12, "at {f}: {p}, expected {want}");
+    }
+    let b = half_power_bandwidth(&[&upper, &lower]).unwrap();
+    // Half power 5 on the tent's sides, at 0.5 and 1.5 exactly.
+    assert!(
+        (b.lower.unwrap() - 0.5).abs() < 1e-12 && (b.upper.unwrap() - 1.5).abs() < 1e-12,
+        "{b:?}"
+    );
+    // A branch that folds back (frequencies not monotone) counts on both legs; a NaN breaks it.
+    let folded = [(0.0, 1.0), (2.0, 3.0), (1.0, 5.0), (f64::NAN, f64::NAN)];
+    assert!(
+        vibrotribo::analysis::envelope(&[&folded]).is_err(),
+        "a NaN frequency is an error"
+    );
+    let folded = [(0.0, 1.0), (2.0, 3.0), (1.0, 5.0), (1.5, f64::NAN), (0.5, 7.0)];
+    let env = vibrotribo::analysis::envelope(&[&folded]).unwrap();
+    let at = |f: f64| env.iter().find(|e| e.0 == f).unwrap().1;
+    assert_eq!(at(1.0), 5.0);
+    assert_eq!(at(0.5), 7.0, "its own sample, not joined to the broken neighbour");
+    assert!((at(2.0) - 3.0).abs() < 1e-12);
+}

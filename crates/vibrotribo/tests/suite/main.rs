@@ -48,6 +48,7 @@ mod orbits_shooting;
 mod properties;
 mod reference_default_case;
 mod reliability;
+mod response;
 mod sensitivity_nonsmooth;
 mod sensitivity_parameters;
 mod sensitivity_stm;

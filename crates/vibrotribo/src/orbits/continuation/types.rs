@@ -173,6 +173,22 @@ pub enum BifurcationKind {
     SequenceChange,
 }
 
+impl BifurcationKind {
+    /// Its name in files: `fold`, `branch_point`, `period_doubling`, `neimark_sacker`,
+    /// `grazing`, `sticking`, `sequence_change`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            BifurcationKind::Fold => "fold",
+            BifurcationKind::BranchPoint => "branch_point",
+            BifurcationKind::PeriodDoubling => "period_doubling",
+            BifurcationKind::NeimarkSacker { .. } => "neimark_sacker",
+            BifurcationKind::Grazing { .. } => "grazing",
+            BifurcationKind::Sticking { .. } => "sticking",
+            BifurcationKind::SequenceChange => "sequence_change",
+        }
+    }
+}
+
 /// A bifurcation located on a branch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bifurcation {
@@ -357,6 +373,40 @@ pub enum BranchEnd {
         /// Parameter of the last point (NaN if the branch has none).
         parameter: f64,
     },
+}
+
+impl BranchEnd {
+    /// Its name in files: `range_end`, `max_points`, `step_floor`, `grazing`,
+    /// `cascade_depth`, `switch_failed`, `collapsed`, `closed`, `stopped`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            BranchEnd::RangeEnd { .. } => "range_end",
+            BranchEnd::MaxPoints => "max_points",
+            BranchEnd::StepFloor { .. } => "step_floor",
+            BranchEnd::Grazing { .. } => "grazing",
+            BranchEnd::CascadeDepth { .. } => "cascade_depth",
+            BranchEnd::SwitchFailed { .. } => "switch_failed",
+            BranchEnd::Collapsed { .. } => "collapsed",
+            BranchEnd::Closed { .. } => "closed",
+            BranchEnd::Stopped { .. } => "stopped",
+        }
+    }
+
+    /// The parameter where the branch ended (`None` for [`BranchEnd::MaxPoints`], which
+    /// records none).
+    pub fn parameter(&self) -> Option<f64> {
+        match self {
+            BranchEnd::RangeEnd { parameter }
+            | BranchEnd::StepFloor { parameter, .. }
+            | BranchEnd::Grazing { parameter, .. }
+            | BranchEnd::CascadeDepth { parameter }
+            | BranchEnd::SwitchFailed { parameter }
+            | BranchEnd::Collapsed { parameter }
+            | BranchEnd::Closed { parameter }
+            | BranchEnd::Stopped { parameter } => Some(*parameter),
+            BranchEnd::MaxPoints => None,
+        }
+    }
 }
 
 /// One branch of periodic orbits.
