@@ -15,8 +15,10 @@ use vibrotribo::config::Config;
 use vibrotribo::study::{PointOptions, SettleMode};
 use vibrotribo::sweep::Continuation;
 
+mod bifmap;
 mod commands;
 
+pub use bifmap::*;
 pub use commands::*;
 
 /// What an output directory holds: the command that wrote it.
@@ -49,6 +51,8 @@ pub enum Kind {
     OptimizeMassRatio,
     /// `vibrotribo optimize` (`optimize.json`, which names no command).
     Optimize,
+    /// `vibrotribo bifmap` (`bifmap.json`).
+    Bifmap,
 }
 
 /// The manifests that name no command, by file name, with a data file that must sit beside.
@@ -62,13 +66,14 @@ const NAMED_MANIFESTS: [(&str, &str, Kind); 6] = [
 ];
 
 /// The manifests that name their command, by file name.
-const COMMAND_MANIFESTS: [(&str, Kind); 6] = [
+const COMMAND_MANIFESTS: [(&str, Kind); 7] = [
     ("sweep.json", Kind::Sweep),
     ("map.json", Kind::Map),
     ("basins.json", Kind::Basins),
     ("attractors.json", Kind::Attractors),
     ("chirp.json", Kind::Chirp),
     ("continue.json", Kind::Continue),
+    ("bifmap.json", Kind::Bifmap),
 ];
 
 /// The kind field every command manifest opens with.

@@ -115,7 +115,7 @@ pub fn read_json(path: &Path) -> Result<serde_json::Value> {
 }
 
 /// The manifests by which a directory is known to hold a command's results.
-pub const MANIFESTS: [&str; 10] = [
+pub const MANIFESTS: [&str; 11] = [
     "summary.json",
     "sweep.json",
     "map.json",
@@ -126,6 +126,7 @@ pub const MANIFESTS: [&str; 10] = [
     "load_sweep.json",
     "lyapunov.json",
     "periodic.json",
+    "bifmap.json",
 ];
 
 /// Refuses to write a job's results into `dir` when it holds another job's: a manifest

@@ -41,8 +41,9 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         Some(Kind::Periodic) => crate::periodic::plot_periodic(dir),
         Some(Kind::OptimizeMassRatio) => crate::mass_ratio_picture::plot_optimize_mass_ratio(dir),
         Some(Kind::Optimize) => crate::optimize::plot_convergence(dir),
+        Some(Kind::Bifmap) => crate::bifmap_picture::plot_dir(dir),
         None => bail!(
-            "{} holds no vibrotribo results (expected the manifest of a command: summary.json beside trajectory.csv, sweep.json, map.json, basins.json, attractors.json, chirp.json, continue.json, lyapunov.json, load_sweep.json, periodic.json, fit.json beside optimum.csv, or optimize.json)",
+            "{} holds no vibrotribo results (expected the manifest of a command: summary.json beside trajectory.csv, sweep.json, map.json, basins.json, attractors.json, chirp.json, continue.json, bifmap.json, lyapunov.json, load_sweep.json, periodic.json, fit.json beside optimum.csv, or optimize.json)",
             dir.display()
         ),
     }
