@@ -166,21 +166,9 @@ fn check_sizes(
     Ok(())
 }
 
-/// What a map made: its curves, the power map's points computed, and whether everything
-/// was (`false` after SIGINT/SIGTERM).
-pub struct Made {
-    /// The curves and seeds.
-    pub map: BifurcationMap,
-    /// Points of the power map computed.
-    pub done: usize,
-    /// Whether the curves and the power map are complete.
-    pub complete: bool,
-}
-
 /// Runs `vibrotribo bifmap`.
 pub fn run(args: &BifmapArgs) -> Result<()> {
-    let made = make(args, true)?;
-    if !made.complete {
+    if !make(args, true)? {
         return Err(Interrupted {
             what: match &args.out {
                 Some(dir) => format!(
@@ -196,8 +184,9 @@ pub fn run(args: &BifmapArgs) -> Result<()> {
 }
 
 /// Computes the map of `args` and writes its files (with `--out`) and picture (with
-/// `--plot`, when complete); `say`: print what it found.
-pub fn make(args: &BifmapArgs, say: bool) -> Result<Made> {
+/// `--plot`, when complete); `say`: print what it found. Returns whether the curves and the
+/// power map are complete (`false` after SIGINT/SIGTERM).
+pub fn make(args: &BifmapArgs, say: bool) -> Result<bool> {
     crate::map::check_axis("x", args.x_from, args.x_to, args.x_steps)?;
     crate::map::check_axis("y", args.y_from, args.y_to, args.y_steps)?;
     if args.x_from == args.x_to || args.y_from == args.y_to {
@@ -275,7 +264,7 @@ pub fn make(args: &BifmapArgs, say: bool) -> Result<Made> {
             );
         }
     }
-    Ok(Made { map, done, complete })
+    Ok(complete)
 }
 
 /// The curves of the map, with a progress bar over the seed branches, then the curves.

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 
+use super::bifmaps::bifurcation_maps;
 use super::chatter::figs_20_25;
 use super::configurations::figs_5_6;
 use super::context::{Budget, Ctx};
@@ -72,7 +73,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         failures: std::sync::Mutex::new(Vec::new()),
     };
     let started = Instant::now();
-    let steps: [(&str, Step); 13] = [
+    let steps: [(&str, Step); 14] = [
         ("Figs. 5–6: mass configurations", figs_5_6),
         ("Figs. 7–11: asymmetric spacing R_δ", figs_7_11),
         ("Fig. 12: symmetric spacing δ", fig_12),
@@ -82,6 +83,10 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         ("Figs. 18–19: Ω = 0.30", figs_18_19),
         ("Figs. 20–25: chatter", figs_20_25),
         ("periodic orbits behind Figs. 7, 9, 14–15, 18–19", periodic_orbits),
+        (
+            "bifurcation maps of the default case in (Ω, R_m) and (Ω, R_δ)",
+            bifurcation_maps,
+        ),
         (
             "what the non-periodic motions are: exponents, error bars, basins, expected power",
             dynamics,

@@ -103,6 +103,8 @@ fn oscillator_args(dir: &str) -> Vec<String> {
         "2",
         "--seeds",
         "2",
+        "--x-starts",
+        "2",
         "--kinds",
         "period_doubling,grazing",
         "--curve-points",
@@ -215,7 +217,8 @@ fn the_impact_oscillators_curves_are_the_closed_forms() {
     assert!(dir.join("bifmap.png").exists() && dir.join("bifmap.svg").exists());
 }
 
-/// A cheap map of the paper's default case: few seeds, short curves, a small power map.
+/// A cheap map of the paper's default case (a small power map, short runs), with the
+/// option-value pairs of `extra` set (replacing the same options).
 fn device_args<'a>(dir: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "bifmap",
@@ -243,7 +246,12 @@ fn device_args<'a>(dir: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
         "--out",
         dir,
     ];
-    args.extend_from_slice(extra);
+    for pair in extra.chunks(2) {
+        match args.iter().position(|a| *a == pair[0]) {
+            Some(i) => args[i + 1] = pair[1],
+            None => args.extend_from_slice(pair),
+        }
+    }
     args
 }
 
@@ -353,9 +361,10 @@ fn bad_input_names_the_problem() {
     let root = tempdir();
     let d = root.path().join("bad");
     let d = d.to_str().unwrap();
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["--kinds", "saddle"], "saddle"),
-        (&["--seeds", "0"], "seed"),
+        (&["--seeds", "0"], "seed values"),
+        (&["--x-starts", "1"], "starts per seed value"),
         (&["--period", "0"], "--period"),
         (&["--curve-points", "1"], "curve points"),
         (&["--y", "excitation.omega_ratio"], "same quantity"),
@@ -364,16 +373,7 @@ fn bad_input_names_the_problem() {
         (&["--y-from", "-1"], "gap_ratio"),
     ];
     for (extra, needle) in cases {
-        let mut args = device_args(d, &[]);
-        // Later options replace earlier ones of the same name.
-        for pair in extra.chunks(2) {
-            if let Some(i) = args.iter().position(|a| *a == pair[0]) {
-                args[i + 1] = pair[1];
-            } else {
-                args.extend_from_slice(pair);
-            }
-        }
-        let o = vibrotribo(&args);
+        let o = vibrotribo(&device_args(d, extra));
         assert!(!o.status.success(), "{extra:?} was accepted");
         let e = stderr(&o);
         assert!(e.contains(needle), "{extra:?}: {e}");

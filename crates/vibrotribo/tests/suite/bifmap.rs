@@ -104,6 +104,8 @@ fn small_options() -> BifmapOptions {
 fn the_map() -> BifurcationMap {
     let mut request = MapRequest::new("omega_ratio", (2.35, 3.5), GAP_KEY, (0.001, 0.0014));
     request.seeds = 2;
+    // The ends only: the impact-free orbit at Ω = 3.5 and the impacting one at 2.35.
+    request.x_starts = 2;
     request.kinds = vec![CurveKind::PeriodDoubling, CurveKind::Grazing];
     bifurcation_map(&config(3.0, 0.001), &request, &small_options(), |_| {}).expect("the map is computed")
 }
@@ -228,7 +230,7 @@ fn bad_requests_name_the_problem() {
         seeds: 0,
         ..base.clone()
     };
-    assert!(matches!(run(&none, &o), BifmapError::Seeds(0)));
+    assert!(matches!(run(&none, &o), BifmapError::Seeds { value: 0, .. }));
     let no_kinds = MapRequest {
         kinds: Vec::new(),
         ..base.clone()
