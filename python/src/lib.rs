@@ -1,5 +1,5 @@
 //! The extension module `vibrotribo._vibrotribo`: Python bindings of vibrotribo's run layer
-//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation, Lyapunov spectra, chirps, basins and attractors, the optimal mass ratio, design optimisation, frequency responses, ngspice netlists). The Python
+//! (configurations, runs, sweeps, maps, load sweeps, periodic orbits and their continuation, bifurcation curves and maps, Lyapunov spectra, chirps, basins and attractors, the optimal mass ratio, design optimisation, frequency responses, ngspice netlists). The Python
 //! package `vibrotribo` (python/vibrotribo/) wraps what this returns into result objects;
 //! nothing here computes: it converts arguments, releases the GIL while the library runs,
 //! watches for Ctrl-C at the library's checkpoints, and converts results to numpy arrays.
@@ -7,6 +7,7 @@
 use pyo3::prelude::*;
 
 mod attractors;
+mod bifmap;
 mod chirp;
 mod config;
 mod convert;
@@ -53,6 +54,7 @@ fn _vibrotribo(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(orbits::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbits::continue_, m)?)?;
     m.add_function(wrap_pyfunction!(curve::curve, m)?)?;
+    m.add_function(wrap_pyfunction!(bifmap::bifmap, m)?)?;
     m.add_function(wrap_pyfunction!(lyapunov::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(chirp::chirp, m)?)?;
     m.add_function(wrap_pyfunction!(attractors::basins, m)?)?;

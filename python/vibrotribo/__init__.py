@@ -52,6 +52,7 @@ from ._results import (
 )
 from ._studies import Attractors, BandResponse, Basins, Chirp, MassRatioOptimum, Response, SpiceExport
 from ._curve import Curve
+from ._bifmap import BifurcationMap
 from ._vibrotribo import Config, OrbitNotFound, __version__, grid, log_spaced
 
 # A Config is a read-only mapping of its effective values (cfg["excitation.amplitude"]).
@@ -67,6 +68,8 @@ __all__ = [
     "continue_",
     "curve",
     "Curve",
+    "bifmap",
+    "BifurcationMap",
     "lyapunov",
     "Lyapunov",
     "chirp",
@@ -432,6 +435,70 @@ def curve(
         mechanics_only=mechanics_only,
     )
     return Curve._from(raw)
+
+
+def bifmap(
+    config: ConfigLike,
+    x: str,
+    x_values: Iterable[float],
+    y: str,
+    y_values: Iterable[float],
+    *,
+    seeds: int = 5,
+    x_starts: int = 5,
+    kinds: Optional[Iterable[str]] = None,
+    period: Optional[int] = None,
+    doublings: int = 1,
+    orbit_transient: int = 200,
+    branch_points: int = 1000,
+    curve_points: int = 200,
+    max_curves: int = 64,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    threads: Optional[int] = None,
+    period_tolerance: float = _vibrotribo.DEFAULT_PERIOD_TOLERANCE,
+    settle: SettleMode = "auto",
+    settle_cap: int = _vibrotribo.DEFAULT_SETTLE_CAP,
+    floquet: bool = False,
+    allow_large: bool = False,
+) -> BifurcationMap:
+    """A bifurcation map, as ``vibrotribo bifmap`` computes it: at ``seeds`` values of ``y``
+    (equally spaced from the first to the last of ``y_values``) the periodic orbits found
+    after ``orbit_transient`` periods from the configured initial state at ``x_starts``
+    values of ``x`` (equally spaced over the first to the last of ``x_values``) are continued
+    in ``x`` towards both ends (``doublings`` period doublings followed);
+    every fold, period doubling, Neimark–Sacker point and grazing located on them (of
+    ``kinds``, default all) that lies on no curve yet is followed in ``y`` towards both ends
+    (``curve_points`` points per half, at most ``max_curves`` curves). The power map is
+    :func:`vibrotribo.map` over ``x_values`` × ``y_values`` with the remaining settings.
+    Returns a :class:`BifurcationMap` equal to the command's files."""
+    raw = _vibrotribo.bifmap(
+        _config(config),
+        x,
+        _values(x_values, "x_values"),
+        y,
+        _values(y_values, "y_values"),
+        seeds=_count(seeds, "seeds", least=1),
+        x_starts=_count(x_starts, "x_starts", least=2),
+        kinds=None if kinds is None else [str(k) for k in kinds],
+        period=_count(period, "period", least=1),
+        doublings=_count(doublings, "doublings"),
+        orbit_transient=_count(orbit_transient, "orbit_transient"),
+        branch_points=_count(branch_points, "branch_points", least=2),
+        curve_points=_count(curve_points, "curve_points", least=2),
+        max_curves=_count(max_curves, "max_curves", least=1),
+        transient=_count(transient, "transient"),
+        recorded=_count(recorded, "recorded"),
+        mechanics_only=mechanics_only,
+        threads=_count(threads, "threads", least=1),
+        period_tolerance=period_tolerance,
+        settle=settle,
+        settle_cap=_count(settle_cap, "settle_cap"),
+        floquet=floquet,
+        allow_large=allow_large,
+    )
+    return BifurcationMap._from(raw)
 
 
 def lyapunov(

@@ -197,6 +197,34 @@ def curve(
 ) -> Dict[str, Any]:
     """A bifurcation curve in two keys: its points, codimension-two points and end."""
 
+def bifmap(
+    config: Any,
+    x: str,
+    x_values: List[float],
+    y: str,
+    y_values: List[float],
+    *,
+    seeds: int = 5,
+    x_starts: int = 5,
+    kinds: Optional[List[str]] = None,
+    period: Optional[int] = None,
+    doublings: int = 1,
+    orbit_transient: int = 200,
+    branch_points: int = 1000,
+    curve_points: int = 200,
+    max_curves: int = 64,
+    transient: Optional[int] = None,
+    recorded: Optional[int] = None,
+    mechanics_only: bool = False,
+    threads: Optional[int] = None,
+    period_tolerance: float = 1e-4,
+    settle: SettleMode = "auto",
+    settle_cap: int = 2000,
+    floquet: bool = False,
+    allow_large: bool = False,
+) -> Dict[str, Any]:
+    """A bifurcation map: its curves, codimension-two and located points, power map."""
+
 def grid(start: float, stop: float, steps: int) -> npt.NDArray[np.float64]:
     """`steps` values equally spaced from `start` to `stop` (both included, `stop` exactly)."""
 

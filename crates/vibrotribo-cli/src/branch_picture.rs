@@ -271,13 +271,58 @@ pub fn draw(
             std::ops::ControlFlow::Continue(())
         },
     );
+    let axes = Axes {
+        title: format!("Periodic orbits in {}", diagram.param),
+        x_label: diagram.param.to_string(),
+        y_label: format!("x{} at t = nT [m]", mass + 1),
+        mass,
+        scale: 1.0,
+    };
+    draw_over(dir, name, config, &axes, (&dx, &dy), drawing, family)
+}
+
+/// How a picture of branches is labelled and scaled.
+pub struct Axes {
+    /// The title.
+    pub title: String,
+    /// The parameter's label.
+    pub x_label: String,
+    /// The position's label.
+    pub y_label: String,
+    /// The mass shown, 0-based.
+    pub mass: usize,
+    /// Positions are drawn times this (1: metres).
+    pub scale: f64,
+}
+
+/// The branches of `drawing` (scaled and labelled by `axes`) over the brute-force points
+/// `brute` (parameter, position already scaled), bifurcations marked: `{name}.png`/`.svg`.
+pub fn draw_over(
+    dir: &Path,
+    name: &str,
+    config: &Config,
+    axes: &Axes,
+    (dx, dy): (&[f64], &[f64]),
+    drawing: &Drawing,
+    family: &impl Fn(f64) -> ChainParams,
+) -> Result<()> {
+    let mass = axes.mass;
+    let scaled = |v: Vec<f64>| v.into_iter().map(|x| x * axes.scale).collect::<Vec<f64>>();
     // Branch curves: one series per run of equal stability and per section point.
     let mut curves: Vec<(Vec<f64>, Vec<f64>, bool)> = Vec::new();
     for b in &drawing.branches {
         let sections: Vec<Vec<f64>> = b
             .points
             .iter()
-            .map(|p| section_positions(&family(p.parameter), &p.state, b.period, mass, config))
+            .map(|p| {
+                scaled(section_positions(
+                    &family(p.parameter),
+                    &p.state,
+                    b.period,
+                    mass,
+                    config,
+                ))
+            })
             .collect();
         for k in 0..b.period as usize {
             let mut start = 0;
@@ -303,7 +348,13 @@ pub fn draw(
     for b in &drawing.branches {
         for f in &b.bifurcations {
             let (label, shape, colour) = marker_of(&f.kind);
-            let ys = section_positions(&family(f.parameter), &f.state, b.period, mass, config);
+            let ys = scaled(section_positions(
+                &family(f.parameter),
+                &f.state,
+                b.period,
+                mass,
+                config,
+            ));
             let at = match marks.iter().position(|m| m.0 == label) {
                 Some(i) => i,
                 None => {
@@ -337,17 +388,13 @@ pub fn draw(
             s.colour(3).dashed()
         });
     }
-    let mut points = vec![Series::new("brute force", &dx, &dy).colour(7)];
+    let mut points = vec![Series::new("brute force", dx, dy).colour(7)];
     points.extend(
         marks
             .iter()
             .map(|(label, shape, colour, x, y)| Series::new(label, x, y).colour(*colour).marker(*shape, 11)),
     );
-    let mut fig = Figure::new(
-        format!("Periodic orbits in {}", diagram.param),
-        diagram.param,
-        format!("x{} at t = nT [m]", mass + 1),
-    );
+    let mut fig = Figure::new(axes.title.clone(), axes.x_label.clone(), axes.y_label.clone());
     let all_x = dx.iter().chain(curves.iter().flat_map(|c| c.0.iter()));
     let all_y = dy.iter().chain(curves.iter().flat_map(|c| c.1.iter()));
     fig.legend = emptier_upper_corner(all_x.copied().zip(all_y.copied()));

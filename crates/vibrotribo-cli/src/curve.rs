@@ -168,7 +168,8 @@ pub fn run(args: &CurveArgs) -> Result<()> {
     Ok(())
 }
 
-fn end_text(end: &CurveEnd) -> String {
+/// Why a curve ended, in words.
+pub fn end_text(end: &CurveEnd) -> String {
     match end {
         CurveEnd::RangeEnd { parameter2 } => format!("range end at {parameter2}"),
         CurveEnd::MaxPoints => "point limit reached".into(),

@@ -9,6 +9,8 @@ mod stdout;
 mod attractors;
 mod band_response;
 mod basins;
+mod bifmap;
+mod bifmap_picture;
 mod branch_picture;
 mod chirp;
 mod config;
@@ -64,6 +66,9 @@ enum Command {
     /// Follow a fold, period doubling, Neimark–Sacker or grazing point in a second parameter:
     /// the bifurcation curve and its codimension-two points.
     Curve(curve::CurveArgs),
+    /// A bifurcation map in two parameters: the fold, period-doubling, Neimark–Sacker and
+    /// grazing curves (from seed branches), their codimension-two points, over the power map.
+    Bifmap(bifmap::BifmapArgs),
     /// Sweep one parameter: orbit diagram, impact velocities, period, power.
     Sweep(sweep::SweepArgs),
     /// Combine the shards of one sweep, map or basins job (`--shard I/N`) into the unsharded
@@ -121,6 +126,7 @@ fn default_out(command: &mut Command) {
         Command::LoadSweep(a) => ("load-sweep", &mut a.out, a.plot),
         Command::Periodic(a) => ("periodic", &mut a.out, a.plot),
         Command::Continue(a) => ("continue", &mut a.out, a.plot),
+        Command::Bifmap(a) => ("bifmap", &mut a.out, a.plot),
         Command::Sweep(a) => ("sweep", &mut a.out, a.plot),
         Command::Chirp(a) => ("chirp", &mut a.out, a.plot),
         Command::Map(a) => ("map", &mut a.out, a.plot),
@@ -146,7 +152,7 @@ fn default_out(command: &mut Command) {
 #[derive(Debug, clap::Args)]
 struct PlotArgs {
     /// A directory written by a command with `--out` (`simulate`, `sweep`, `map`, `chirp`,
-    /// `lyapunov`, `basins`, `attractors`, `response`, `band-response`, …).
+    /// `lyapunov`, `basins`, `attractors`, `continue`, `bifmap`, `response`, `band-response`, …).
     dir: std::path::PathBuf,
     /// PSD of this mass only (1-based; default: every mass).
     #[arg(long)]
@@ -165,6 +171,7 @@ fn run() -> anyhow::Result<()> {
         Command::Periodic(args) => periodic::run(&args),
         Command::Continue(args) => continuation::run(&args),
         Command::Curve(args) => curve::run(&args),
+        Command::Bifmap(args) => bifmap::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Chirp(args) => chirp::run(&args),

@@ -15,9 +15,11 @@ use vibrotribo::config::Config;
 use vibrotribo::study::{PointOptions, SettleMode};
 use vibrotribo::sweep::Continuation;
 
+mod bifmap;
 mod commands;
 mod response;
 
+pub use bifmap::*;
 pub use commands::*;
 pub use response::*;
 
@@ -56,6 +58,8 @@ pub enum Kind {
     /// `vibrotribo band-response` (`band_response.json`).
     #[serde(rename = "band-response")]
     BandResponse,
+    /// `vibrotribo bifmap` (`bifmap.json`).
+    Bifmap,
 }
 
 /// The manifests that name no command, by file name, with a data file that must sit beside.
@@ -69,7 +73,7 @@ const NAMED_MANIFESTS: [(&str, &str, Kind); 6] = [
 ];
 
 /// The manifests that name their command, by file name.
-const COMMAND_MANIFESTS: [(&str, Kind); 8] = [
+const COMMAND_MANIFESTS: [(&str, Kind); 9] = [
     ("sweep.json", Kind::Sweep),
     ("map.json", Kind::Map),
     ("basins.json", Kind::Basins),
@@ -78,6 +82,7 @@ const COMMAND_MANIFESTS: [(&str, Kind); 8] = [
     ("continue.json", Kind::Continue),
     ("response.json", Kind::Response),
     ("band_response.json", Kind::BandResponse),
+    ("bifmap.json", Kind::Bifmap),
 ];
 
 /// The kind field every command manifest opens with.

@@ -73,7 +73,8 @@ pub struct MapArgs {
     pub run: RunArgs,
 }
 
-fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
+/// Checks one axis of a grid: at least one value, finite ends.
+pub(crate) fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> Result<()> {
     if steps == 0 {
         bail!("--{name}-steps must be at least 1");
     }

@@ -115,7 +115,7 @@ pub fn read_json(path: &Path) -> Result<serde_json::Value> {
 }
 
 /// The manifests by which a directory is known to hold a command's results.
-pub const MANIFESTS: [&str; 12] = [
+pub const MANIFESTS: [&str; 13] = [
     "summary.json",
     "sweep.json",
     "map.json",
@@ -128,6 +128,7 @@ pub const MANIFESTS: [&str; 12] = [
     "periodic.json",
     "response.json",
     "band_response.json",
+    "bifmap.json",
 ];
 
 /// Refuses to write a job's results into `dir` when it holds another job's: a manifest

@@ -43,8 +43,9 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         Some(Kind::Optimize) => crate::optimize::plot_convergence(dir),
         Some(Kind::Response) => crate::response_picture::plot_response(dir),
         Some(Kind::BandResponse) => crate::response_picture::plot_band_response(dir),
+        Some(Kind::Bifmap) => crate::bifmap_picture::plot_dir(dir),
         None => bail!(
-            "{} holds no vibrotribo results (expected the manifest of a command: summary.json beside trajectory.csv, sweep.json, map.json, basins.json, attractors.json, chirp.json, continue.json, response.json, band_response.json, lyapunov.json, load_sweep.json, periodic.json, fit.json beside optimum.csv, or optimize.json)",
+            "{} holds no vibrotribo results (expected the manifest of a command: summary.json beside trajectory.csv, sweep.json, map.json, basins.json, attractors.json, chirp.json, continue.json, bifmap.json, response.json, band_response.json, lyapunov.json, load_sweep.json, periodic.json, fit.json beside optimum.csv, or optimize.json)",
             dir.display()
         ),
     }

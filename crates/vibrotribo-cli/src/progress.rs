@@ -140,6 +140,20 @@ impl Progress {
         }
     }
 
+    /// Sets the number of steps in all (a job whose size grows as it goes).
+    pub fn set_len(&self, len: u64) {
+        if let Some(b) = &self.bar {
+            b.set_length(len);
+        }
+    }
+
+    /// Sets the steps done.
+    pub fn set_position(&self, pos: u64) {
+        if let Some(b) = &self.bar {
+            b.set_position(pos);
+        }
+    }
+
     /// Removes the bar.
     pub fn finish(&self) {
         if let Some(b) = &self.bar {

@@ -163,15 +163,41 @@ pub fn config_family2(config: &Config, key: &str, key2: &str) -> impl Fn(f64, f6
     }
 }
 
-/// Whether a located bifurcation is of `kind`.
-fn is_kind(b: &BifurcationKind, kind: CurveKind) -> bool {
-    matches!(
-        (b, kind),
-        (BifurcationKind::Fold, CurveKind::Fold)
-            | (BifurcationKind::PeriodDoubling, CurveKind::PeriodDoubling)
-            | (BifurcationKind::NeimarkSacker { .. }, CurveKind::NeimarkSacker)
-            | (BifurcationKind::Grazing { .. }, CurveKind::Grazing)
-    )
+/// The curve kind a located bifurcation lies on: folds, period doublings, Neimark–Sacker
+/// points and grazings; `None` for the others (branch points, sticking, other sequence
+/// changes), which no curve follows.
+pub fn curve_kind_of(b: &BifurcationKind) -> Option<CurveKind> {
+    match b {
+        BifurcationKind::Fold => Some(CurveKind::Fold),
+        BifurcationKind::PeriodDoubling => Some(CurveKind::PeriodDoubling),
+        BifurcationKind::NeimarkSacker { .. } => Some(CurveKind::NeimarkSacker),
+        BifurcationKind::Grazing { .. } => Some(CurveKind::Grazing),
+        _ => None,
+    }
+}
+
+/// Where the curve through a bifurcation located on a branch of period `period` starts: its
+/// orbit, and for a grazing its contact and the orbit on the side without the grazing
+/// impact.
+pub fn curve_start_of(located: &Bifurcation, period: u32) -> CurveStart {
+    let (orbit, contact) = match located.kind {
+        // The side without the grazing impact.
+        BifurcationKind::Grazing { contact, appears } => {
+            let side = if appears {
+                &located.point
+            } else {
+                located.after.as_ref().unwrap_or(&located.point)
+            };
+            (side, Some(contact))
+        }
+        _ => (&located.point, None),
+    };
+    CurveStart {
+        state: orbit.state.clone(),
+        period,
+        parameter: orbit.parameter,
+        contact,
+    }
 }
 
 /// The bifurcation of `request.kind` nearest `near` on the branch of `config` (with `key2 =
@@ -242,7 +268,7 @@ pub fn curve_config(
     let wanted = request.period;
     let best = found
         .iter()
-        .filter(|(f, p)| is_kind(&f.kind, request.kind) && wanted.is_none_or(|w| w == *p))
+        .filter(|(f, p)| curve_kind_of(&f.kind) == Some(request.kind) && wanted.is_none_or(|w| w == *p))
         .min_by(|a, b| {
             (a.0.parameter - request.near)
                 .abs()
@@ -262,24 +288,7 @@ pub fn curve_config(
                 .collect(),
         });
     };
-    let (orbit, contact) = match located.kind {
-        // The side without the grazing impact.
-        BifurcationKind::Grazing { contact, appears } => {
-            let side = if appears {
-                &located.point
-            } else {
-                located.after.as_ref().unwrap_or(&located.point)
-            };
-            (side, Some(contact))
-        }
-        _ => (&located.point, None),
-    };
-    let curve_start = CurveStart {
-        state: orbit.state.clone(),
-        period,
-        parameter: orbit.parameter,
-        contact,
-    };
+    let curve_start = curve_start_of(&located, period);
     let curve_options = CurveOptions {
         shooting,
         ..options.curve.clone()

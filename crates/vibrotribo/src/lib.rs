@@ -42,7 +42,9 @@
 //!   grazings and the onset of sticking; [`branch`] runs that continuation from a
 //!   configuration and a key (what `vibrotribo continue` and Python's `continue_` call), and
 //!   [`curve`] follows a located fold, period doubling, Neimark–Sacker point or grazing in a
-//!   second key. Long searches stop through [`orbits::Cancel`]. [`lyapunov`] computes all 2N Lyapunov exponents
+//!   second key; [`bifmap`] finds a device's fold, doubling, Neimark–Sacker and grazing
+//!   curves in a plane of two keys from seed branches. Long searches stop through
+//!   [`orbits::Cancel`]. [`lyapunov`] computes all 2N Lyapunov exponents
 //!   through impacts, sticking and chatter, with a batch-means error bar. [`attractors`]
 //!   finds the attractors that starts end on (by their stroboscopic sets), their basin
 //!   fractions and powers, and follows them across a parameter.
@@ -82,6 +84,8 @@
 
 pub mod analysis;
 pub mod attractors;
+#[cfg(feature = "config")]
+pub mod bifmap;
 #[cfg(feature = "config")]
 pub mod branch;
 #[cfg(feature = "config")]

@@ -3,6 +3,7 @@
 
 use super::figure::{Figure, HeatMap, Series};
 use super::style::{finite_bounds, widen};
+use super::xy::check_series;
 use super::xy::{HeatChart, Layers, write, xy_chart};
 use anyhow::{Result, anyhow, ensure};
 use std::path::Path;
@@ -65,6 +66,20 @@ pub fn phase_portrait(
 
 /// A heat map of `map` with a colour bar on the right.
 pub fn heat_map(path: &Path, figure: &Figure, map: &HeatMap<'_>) -> Result<()> {
+    heat_map_with(path, figure, map, &[], &[], 1)
+}
+
+/// A heat map of `map` with a colour bar on the right, and `lines` and `points` (marks of
+/// `marker_px` pixels) in the map's coordinates drawn over it, with their legend: e.g.
+/// bifurcation curves over a power map.
+pub fn heat_map_with(
+    path: &Path,
+    figure: &Figure,
+    map: &HeatMap<'_>,
+    lines: &[Series<'_>],
+    points: &[Series<'_>],
+    marker_px: u32,
+) -> Result<()> {
     ensure!(
         map.nx > 0 && map.ny > 0,
         "heat map grid is empty ({} × {} cells)",
@@ -78,6 +93,9 @@ pub fn heat_map(path: &Path, figure: &Figure, map: &HeatMap<'_>) -> Result<()> {
         map.nx,
         map.ny
     );
+    for (i, s) in lines.iter().chain(points).enumerate() {
+        check_series(s, i)?;
+    }
     for (name, (a, b)) in [("x", map.x_edges), ("y", map.y_edges)] {
         ensure!(
             a.is_finite() && b.is_finite() && a < b,
@@ -105,6 +123,11 @@ pub fn heat_map(path: &Path, figure: &Figure, map: &HeatMap<'_>) -> Result<()> {
             figure,
             map,
             range: (lo, hi),
+            layers: Layers {
+                lines,
+                points,
+                marker_px,
+            },
         },
     )
 }

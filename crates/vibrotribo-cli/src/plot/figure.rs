@@ -50,6 +50,10 @@ pub enum Legend {
     UpperRight,
     /// Inside the plot, upper left.
     UpperLeft,
+    /// Inside the plot, lower right.
+    LowerRight,
+    /// Inside the plot, lower left.
+    LowerLeft,
     /// No legend, even if series have labels.
     Hidden,
 }
@@ -109,6 +113,8 @@ pub struct Series<'a> {
     /// As points: a marker of its own (shape and size) instead of the chart's small squares;
     /// for a few points that must stand out, such as bifurcations on a branch.
     pub marker: Option<Marker>,
+    /// As a line: drawn 3 px wide over a white band, to stand out over a heat map.
+    pub halo: bool,
 }
 
 /// A point marker: a shape drawn `size_px` pixels across, filled (a cross is stroked).
@@ -145,6 +151,7 @@ impl<'a> Series<'a> {
             dashed: false,
             colour: None,
             marker: None,
+            halo: false,
         }
     }
 
@@ -157,7 +164,13 @@ impl<'a> Series<'a> {
             dashed: false,
             colour: None,
             marker: None,
+            halo: false,
         }
+    }
+
+    /// The same series drawn (as a line) over a white band.
+    pub fn halo(self) -> Self {
+        Series { halo: true, ..self }
     }
 
     /// The same series drawn dashed (as a line).

@@ -1,7 +1,8 @@
 //! Heat maps: the viridis colour scale and the grid with its colour bar.
 
-use super::figure::{Figure, HeatMap};
+use super::figure::{Figure, Format, HeatMap};
 use super::style::{LABEL_PX, TICK_PX, err, font, tick_label, titled};
+use super::xy::{Layers, draw_layers, draw_legend};
 use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -33,11 +34,15 @@ pub(super) fn viridis(t: f64) -> RGBColor {
 
 pub(super) const MISSING: RGBColor = RGBColor(200, 200, 200);
 
+/// The heat map `map` coloured over `(lo, hi)`, with `layers` (lines and points in the map's
+/// coordinates) drawn over it and their legend.
 pub(super) fn draw_heat_map<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     figure: &Figure,
     map: &HeatMap<'_>,
     (lo, hi): (f64, f64),
+    layers: &Layers<'_, '_>,
+    format: Format,
 ) -> Result<()> {
     let area = titled(root, &figure.title)?;
     let (w, _) = area.dim_in_pixel();
@@ -82,6 +87,8 @@ pub(super) fn draw_heat_map<DB: DrawingBackend>(
         .y_label_formatter(&formatter)
         .draw()
         .map_err(err)?;
+    draw_layers(root, &mut chart, layers, format, false)?;
+    draw_legend(&mut chart, figure.legend, layers)?;
 
     // Colour bar: a column of 256 bands, labelled on its right.
     let mut scale = ChartBuilder::on(&bar)

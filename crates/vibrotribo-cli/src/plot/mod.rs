@@ -30,6 +30,6 @@ mod tests;
 mod xy;
 
 pub use category::{Bands, CategoryMap, category_map, stacked_bands};
-pub use draw::{heat_map, line_plot, lines_and_points, phase_portrait, scatter_plot};
+pub use draw::{heat_map, heat_map_with, line_plot, lines_and_points, phase_portrait, scatter_plot};
 pub use figure::{Figure, HeatMap, Legend, Scale, Series, Shape};
 pub use files::both;

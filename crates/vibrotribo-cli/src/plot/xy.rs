@@ -9,6 +9,7 @@ use super::style::{
 use anyhow::{Context, Result, ensure};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::ops::Range;
 use std::path::Path;
@@ -59,16 +60,17 @@ impl Render for XyChart<'_, '_, '_> {
     }
 }
 
-/// A heat map with its colour range.
-pub(super) struct HeatChart<'f, 'm, 'a> {
+/// A heat map with its colour range and the layers drawn over it.
+pub(super) struct HeatChart<'f, 'm, 's, 'a> {
     pub(super) figure: &'f Figure,
     pub(super) map: &'m HeatMap<'a>,
     pub(super) range: (f64, f64),
+    pub(super) layers: Layers<'s, 'a>,
 }
 
-impl Render for HeatChart<'_, '_, '_> {
-    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, _format: Format) -> Result<()> {
-        draw_heat_map(root, self.figure, self.map, self.range)
+impl Render for HeatChart<'_, '_, '_, '_> {
+    fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, format: Format) -> Result<()> {
+        draw_heat_map(root, self.figure, self.map, self.range, &self.layers, format)
     }
 }
 
@@ -252,9 +254,27 @@ where
         .draw()
         .map_err(err)?;
 
+    draw_layers(root, &mut chart, layers, format, figure.y_scale == Scale::Log)?;
+    draw_legend(&mut chart, figure.legend, layers)
+}
+
+/// Draws the lines of `layers` (clipped to the plotting area, thinned, dashed, over a white
+/// band where the series asks for a halo), then its points (rasterised: each occupied pixel
+/// marked once), each labelled series with a legend entry. `log_y`: points with y ≤ 0 are
+/// left out.
+pub(super) fn draw_layers<'a, DB, Y>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
+    layers: &Layers<'_, '_>,
+    format: Format,
+    log_y: bool,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    Y: Ranged<ValueType = f64>,
+{
     // The plotting area in pixels: drawing there clips to the axes.
     let plot = chart.plotting_area().strip_coord_spec();
-    let log_y = figure.y_scale == Scale::Log;
     let usable = |x: f64, y: f64| x.is_finite() && y.is_finite() && (!log_y || y > 0.0);
     for (i, s) in layers.lines.iter().enumerate() {
         let colour = PALETTE[s.colour.unwrap_or(i) % PALETTE.len()];
@@ -285,27 +305,26 @@ where
         }
         runs.last_mut().expect("runs is never empty").extend(pending);
         let (w, h) = plot.dim_in_pixel();
-        let clipped = runs.iter().flat_map(|r| clip_polyline(r, w as i32, h as i32));
-        let pieces: Vec<Vec<(i32, i32)>> = if s.dashed {
-            clipped.flat_map(|r| dashes(&r, DASH_ON, DASH_OFF)).collect()
-        } else {
-            clipped.collect()
-        };
-        for run in pieces {
-            match format {
-                Format::Svg => plot
-                    .draw(&PathElement::new(run, colour.stroke_width(2)))
-                    .map_err(err)?,
-                // plotters' bitmap lines wider than 1 px come out hollow on steep segments:
-                // draw the 1-px line three times, offset by a pixel right and down.
-                Format::Png => {
-                    for (ox, oy) in [(0, 0), (1, 0), (0, 1)] {
-                        let shifted: Vec<(i32, i32)> = run.iter().map(|&(x, y)| (x + ox, y + oy)).collect();
-                        plot.draw(&PathElement::new(shifted, colour.stroke_width(1)))
-                            .map_err(err)?;
-                    }
-                }
+        let clipped: Vec<Vec<(i32, i32)>> = runs
+            .iter()
+            .flat_map(|r| clip_polyline(r, w as i32, h as i32))
+            .collect();
+        if s.halo {
+            for run in &clipped {
+                stroke(&plot, run, WHITE, HALO_PX, format)?;
             }
+        }
+        let pieces: Vec<Vec<(i32, i32)>> = if s.dashed {
+            clipped
+                .iter()
+                .flat_map(|r| dashes(r, DASH_ON, DASH_OFF))
+                .collect()
+        } else {
+            clipped
+        };
+        let width = if s.halo { 3 } else { 2 };
+        for run in &pieces {
+            stroke(&plot, run, colour, width, format)?;
         }
         if let Some(label) = s.label {
             let dashed = s.dashed;
@@ -391,9 +410,25 @@ where
         }
     }
 
-    let position = match figure.legend {
+    Ok(())
+}
+
+/// The legend of the labelled series of `layers` at `legend` (none when hidden or when no
+/// series has a label).
+pub(super) fn draw_legend<'a, DB, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
+    legend: Legend,
+    layers: &Layers<'_, '_>,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    Y: Ranged<ValueType = f64>,
+{
+    let position = match legend {
         Legend::UpperRight => SeriesLabelPosition::UpperRight,
         Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+        Legend::LowerRight => SeriesLabelPosition::LowerRight,
+        Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
         Legend::Hidden => return Ok(()),
     };
     if layers.all().any(|s| s.label.is_some()) {
@@ -408,6 +443,44 @@ where
             .map_err(err)?;
     }
     Ok(())
+}
+
+/// Width of the white band under a line with a halo, pixels.
+const HALO_PX: u32 = 7;
+
+/// Draws the polyline `run` (pixels of `plot`) `width` pixels wide.
+fn stroke<DB: DrawingBackend>(
+    plot: &DrawingArea<DB, Shift>,
+    run: &[(i32, i32)],
+    colour: RGBColor,
+    width: u32,
+    format: Format,
+) -> Result<()> {
+    match format {
+        Format::Svg => plot
+            .draw(&PathElement::new(run.to_vec(), colour.stroke_width(width)))
+            .map_err(err),
+        // plotters' bitmap lines wider than 1 px come out hollow on steep segments: draw
+        // the 1-px line several times, offset by a pixel (right and down for 2 px, over a
+        // diamond for wider lines).
+        Format::Png => {
+            let reach = (width / 2) as i32;
+            let offsets: Vec<(i32, i32)> = if width <= 2 {
+                vec![(0, 0), (1, 0), (0, 1)]
+            } else {
+                (-reach..=reach)
+                    .flat_map(|ox| (-reach..=reach).map(move |oy| (ox, oy)))
+                    .filter(|(ox, oy)| ox.abs() + oy.abs() <= reach)
+                    .collect()
+            };
+            for (ox, oy) in offsets {
+                let shifted: Vec<(i32, i32)> = run.iter().map(|&(x, y)| (x + ox, y + oy)).collect();
+                plot.draw(&PathElement::new(shifted, colour.stroke_width(1)))
+                    .map_err(err)?;
+            }
+            Ok(())
+        }
+    }
 }
 
 /// The outline of `marker` centred on the pixel `at`, as a polygon (a disc as 16 sides, a

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 
+use super::bifmaps::bifurcation_maps;
 use super::chatter::figs_20_25;
 use super::configurations::figs_5_6;
 use super::context::{Budget, Ctx};
@@ -83,6 +84,10 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         ("Figs. 18–19: Ω = 0.30", figs_18_19),
         ("Figs. 20–25: chatter", figs_20_25),
         ("periodic orbits behind Figs. 7, 9, 14–15, 18–19", periodic_orbits),
+        (
+            "bifurcation maps of the default case in (Ω, R_m) and (Ω, R_δ)",
+            bifurcation_maps,
+        ),
         (
             "what the non-periodic motions are: exponents, error bars, basins, expected power",
             dynamics,

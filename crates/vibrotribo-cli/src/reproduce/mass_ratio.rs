@@ -8,6 +8,7 @@ use vibrotribo::study::PointResult;
 
 use super::context::{Ctx, Verdict};
 use super::draw::{both, closing_speeds, impact_figure, lines, orbit_figure, return_map, running_power};
+use super::overlay::{Diagram, branches_over};
 use super::runs::{arr, config, describe_motions, f, motion_of, run_series, sweep, with};
 use crate::job::RunArgs;
 use crate::map::{optima, paper_fit, plot_optimal_mass_ratio, refine_maximum};
@@ -134,14 +135,33 @@ pub(super) fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     let mut fig = Figure::new("Average power against R_m (Ω = 0.72)", "R_m", "P_a [W]");
     fig.legend = Legend::Hidden;
     let c = lines(ctx, "fig14c_power", &fig, &[("P_a", &values, &power)])?;
+    let (d, text, agree) = branches_over(
+        ctx,
+        &Diagram {
+            name: "fig14d_branches",
+            title: "Continued branches over the orbit diagram of X2 against R_m (Ω = 0.72)".into(),
+            x_label: "R_m = m2/m1",
+            base: &base,
+            key: "mass_ratio",
+            values: &values,
+            results: &res,
+        },
+    )?;
     ctx.figure(
         "14",
         "Bifurcation diagrams against the mass ratio at Ω = 0.72",
         format!(
-            "m1 = m3 = 50 g, m2 = R_m·m1, δ1 = δ2 = 20 mm, Ω = 0.72; {} values from rest.",
+            "m1 = m3 = 50 g, m2 = R_m·m1, δ1 = δ2 = 20 mm, Ω = 0.72; {} values from rest. The last picture draws the continued periodic orbits over the orbit diagram: {text}",
             values.len()
         ),
-        vec![a, b, c],
+        vec![a, b, c, d],
+    );
+    branch_finding(
+        ctx,
+        "14 (branches)",
+        "The orbit diagram of X2 against R_m at Ω = 0.72 (runs from rest).",
+        &text,
+        agree,
     );
     let (best_r, best_p) = refine_maximum(&values, &power).unwrap_or((f64::NAN, f64::NAN));
     let vmax: Vec<f64> = res
@@ -276,6 +296,17 @@ pub(super) fn figs_14_16(ctx: &mut Ctx) -> Result<()> {
     Ok(())
 }
 
+/// A finding on how the continued branches account for a brute-force diagram: agrees when
+/// every value does.
+fn branch_finding(ctx: &mut Ctx, figures: &str, paper: &str, text: &str, (agree, total): (usize, usize)) {
+    ctx.finding(
+        figures,
+        paper,
+        format!("Continued orbits: {text}"),
+        Verdict::of(agree, total),
+    );
+}
+
 /// Runs of period p, 2p, 4p (consecutive runs of equal detected period) along a sweep, in
 /// either direction of the parameter, described as "p → 2p → 4p at R_m = a–b".
 pub(super) fn doubling_runs(values: &[f64], results: &[PointResult]) -> Vec<String> {
@@ -303,6 +334,7 @@ pub(super) fn fig_17(ctx: &mut Ctx) -> Result<()> {
     let mut images = Vec::new();
     let mut texts = Vec::new();
     let mut saturate = 0;
+    let mut branch_texts = Vec::new();
     for w in [1.30, 2.00] {
         let base = config(&[
             ("oscillator.masses", arr(&[0.05, 0.15, 0.05])),
@@ -320,6 +352,27 @@ pub(super) fn fig_17(ctx: &mut Ctx) -> Result<()> {
             &res,
             1.0 / 0.020,
         )?);
+        let (img, text, agree) = branches_over(
+            ctx,
+            &Diagram {
+                name: &format!("fig17c_branches_{w}"),
+                title: format!("Continued branches over the orbit diagram of X2 against R_m, Ω = {w}"),
+                x_label: "R_m",
+                base: &base,
+                key: "mass_ratio",
+                values: &values,
+                results: &res,
+            },
+        )?;
+        images.push(img);
+        branch_texts.push(format!("Ω = {w}: {text}"));
+        branch_finding(
+            ctx,
+            "17 (branches)",
+            &format!("The orbit diagram of X2 against R_m at Ω = {w} (runs from rest)."),
+            &text,
+            agree,
+        );
         images.push(impact_figure(
             ctx,
             &format!("fig17b_v12_{w}"),
@@ -358,7 +411,10 @@ pub(super) fn fig_17(ctx: &mut Ctx) -> Result<()> {
     ctx.figure(
         "17",
         "Orbit and impact-velocity diagrams at high frequencies",
-        "m1 = m3 = 50 g, δ = 20 mm, Ω = 1.30 and 2.00, R_m from 1.5 to 8.".into(),
+        format!(
+            "m1 = m3 = 50 g, δ = 20 mm, Ω = 1.30 and 2.00, R_m from 1.5 to 8; with each orbit diagram the continued periodic orbits over it. {}",
+            branch_texts.join(" ")
+        ),
         images,
     );
     ctx.finding(
@@ -399,15 +455,44 @@ pub(super) fn figs_18_19(ctx: &mut Ctx) -> Result<()> {
         &fres,
         1.0 / 0.020,
     )?;
+    let mut texts = Vec::new();
+    let mut images = vec![a, b];
+    for (name, range, v, r) in [
+        ("fig18c_branches", "[1.5, 6]", &values, &res),
+        ("fig18d_branches_zoom", "[3.9, 4.5]", &fine, &fres),
+    ] {
+        let (img, text, agree) = branches_over(
+            ctx,
+            &Diagram {
+                name,
+                title: format!("Continued branches over the orbit diagram of X2, R_m on {range}, Ω = 0.30"),
+                x_label: "R_m",
+                base: &base,
+                key: "mass_ratio",
+                values: v,
+                results: r,
+            },
+        )?;
+        images.push(img);
+        branch_finding(
+            ctx,
+            "18 (branches)",
+            &format!("The orbit diagram of X2 against R_m on {range} at Ω = 0.30 (runs from rest)."),
+            &text,
+            agree,
+        );
+        texts.push(format!("On {range}: {text}"));
+    }
     ctx.figure(
         "18",
         "Orbit diagram against R_m at Ω = 0.30",
         format!(
-            "m1 = m3 = 50 g, δ = 20 mm, Ω = 0.30; {} values on [1.5, 6], {} on [3.9, 4.5].",
+            "m1 = m3 = 50 g, δ = 20 mm, Ω = 0.30; {} values on [1.5, 6], {} on [3.9, 4.5]; the last two pictures draw the continued periodic orbits over them. {}",
             values.len(),
-            fine.len()
+            fine.len(),
+            texts.join(" ")
         ),
-        vec![a, b],
+        images,
     );
     let periods: Vec<usize> = res
         .iter()

@@ -4,9 +4,10 @@
 //! the numbers of this run.
 //!
 //! One file per group of figures (`configurations`, `spacing`, `mass_ratio`, `chatter`,
-//! `orbits`, `dynamics`, `extras`, `vibration`, `coupling`, `design`), on shared runs (`runs`), figure helpers (`draw`) and context (`context`);
+//! `orbits`, `dynamics`, `extras`, `vibration`, `coupling`, `design`, `bifmaps`), on shared runs (`runs`), figure helpers (`draw`), the branches drawn over orbit diagrams (`overlay`) and context (`context`);
 //! `report` writes REPORT.md.
 
+mod bifmaps;
 mod chatter;
 mod command;
 mod configurations;
@@ -18,6 +19,7 @@ mod dynamics;
 mod extras;
 mod mass_ratio;
 mod orbits;
+mod overlay;
 mod report;
 mod runs;
 mod spacing;

@@ -7,6 +7,7 @@ use vibrotribo::study::PointResult;
 
 use super::context::{Ctx, Verdict};
 use super::draw::{closing_speeds, d1_figures, impact_figure, lines, orbit_figure, return_map, scatter};
+use super::overlay::{Diagram, branches_over};
 use super::runs::{arr, config, f, mean, motion_of, run_series, sweep, with};
 use crate::job::RunArgs;
 use crate::output::si;
@@ -63,15 +64,50 @@ pub(super) fn figs_7_11(ctx: &mut Ctx) -> Result<()> {
         &results,
         1,
     )?;
+    let (e, text_e, agree_e) = branches_over(
+        ctx,
+        &Diagram {
+            name: "fig07a_branches",
+            title: "Continued branches over the orbit diagram of X2 against R_δ".into(),
+            x_label: "R_δ = δ2/δ1",
+            base: &base,
+            key: "gap_ratio",
+            values: &values,
+            results: &results,
+        },
+    )?;
+    let (g, text_g, agree_g) = branches_over(
+        ctx,
+        &Diagram {
+            name: "fig07b_branches",
+            title: "Continued branches over the orbit diagram of X2, R_δ = 1.40–1.52".into(),
+            x_label: "R_δ",
+            base: &base,
+            key: "gap_ratio",
+            values: &fine,
+            results: &fres,
+        },
+    )?;
     ctx.figure(
         "7",
         "Bifurcation diagrams against the spacing ratio R_δ",
         format!(
-            "m1 = m3 = 90 g, m2 = 120 g, δ1 = 20 mm, Ω = 0.70, other parameters as Sect. 4.1. Each value from rest; {} transient and {} recorded periods; {} values on [1.0, 1.6] and {} on [1.40, 1.52].",
+            "m1 = m3 = 90 g, m2 = 120 g, δ1 = 20 mm, Ω = 0.70, other parameters as Sect. 4.1. Each value from rest; {} transient and {} recorded periods; {} values on [1.0, 1.6] and {} on [1.40, 1.52]. The last two pictures draw the periodic orbits continued through grazing and onto doubled branches (stable solid, unstable dashed, bifurcations marked) over the same points. On [1.0, 1.6]: {text_e} On [1.40, 1.52]: {text_g}",
             ctx.budget.transient, ctx.budget.recorded, values.len(), fine.len()
         ),
-        vec![a, b, c, d],
+        vec![a, b, c, d, e, g],
     );
+    for (range, text, (agree, total)) in [
+        ("[1.0, 1.6]", &text_e, agree_e),
+        ("[1.40, 1.52]", &text_g, agree_g),
+    ] {
+        ctx.finding(
+            "7 (branches)",
+            &format!("The orbit diagram of X2 against R_δ on {range} (runs from rest)."),
+            format!("Continued orbits: {text}"),
+            Verdict::of(agree, total),
+        );
+    }
 
     // The jump from two to one impacts per cycle (Fig. 8): locate it on a fine grid.
     let jump_grid = grid(1.05, 1.12, if ctx.quick { 36 } else { 141 });

@@ -2,7 +2,8 @@
 //! verdict written as a constant.
 
 /// The source of every file of `reproduce`, by name.
-const SOURCES: [(&str, &str); 16] = [
+const SOURCES: [(&str, &str); 18] = [
+    ("bifmaps.rs", include_str!("bifmaps.rs")),
     ("chatter.rs", include_str!("chatter.rs")),
     ("command.rs", include_str!("command.rs")),
     ("configurations.rs", include_str!("configurations.rs")),
@@ -15,6 +16,7 @@ const SOURCES: [(&str, &str); 16] = [
     ("mass_ratio.rs", include_str!("mass_ratio.rs")),
     ("mod.rs", include_str!("mod.rs")),
     ("orbits.rs", include_str!("orbits.rs")),
+    ("overlay.rs", include_str!("overlay.rs")),
     ("report.rs", include_str!("report.rs")),
     ("runs.rs", include_str!("runs.rs")),
     ("spacing.rs", include_str!("spacing.rs")),

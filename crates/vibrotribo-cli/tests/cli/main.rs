@@ -2,6 +2,7 @@
 //! One test target; each fixed bug has its own module (`issue_*.rs`) opening with what broke.
 
 mod basins;
+mod bifmap;
 mod chirp;
 mod closed_pipe_and_full_disk;
 mod composition;

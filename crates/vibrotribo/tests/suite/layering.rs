@@ -12,7 +12,7 @@
 //! 3. runs and studies: `config` (the edge that reads a configuration into a run), `study`,
 //!    `sweep` (a study runs the engine with the observers of layer 2 and earns its labels from
 //!    them), `merit` (the figures of merit, a run observer);
-//! 4. studies of studies: `attractors`, `branch`, `curve`, `optimize`, `response`;
+//! 4. studies of studies: `attractors`, `branch`, `curve`, `bifmap`, `optimize`, `response`;
 //! 5. output: `report`.
 //!
 //! Only code counts: paths in comments and doc links do not.
@@ -35,7 +35,7 @@ const LAYERS: &[&[&str]] = &[
     ],
     &["analysis", "orbits", "lyapunov"],
     &["config", "study", "sweep", "merit"],
-    &["attractors", "branch", "curve", "optimize", "response"],
+    &["attractors", "branch", "curve", "bifmap", "optimize", "response"],
     &["report"],
 ];
 

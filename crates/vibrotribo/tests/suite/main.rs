@@ -6,6 +6,7 @@ mod common;
 
 mod attractors;
 mod bandwidth;
+mod bifmap;
 mod charge_layers;
 mod chirp;
 mod config;
