@@ -13,6 +13,7 @@ mod chirp;
 mod config;
 mod continuation;
 mod curve;
+mod decimal;
 mod export_spice;
 mod job;
 mod limits;
