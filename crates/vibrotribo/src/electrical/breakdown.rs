@@ -352,24 +352,27 @@ impl BreakdownWatch {
         let p = &self.paschen.params;
         // |c|·denominator above this may beat the worst.
         let threshold = worst * (self.field.eps_s * p.b * p.pressure) * (1.0 - 4e-9);
+        // The largest |c|·denominator over the points, and whether a charge was NaN (then the
+        // points are observed, as any NaN answers true), without a branch per point: a closed
+        // gap (breakdown cannot start there) or an absent second gap contributes 0.
         let mut top = 0.0f64;
+        let mut nan = false;
+        let counted = [true, second];
         for (&q, row) in charges.iter().zip(gaps.chunks_exact(n)) {
             let d = [row[k0], row[k1]];
             let c = self.field.charges(q, d[0], d[1]);
             for k in 0..2 {
-                // A closed gap: breakdown cannot start.
-                if d[k] > 0.0 && (k == 0 || second) {
-                    let (den, slope) = tangent[k];
-                    let den = den + (d[k] * slope - 1.0);
-                    // NaN is caught below.
-                    top = top.max(c[k].abs() * den.max(0.0));
-                    if c[k].is_nan() {
-                        return true;
-                    }
+                let (den, slope) = tangent[k];
+                let den = den + (d[k] * slope - 1.0);
+                let open = d[k] > 0.0 && counted[k];
+                nan |= open && c[k].is_nan();
+                let v = c[k].abs() * if den > 0.0 { den } else { 0.0 };
+                if open && v > top {
+                    top = v;
                 }
             }
         }
-        top.is_nan() || top > threshold
+        nan || top > threshold
     }
 
     /// Maximises the ratio over `[a, b]`, s, by golden-section search, with `eval(t)` giving
