@@ -262,6 +262,46 @@ pub(crate) struct BreakdownWatch {
     pub margin: BreakdownMargin,
 }
 
+/// The points of [`BreakdownWatch::may_beat`]: their charges, C, and rows of `n` gaps, m, the
+/// transducer's gaps in a row, which of them count, and the denominator's tangent `(value at
+/// the widest gap, slope)` for each.
+struct Points<'a> {
+    charges: &'a [f64],
+    gaps: &'a [f64],
+    n: usize,
+    contacts: [usize; 2],
+    counted: [bool; 2],
+    tangent: [(f64, f64); 2],
+}
+
+impl Points<'_> {
+    /// The largest |c|·denominator over the points (`charges` as [`GapField::charges`]), and
+    /// whether a charge was NaN (then the points are observed, as any NaN answers true),
+    /// without a branch per point: a closed gap (breakdown cannot start there) or an absent
+    /// second gap contributes 0.
+    #[inline(always)]
+    fn top(&self, charges: impl Fn(f64, f64, f64) -> [f64; 2]) -> (f64, bool) {
+        let [k0, k1] = self.contacts;
+        let mut top = 0.0f64;
+        let mut nan = false;
+        for (&q, row) in self.charges.iter().zip(self.gaps.chunks_exact(self.n)) {
+            let d = [row[k0], row[k1]];
+            let c = charges(q, d[0], d[1]);
+            for k in 0..2 {
+                let (den, slope) = self.tangent[k];
+                let den = den + (d[k] * slope - 1.0);
+                let open = d[k] > 0.0 && self.counted[k];
+                nan |= open && c[k].is_nan();
+                let v = c[k].abs() * if den > 0.0 { den } else { 0.0 };
+                if open && v > top {
+                    top = v;
+                }
+            }
+        }
+        (top, nan)
+    }
+}
+
 /// Golden-section iterations of a refinement: the interval shrinks to 0.618³⁰ ≈ 5e-7 of
 /// itself, the ratio at a smooth maximum to ~1e-13 relative.
 const REFINE_ITERATIONS: usize = 30;
@@ -355,23 +395,25 @@ impl BreakdownWatch {
         // The largest |c|·denominator over the points, and whether a charge was NaN (then the
         // points are observed, as any NaN answers true), without a branch per point: a closed
         // gap (breakdown cannot start there) or an absent second gap contributes 0.
-        let mut top = 0.0f64;
-        let mut nan = false;
-        let counted = [true, second];
-        for (&q, row) in charges.iter().zip(gaps.chunks_exact(n)) {
-            let d = [row[k0], row[k1]];
-            let c = self.field.charges(q, d[0], d[1]);
-            for k in 0..2 {
-                let (den, slope) = tangent[k];
-                let den = den + (d[k] * slope - 1.0);
-                let open = d[k] > 0.0 && counted[k];
-                nan |= open && c[k].is_nan();
-                let v = c[k].abs() * if den > 0.0 { den } else { 0.0 };
-                if open && v > top {
-                    top = v;
-                }
-            }
-        }
+        let points = Points {
+            charges,
+            gaps,
+            n,
+            contacts: [k0, k1],
+            counted: [true, second],
+            tangent,
+        };
+        // The charge law chosen once, not at every point (`GapField::charges`' arms).
+        let field = self.field;
+        let sigma_s = field.sigma_s;
+        let (top, nan) = match (field.mode, field.voc_model) {
+            (TransducerMode::Freestanding, VocModel::Exact) => points.top(|q, _, _| [q + sigma_s, sigma_s - q]),
+            (TransducerMode::Freestanding, VocModel::Paper) => points.top(|q, d1, d2| {
+                let q = q - sigma_s * (d1 + d2) / (field.d0 + d1 + d2);
+                [q + sigma_s, sigma_s - q]
+            }),
+            (TransducerMode::ContactSeparation, _) => points.top(|q, _, _| [sigma_s - q, 0.0]),
+        };
         nan || top > threshold
     }
 
