@@ -499,8 +499,9 @@ impl ChargeSolver {
         let mut nodes = [TransducerState::default(); S];
         // Every node first, then one test (the error names the first invalid one).
         let mut valid = true;
-        for (node, g) in nodes.iter_mut().zip(gaps.chunks_exact(n.max(1))) {
-            *node = self.charge_map.state(g);
+        // (Rows by multiplication: `chunks_exact` would divide by the row length.)
+        for (i, node) in nodes.iter_mut().enumerate() {
+            *node = self.charge_map.state(&gaps[i * n..(i + 1) * n]);
             valid &= node.elastance > 0.0 && node.elastance.is_finite() && node.equilibrium_charge.is_finite();
         }
         if !valid {
