@@ -125,7 +125,11 @@ mod tests {
     fn check(x: f64) {
         let mut got = Vec::new();
         push_f64(&mut got, x);
-        let want = if x.is_finite() { format!("{x}") } else { String::new() };
+        let want = if x.is_finite() {
+            format!("{x}")
+        } else {
+            String::new()
+        };
         assert_eq!(
             String::from_utf8_lossy(&got),
             want,

@@ -288,7 +288,10 @@ impl Points {
         let mut nan = false;
         for (&q, row) in qs.iter().zip(rows) {
             // The rows were checked to hold both gaps.
-            let d = [row.get(k0).copied().unwrap_or(0.0), row.get(k1).copied().unwrap_or(0.0)];
+            let d = [
+                row.get(k0).copied().unwrap_or(0.0),
+                row.get(k1).copied().unwrap_or(0.0),
+            ];
             let c = charges(q, d[0], d[1]);
             for k in 0..2 {
                 let (den, slope) = self.tangent[k];

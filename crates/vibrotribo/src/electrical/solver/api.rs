@@ -502,7 +502,8 @@ impl ChargeSolver {
         // (Rows by multiplication: `chunks_exact` would divide by the row length.)
         for (i, node) in nodes.iter_mut().enumerate() {
             *node = self.charge_map.state(&gaps[i * n..(i + 1) * n]);
-            valid &= node.elastance > 0.0 && node.elastance.is_finite() && node.equilibrium_charge.is_finite();
+            valid &=
+                node.elastance > 0.0 && node.elastance.is_finite() && node.equilibrium_charge.is_finite();
         }
         if !valid {
             for (i, &t) in times.iter().enumerate() {
