@@ -16,6 +16,7 @@ mod chirp;
 mod config;
 mod continuation;
 mod curve;
+mod decimal;
 mod export_spice;
 mod job;
 mod limits;

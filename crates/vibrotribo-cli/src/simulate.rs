@@ -148,28 +148,21 @@ impl RunObserver for Files {
         }
         self.row.push(s.base);
         self.row.extend_from_slice(s.gaps);
-        let r = self.trajectory.row(self.row.iter());
+        let r = self.trajectory.row_with(|f| f.numbers(&self.row));
         self.keep(r);
     }
 
     fn event(&mut self, e: &Event, state: &StateView<'_>) {
-        use std::fmt::Display;
-        let (kind, contact) = (e.kind.as_str(), e.contact + 1);
-        // Written straight into the row (no string per field).
-        let head: [&dyn Display; 6] = [
-            &e.time,
-            &kind,
-            &contact,
-            &e.velocity_before,
-            &e.velocity_after,
-            &e.sequence_impacts,
-        ];
-        let values = state
-            .positions
-            .iter()
-            .chain(state.velocities)
-            .map(|x| x as &dyn Display);
-        let r = self.events.row(head.into_iter().chain(values));
+        let r = self.events.row_with(|f| {
+            f.number(e.time);
+            f.text(e.kind.as_str());
+            f.integer(e.contact as u64 + 1);
+            f.number(e.velocity_before);
+            f.number(e.velocity_after);
+            f.integer(u64::from(e.sequence_impacts));
+            f.numbers(state.positions);
+            f.numbers(state.velocities);
+        });
         self.keep(r);
     }
 }

@@ -500,10 +500,22 @@ impl Oscillator {
         let two_ar = 2.0 * self.alpha * r;
         let wn2r2 = self.wn2 * r * r;
         let min_terms = TAIL_K * self.rate_bound() * r;
+        // The first term after which the tail is bounded: j ≥ min_terms (j as f64 ≥ min_terms,
+        // never for NaN) and j > drive_len.
+        let bounded_from = if min_terms <= 0.0 {
+            0
+        } else if min_terms < RECIPROCALS as f64 {
+            min_terms.ceil() as usize
+        } else {
+            usize::MAX
+        }
+        .max(drive_len + 1);
+        let coef = &mut coef[..max_terms];
         let mut tail = f64::INFINITY;
         let mut n = 2;
         let mut inv_prev = 1.0;
-        for (j, slot) in coef.iter_mut().enumerate().take(max_terms).skip(2) {
+        let forced_scale = FORCED_TAIL * amp;
+        for j in 2..coef.len() {
             let inv_j = INV[j];
             let mut g_next = -(two_ar * g + wn2r2 * g_prev * inv_prev) * inv_j;
             if j < drive_len + 2 {
@@ -512,14 +524,14 @@ impl Oscillator {
             let step = wr * inv_j;
             (p, q) = (q * step, -p * step);
             w *= step;
-            *slot = p + g_next;
+            coef[j] = p + g_next;
             g_prev = g;
             g = g_next;
             inv_prev = inv_j;
             n = j + 1;
             // Terms 0..=j are written: bound the tail Σ_{i > j} (see the docs).
-            if j as f64 >= min_terms && j > drive_len {
-                let forced_tail = FORCED_TAIL * amp * w * wr * INV[j + 1];
+            if j >= bounded_from {
+                let forced_tail = forced_scale * w * wr * INV[j + 1];
                 tail = forced_tail + HOMOGENEOUS_TAIL * g.abs().max(g_prev.abs());
                 if tail <= tol {
                     break;

@@ -284,6 +284,35 @@ impl GapPolynomial {
 
     /// Gaps, m, and their rates, m/s, at `t`, s (within the piece).
     pub(crate) fn values_and_rates(&self, t: f64, gaps: &mut [f64], rates: &mut [f64]) {
+        match self.n_gaps {
+            1 => self.values_and_rates_n::<1>(t, gaps, rates),
+            2 => self.values_and_rates_n::<2>(t, gaps, rates),
+            3 => self.values_and_rates_n::<3>(t, gaps, rates),
+            _ => self.values_and_rates_any(t, gaps, rates),
+        }
+    }
+
+    /// [`values_and_rates`](Self::values_and_rates) for `N` gaps, with the sums in registers.
+    #[inline]
+    fn values_and_rates_n<const N: usize>(&self, t: f64, gaps: &mut [f64], rates: &mut [f64]) {
+        let s = self.sub_at(t);
+        let x = (t - s.tc) * s.inv_r;
+        let c = &self.coefs[s.base..s.base + s.terms * N];
+        let (mut g, mut d) = ([0.0; N], [0.0; N]);
+        // Horner's rule for the polynomial and its derivative together.
+        for row in c.as_chunks::<N>().0.iter().rev() {
+            for k in 0..N {
+                d[k] = d[k] * x + g[k];
+                g[k] = g[k] * x + row[k];
+            }
+        }
+        for k in 0..N {
+            gaps[k] = g[k];
+            rates[k] = d[k] * s.inv_r;
+        }
+    }
+
+    fn values_and_rates_any(&self, t: f64, gaps: &mut [f64], rates: &mut [f64]) {
         let s = self.sub_at(t);
         let x = (t - s.tc) * s.inv_r;
         let n = self.n_gaps;

@@ -262,6 +262,52 @@ pub(crate) struct BreakdownWatch {
     pub margin: BreakdownMargin,
 }
 
+/// How [`BreakdownWatch::may_beat`] reads its points: the transducer's gaps in a row of the
+/// chain's gaps, which of them count, and the denominator's tangent `(value at the widest gap,
+/// slope)` for each.
+struct Points {
+    contacts: [usize; 2],
+    counted: [bool; 2],
+    tangent: [(f64, f64); 2],
+}
+
+impl Points {
+    /// The largest |c|·denominator over the points with charges `qs`, C, and rows of gaps
+    /// `rows`, m (`charges` as [`GapField::charges`]), and whether a charge was NaN (then the
+    /// points are observed, as any NaN answers true), without a branch per point: a closed
+    /// gap (breakdown cannot start there) or an absent second gap contributes 0.
+    #[inline(always)]
+    fn top<'a>(
+        &self,
+        qs: &[f64],
+        rows: impl Iterator<Item = &'a [f64]>,
+        charges: impl Fn(f64, f64, f64) -> [f64; 2],
+    ) -> (f64, bool) {
+        let [k0, k1] = self.contacts;
+        let mut top = 0.0f64;
+        let mut nan = false;
+        for (&q, row) in qs.iter().zip(rows) {
+            // The rows were checked to hold both gaps.
+            let d = [
+                row.get(k0).copied().unwrap_or(0.0),
+                row.get(k1).copied().unwrap_or(0.0),
+            ];
+            let c = charges(q, d[0], d[1]);
+            for k in 0..2 {
+                let (den, slope) = self.tangent[k];
+                let den = den + (d[k] * slope - 1.0);
+                let open = d[k] > 0.0 && self.counted[k];
+                nan |= open && c[k].is_nan();
+                let v = c[k].abs() * if den > 0.0 { den } else { 0.0 };
+                if open && v > top {
+                    top = v;
+                }
+            }
+        }
+        (top, nan)
+    }
+}
+
 /// Golden-section iterations of a refinement: the interval shrinks to 0.618³⁰ ≈ 5e-7 of
 /// itself, the ratio at a smooth maximum to ~1e-13 relative.
 const REFINE_ITERATIONS: usize = 30;
@@ -314,10 +360,26 @@ impl BreakdownWatch {
     pub fn may_beat(&self, charges: &[f64], gaps: &[f64]) -> bool {
         let worst = self.margin.worst_ratio;
         let points = charges.len();
-        if worst.is_nan() || worst <= 0.0 || points == 0 || !gaps.len().is_multiple_of(points) {
+        if worst.is_nan() || worst <= 0.0 || points == 0 {
             return true;
         }
         let n = gaps.len() / points;
+        if n * points != gaps.len() {
+            return true;
+        }
+        // Rows of a length known at compile time for the usual chains (no division per row).
+        match n {
+            1 => self.screen(charges, gaps.as_chunks::<1>().0.iter().map(|r| &r[..])),
+            2 => self.screen(charges, gaps.as_chunks::<2>().0.iter().map(|r| &r[..])),
+            3 => self.screen(charges, gaps.as_chunks::<3>().0.iter().map(|r| &r[..])),
+            _ => self.screen(charges, gaps.chunks_exact(n)),
+        }
+    }
+
+    /// [`may_beat`](Self::may_beat) over `rows`, one row of gaps per charge.
+    #[inline(always)]
+    fn screen<'a>(&self, charges: &[f64], rows: impl Iterator<Item = &'a [f64]> + Clone) -> bool {
+        let worst = self.margin.worst_ratio;
         // Offsets of the transducer's gaps in a point's row; a missing second gap reads the
         // first and is ignored.
         let second = self.contacts[1].is_some();
@@ -325,17 +387,16 @@ impl BreakdownWatch {
             return true;
         };
         let k1 = k1.unwrap_or(k0);
-        if k0.max(k1) >= n {
-            return true;
-        }
         // The widest gaps.
         let mut widest = [0.0f64; 2];
-        for row in gaps.chunks_exact(n) {
-            let d = [row[k0], row[k1]];
-            if d[0].is_nan() || d[1].is_nan() {
+        for row in rows.clone() {
+            let (Some(&d0), Some(&d1)) = (row.get(k0), row.get(k1)) else {
+                return true;
+            };
+            if d0.is_nan() || d1.is_nan() {
                 return true;
             }
-            widest = [widest[0].max(d[0]), widest[1].max(d[1])];
+            widest = [widest[0].max(d0), widest[1].max(d1)];
         }
         // The bound of the denominator there, unclamped (the tangent continues it), and the
         // tangent's slope in d.
@@ -352,24 +413,25 @@ impl BreakdownWatch {
         let p = &self.paschen.params;
         // |c|·denominator above this may beat the worst.
         let threshold = worst * (self.field.eps_s * p.b * p.pressure) * (1.0 - 4e-9);
-        let mut top = 0.0f64;
-        for (&q, row) in charges.iter().zip(gaps.chunks_exact(n)) {
-            let d = [row[k0], row[k1]];
-            let c = self.field.charges(q, d[0], d[1]);
-            for k in 0..2 {
-                // A closed gap: breakdown cannot start.
-                if d[k] > 0.0 && (k == 0 || second) {
-                    let (den, slope) = tangent[k];
-                    let den = den + (d[k] * slope - 1.0);
-                    // NaN is caught below.
-                    top = top.max(c[k].abs() * den.max(0.0));
-                    if c[k].is_nan() {
-                        return true;
-                    }
-                }
+        let points = Points {
+            contacts: [k0, k1],
+            counted: [true, second],
+            tangent,
+        };
+        // The charge law chosen once, not at every point (`GapField::charges`' arms).
+        let field = self.field;
+        let sigma_s = field.sigma_s;
+        let (top, nan) = match (field.mode, field.voc_model) {
+            (TransducerMode::Freestanding, VocModel::Exact) => {
+                points.top(charges, rows, |q, _, _| [q + sigma_s, sigma_s - q])
             }
-        }
-        top.is_nan() || top > threshold
+            (TransducerMode::Freestanding, VocModel::Paper) => points.top(charges, rows, |q, d1, d2| {
+                let q = q - sigma_s * (d1 + d2) / (field.d0 + d1 + d2);
+                [q + sigma_s, sigma_s - q]
+            }),
+            (TransducerMode::ContactSeparation, _) => points.top(charges, rows, |q, _, _| [sigma_s - q, 0.0]),
+        };
+        nan || top > threshold
     }
 
     /// Maximises the ratio over `[a, b]`, s, by golden-section search, with `eval(t)` giving

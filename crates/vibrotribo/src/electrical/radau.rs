@@ -220,32 +220,49 @@ const DD7: [f64; 7] = [
 /// test). Returns false on a zero or non-finite pivot.
 #[inline]
 pub(crate) fn solve_unpivoted<const N: usize>(m: &mut [[f64; N]; N], b: &mut [f64; N]) -> bool {
+    solve_unpivoted_many(m, std::array::from_mut(b))
+}
+
+/// [`solve_unpivoted`] for `K` right-hand sides at once: one elimination of `m`, each
+/// solution bit for bit the one a solve of its own gives (the same operations in the same
+/// order: the elimination's multipliers are kept below the diagonal and applied to each
+/// right-hand side afterwards).
+#[inline]
+pub(crate) fn solve_unpivoted_many<const N: usize, const K: usize>(
+    m: &mut [[f64; N]; N],
+    b: &mut [[f64; N]; K],
+) -> bool {
     // Reciprocals of the pivots, reused by the back substitution (no division on its chain).
     let mut inv_diag = [0.0; N];
     for col in 0..N {
-        let (done, rest) = m.split_at_mut(col + 1);
-        let pivot = &done[col];
-        let inv = 1.0 / pivot[col];
+        let inv = 1.0 / m[col][col];
         if !(inv != 0.0 && inv.is_finite()) {
             return false;
         }
         inv_diag[col] = inv;
-        let bc = b[col];
-        for (row, br) in rest.iter_mut().zip(b[col + 1..].iter_mut()) {
-            let f = row[col] * inv;
-            // Sweep the whole row: entries left of the diagonal are never read again.
-            for (x, p) in row.iter_mut().zip(pivot) {
-                *x -= f * p;
+        let pivot = m[col];
+        for r in col + 1..N {
+            let f = m[r][col] * inv;
+            m[r][col] = f;
+            for j in col + 1..N {
+                m[r][j] -= f * pivot[j];
             }
-            *br -= f * bc;
         }
     }
-    for col in (0..N).rev() {
-        let mut s = b[col];
-        for k in col + 1..N {
-            s -= m[col][k] * b[k];
+    for bk in b.iter_mut() {
+        for col in 0..N {
+            let bc = bk[col];
+            for r in col + 1..N {
+                bk[r] -= m[r][col] * bc;
+            }
         }
-        b[col] = s * inv_diag[col];
+        for col in (0..N).rev() {
+            let mut s = bk[col];
+            for k in col + 1..N {
+                s -= m[col][k] * bk[k];
+            }
+            bk[col] = s * inv_diag[col];
+        }
     }
     true
 }

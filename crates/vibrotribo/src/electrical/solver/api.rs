@@ -493,11 +493,22 @@ impl ChargeSolver {
         wave: &W,
     ) -> Result<[TransducerState; S], ElectricalError> {
         let n = self.gaps.len();
-        wave.gap_values_at(times, &mut self.node_gaps[..S * n]);
+        let gaps = &mut self.node_gaps[..S * n];
+        wave.gap_values_at(times, gaps);
         self.stats.waveform_evaluations += S as u64;
         let mut nodes = [TransducerState::default(); S];
+        // Every node first, then one test (the error names the first invalid one).
+        let mut valid = true;
+        // (Rows by multiplication: `chunks_exact` would divide by the row length.)
         for (i, node) in nodes.iter_mut().enumerate() {
-            *node = self.state_at_gaps(&self.node_gaps[i * n..(i + 1) * n], times[i])?;
+            *node = self.charge_map.state(&gaps[i * n..(i + 1) * n]);
+            valid &=
+                node.elastance > 0.0 && node.elastance.is_finite() && node.equilibrium_charge.is_finite();
+        }
+        if !valid {
+            for (i, &t) in times.iter().enumerate() {
+                self.state_at_gaps(&self.node_gaps[i * n..(i + 1) * n], t)?;
+            }
         }
         Ok(nodes)
     }

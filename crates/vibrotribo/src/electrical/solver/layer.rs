@@ -47,7 +47,7 @@
 use super::layer_term::{LayerTerm, MONO_TERMS, Mono};
 use super::state::{ChargeSolver, NOISE, RESISTOR_STAGES, Step, Trial};
 use crate::electrical::ElectricalError;
-use crate::electrical::radau::{Tableau, solve_unpivoted};
+use crate::electrical::radau::{Tableau, solve_unpivoted, solve_unpivoted_many};
 use crate::electrical::transducer::TransducerState;
 use crate::electrical::waveform::GapWaveform;
 
@@ -117,12 +117,12 @@ impl ChargeSolver {
         let hk: [f64; S] = std::array::from_fn(|j| h * conductance * nodes[j].elastance);
         let dq: [f64; S] = std::array::from_fn(|j| nodes[j].equilibrium_charge - n0.equilibrium_charge);
         // (I + hA·diag(k)) z = −ΔQ_eq − (hA k) w₀: z = z_a + w₀ z_b.
-        let (mut m, mut zb) = tab.stage_system(&hk, |_, row_sum| -row_sum);
-        let mut za: [f64; S] = std::array::from_fn(|i| -dq[i]);
-        let mut m2 = m;
-        if !solve_unpivoted(&mut m, &mut za) || !solve_unpivoted(&mut m2, &mut zb) {
+        let (mut m, zb) = tab.stage_system(&hk, |_, row_sum| -row_sum);
+        let mut z = [std::array::from_fn(|i| -dq[i]), zb];
+        if !solve_unpivoted_many(&mut m, &mut z) {
             return None;
         }
+        let [za, zb] = z;
         // The estimate's condition h f₀ + Σ ddᵢ (zᵢ + ΔQ_eq,ᵢ) = 0 with f₀ = −k₀ w₀.
         let k0h = h * conductance * n0.elastance;
         let mut num = 0.0;

@@ -47,13 +47,15 @@ impl ChargeSolver {
             (self.target_voltage, self.target_time, self.load),
             (Some(_), None, LoadModel::Rectifier(_))
         );
-        if self.sampler.is_none() && self.vq.is_none() && !rectifier_target {
-            return Ok(());
-        }
-        let Some(step) = self.last_step else {
+        let Some(step) = self.last_step.as_ref() else {
             return Ok(());
         };
         let t1 = step.t0 + step.h;
+        // (The step is copied out only when an output needs it: most steps hold no sample.)
+        if !self.grids_due(t1) && !rectifier_target {
+            return Ok(());
+        }
+        let step = *step;
         self.sample_between(step.t0, t1, wave, Some(&step))?;
         if let (Some(target), None, LoadModel::Rectifier(_)) =
             (self.target_voltage, self.target_time, self.load)
@@ -188,6 +190,12 @@ impl ChargeSolver {
         result
     }
 
+    /// Whether a grid (samples, V–Q cycle) has a time up to `tb` to take or skip.
+    #[inline]
+    fn grids_due(&self, tb: f64) -> bool {
+        self.sampler.as_ref().is_some_and(|g| g.due(tb)) || self.vq.as_ref().is_some_and(|g| g.due(tb))
+    }
+
     /// Samples grid times inside `[ta, tb]`: from a step's polynomial, or (open, short, or
     /// the first instant) from the current state.
     pub(super) fn sample_between<W: GapWaveform + ?Sized>(
@@ -197,11 +205,18 @@ impl ChargeSolver {
         wave: &W,
         step: Option<&Step>,
     ) -> Result<(), ElectricalError> {
-        if self.sampler.is_none() && self.vq.is_none() {
+        if !self.grids_due(tb) {
             return Ok(());
         }
         let rectifier = matches!(self.load, LoadModel::Rectifier(_));
         for which in 0..2 {
+            let due = match which {
+                0 => &self.sampler,
+                _ => &self.vq,
+            };
+            if !due.as_ref().is_some_and(|g| g.due(tb)) {
+                continue;
+            }
             let mut grid = match which {
                 0 => self.sampler.take(),
                 _ => self.vq.take(),

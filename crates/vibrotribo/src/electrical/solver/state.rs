@@ -31,6 +31,14 @@ pub(super) struct Grid {
 }
 
 impl Grid {
+    /// Whether [`next_in`](Self::next_in) has a time for `[ta, tb]` or earlier ones to skip:
+    /// false exactly where it would return `None` at once, changing nothing.
+    #[inline]
+    pub(super) fn due(&self, tb: f64) -> bool {
+        !self.last.is_some_and(|l| self.next > l)
+            && self.t0 + self.span * (self.next as f64 / self.per as f64) <= tb
+    }
+
     /// The next grid time inside `[ta, tb]`, advancing past earlier ones.
     pub(super) fn next_in(&mut self, ta: f64, tb: f64) -> Option<f64> {
         loop {

@@ -96,8 +96,10 @@ impl ChargeSolver {
                 }
                 self.accept(t, t1, &trial, nodes[S - 1]);
                 self.smooth_since_last_step = true;
-                self.record(wave)?;
+                // The next step's size before the step's outputs, which do not touch the
+                // controller's state (its chain of roots then overlaps their work).
                 let hnew = self.controller::<S>(h, err, true);
+                self.record(wave)?;
                 self.h = if clipped {
                     // A step shortened to meet the interval end says little about the next:
                     // it grows back to the step proposed before at most as its error allows,
