@@ -17,7 +17,7 @@ use vibrotribo::sweep::grid;
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
 use crate::job::{RunArgs, check_all, check_distinct, set_threads};
-use crate::manifest::{AttractorTolerances, AttractorsManifest, Kind, StartBoxRecord, read, to_value};
+use crate::manifest::{AttractorTolerances, AttractorsManifest, Axis, Kind, StartBoxRecord, read, to_value};
 use crate::output::{CsvFile, check_out_dir, create_dir, read_csv, si, write_json};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};
@@ -209,11 +209,13 @@ pub fn manifest_of(
     let options = starts.options();
     Ok(AttractorsManifest {
         command: Kind::Attractors,
-        param: param.to_string(),
-        from,
-        to,
-        steps: values.len(),
-        values: values.to_vec(),
+        axis: Axis {
+            param: param.to_string(),
+            from,
+            to,
+            steps: values.len(),
+            values: values.to_vec(),
+        },
         samples: sampling.samples,
         seed: sampling.seed,
         start_box: sampling.bounds.map(|b| StartBoxRecord {
@@ -348,8 +350,8 @@ fn print_value(v: &ValueAttractors, param: &str) {
 /// Draws the fractions (stacked bands) and powers of an `attractors` directory.
 pub fn plot_attractors(dir: &Path) -> Result<()> {
     let m: AttractorsManifest = read(&dir.join("attractors.json"))?;
-    let param = m.param.clone();
-    let values = &m.values[..m.done.min(m.values.len())];
+    let param = m.axis.param.clone();
+    let values = &m.axis.values[..m.done.min(m.axis.values.len())];
     let (h, rows) = read_csv(&dir.join("attractors.csv"))?;
     let col = |name: &str| crate::output::column(&h, name);
     let (cp, ca, cf, cw) = (

@@ -52,7 +52,7 @@ pub fn plot_dir(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
 /// Orbit diagrams, impact-velocity diagrams and the summary curves of a sweep.
 pub fn plot_sweep(dir: &Path) -> Result<()> {
     let m: SweepManifest = read_of(dir, Kind::Sweep)?;
-    let param = m.param;
+    let param = m.axis.param;
     let delta1 = m.settings["oscillator"]["gaps"]
         .as_array()
         .and_then(|g| g.first())

@@ -92,16 +92,9 @@ pub struct AttractorTolerances {
 pub struct AttractorsManifest {
     /// Always [`Kind::Attractors`].
     pub command: Kind,
-    /// The varied key.
-    pub param: String,
-    /// First value.
-    pub from: f64,
-    /// Last value.
-    pub to: f64,
-    /// Number of values.
-    pub steps: usize,
-    /// The values, in order.
-    pub values: Vec<f64>,
+    /// The varied key and its values (`param`, `from`, `to`, `steps`, `values`).
+    #[serde(flatten)]
+    pub axis: Axis,
     /// Random starts per value.
     pub samples: usize,
     /// Seed of the starts.

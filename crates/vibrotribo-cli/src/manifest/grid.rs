@@ -67,19 +67,9 @@ pub fn base_motion_of(config: &Config) -> Option<BaseMotionSummary> {
 pub struct SweepManifest {
     /// Always [`Kind::Sweep`].
     pub command: Kind,
-    /// The swept key.
-    pub param: String,
-    /// First value.
-    #[serde(default)]
-    pub from: f64,
-    /// Last value.
-    #[serde(default)]
-    pub to: f64,
-    /// Number of values.
-    #[serde(default)]
-    pub steps: usize,
-    /// The values, in grid order.
-    pub values: Vec<f64>,
+    /// The swept key and its values (`param`, `from`, `to`, `steps`, `values`).
+    #[serde(flatten)]
+    pub axis: Axis,
     /// How the values start.
     #[serde(default)]
     pub continuation: Continuation,
