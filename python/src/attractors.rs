@@ -9,64 +9,21 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use vibrotribo::attractors::{
-    AcrossDelivery, Attractor, AttractorOptions, Classification, DEFAULT_START_PERIODS, Fingerprint,
-    RandomStarts, SectionScale, StartBox, StartRunner, ValueAttractors, attractors_across, basin_points,
-    classify, initial_condition_index,
+    AcrossDelivery, AttractorOptions, BASIN_COLUMNS, DEFAULT_START_PERIODS, EXPECTED_POWER_COLUMNS,
+    Fingerprint, RandomStarts, START_COLUMNS, SectionScale, StartBox, StartRunner, ValueAttractors,
+    attractors_across, basin_attractor_columns, basin_attractor_rows, basin_points, basin_rows,
+    census_attractor_columns, census_attractor_rows, classify, columns, expected_power_row,
+    initial_condition_index, start_rows, table_of,
 };
 use vibrotribo::study::{DEFAULT_PERIOD_TOLERANCE, DEFAULT_SETTLE_CAP};
-use vibrotribo::sweep::{Cell, Kind, Table, grid};
+use vibrotribo::sweep::grid;
 
-use crate::config::{config_error, config_of, table_to_dict};
+use crate::config::{config_error, config_of};
 use crate::convert::table_to_py;
 use crate::interrupt::Signals;
 use crate::limits::check_grid;
-use crate::sweep::{PointSettings, check_points};
-
-/// `x1_m … xN_m, v1_m_s … vN_m_s`.
-fn state_names(masses: usize) -> Vec<String> {
-    let mut names: Vec<String> = (1..=masses).map(|i| format!("x{i}_m")).collect();
-    names.extend((1..=masses).map(|i| format!("v{i}_m_s")));
-    names
-}
-
-/// A table with the given (name, kind) columns.
-fn table(columns: &[(&str, Kind)], extra: Vec<String>) -> Table {
-    let mut names: Vec<String> = columns.iter().map(|(n, _)| n.to_string()).collect();
-    let mut kinds: Vec<Kind> = columns.iter().map(|(_, k)| *k).collect();
-    kinds.extend(extra.iter().map(|_| Kind::Float));
-    names.extend(extra);
-    Table::new(names, kinds)
-}
-
-fn opt(v: Option<f64>) -> Cell {
-    v.map_or(Cell::Missing, Cell::Float)
-}
-
-/// One attractor's row of `attractors.csv` after its leading columns.
-fn attractor_cells(c: &Classification, a: usize, at: &Attractor, masses: usize) -> Vec<Cell> {
-    let (f, se) = c.fraction(a);
-    let mut row = vec![
-        Cell::Int(at.period as i64),
-        Cell::Int(at.starts as i64),
-        Cell::Float(f),
-        Cell::Float(se),
-        Cell::Float(at.impacts_per_period),
-        opt(at.power_w),
-        opt(at.power_se),
-    ];
-    row.extend(at.points[..2 * masses].iter().map(|&x| Cell::Float(x)));
-    row
-}
-
-const ATTRACTOR_TAIL: [(&str, Kind); 7] = [
-    ("period", Kind::Int),
-    ("starts", Kind::Int),
-    ("fraction", Kind::Float),
-    ("fraction_se", Kind::Float),
-    ("impacts_per_period", Kind::Float),
-    ("average_power_w", Kind::Float),
-    ("power_se_w", Kind::Float),
-];
+use crate::sweep::{PointSettings, StudySettings, check_points};
+use vibrotribo::config::Config;
 
 /// The attractor options of the command line's `--cell`, `--section-tolerance`,
 /// `--match-tolerance` (and `--continuation-distance`).
@@ -83,6 +40,13 @@ fn attractor_options(
         cell,
         continuation_distance: distance.unwrap_or(d.continuation_distance),
     }
+}
+
+/// The start runner of `base` under `settings` (a start's default periods
+/// [`DEFAULT_START_PERIODS`]), its starts told apart by `options`.
+fn starts_of(base: Config, settings: &PointSettings, options: AttractorOptions) -> PyResult<StartRunner> {
+    StartRunner::new(settings.runner_or(base, DEFAULT_START_PERIODS)?, options)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// Basins of attraction over two initial conditions (see the Python `vibrotribo.basins`).
@@ -150,11 +114,7 @@ pub fn basins<'py>(
         allow_large,
     };
     let options = attractor_options(cell, section_tolerance, match_tolerance, None);
-    let starts = StartRunner::new(
-        settings_of.runner_or(base, DEFAULT_START_PERIODS)?,
-        options.clone(),
-    )
-    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let starts = starts_of(base, &settings_of, options.clone())?;
     let (xs, ys) = (grid(x_from, x_to, nx), grid(y_from, y_to, ny));
     let points = basin_points(&xs, &ys);
     let pool = settings_of.pool()?;
@@ -166,20 +126,12 @@ pub fn basins<'py>(
         &results,
         &options,
     )?;
-    let o = starts.point_runner().options();
-    let s = PyDict::new(py);
-    s.set_item("command", "basins")?;
-    s.set_item("x", x)?;
-    s.set_item("x_values", xs)?;
-    s.set_item("y", y)?;
-    s.set_item("y_values", ys)?;
-    s.set_item("transient_periods", o.transient_periods)?;
-    s.set_item("recorded_periods", o.recorded_periods)?;
-    s.set_item("mechanics_only", mechanics_only)?;
-    s.set_item(
-        "settings",
-        table_to_dict(py, starts.point_runner().base().table())?,
-    )?;
+    let s = StudySettings::new(py, "basins")?
+        .set("x", x)?
+        .set("x_values", xs)?
+        .set("y", y)?
+        .set("y_values", ys)?
+        .finish(starts.point_runner())?;
     out.set_item("settings", s)?;
     Ok(out)
 }
@@ -195,66 +147,13 @@ fn basin_tables<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let masses = chain.len();
     let fingerprints: Vec<Option<Fingerprint>> = results.iter().map(|r| r.as_ref().ok().cloned()).collect();
-    let scale = SectionScale::of(chain);
-    let c = classify(&fingerprints, &scale, options);
-    let mut starts_table = table(
-        &[
-            ("x", Kind::Float),
-            ("y", Kind::Float),
-            ("period", Kind::Int),
-            ("impacts_per_period", Kind::Float),
-            ("average_power_w", Kind::Float),
-            ("error", Kind::Text),
-        ],
-        Vec::new(),
+    let c = classify(&fingerprints, &SectionScale::of(chain), options);
+    let starts_table = table_of(columns(&START_COLUMNS, &[], 0), start_rows(points, results));
+    let basin_table = table_of(
+        columns(&BASIN_COLUMNS, &[], 0),
+        basin_rows(points, &fingerprints, &c),
     );
-    let mut basin_table = table(
-        &[
-            ("x", Kind::Float),
-            ("y", Kind::Float),
-            ("attractor", Kind::Int),
-            ("period", Kind::Int),
-            ("impacts_per_period", Kind::Float),
-            ("average_power_w", Kind::Float),
-        ],
-        Vec::new(),
-    );
-    for ((&(xv, yv), r), label) in points.iter().zip(results).zip(&c.labels) {
-        let (period, impacts, power, error) = match r {
-            Ok(f) => (
-                Cell::Int(f.period as i64),
-                Cell::Float(f.impacts_per_period),
-                opt(f.power_w),
-                String::new(),
-            ),
-            Err(e) => (Cell::Missing, Cell::Missing, Cell::Missing, e.clone()),
-        };
-        starts_table.push_row(vec![
-            Cell::Float(xv),
-            Cell::Float(yv),
-            period.clone(),
-            impacts.clone(),
-            power.clone(),
-            Cell::Text(error),
-        ]);
-        basin_table.push_row(vec![
-            Cell::Float(xv),
-            Cell::Float(yv),
-            label.map_or(Cell::Missing, |a| Cell::Int(a as i64 + 1)),
-            period,
-            impacts,
-            power,
-        ]);
-    }
-    let mut attractor_table = table(
-        &[&[("attractor", Kind::Int)][..], &ATTRACTOR_TAIL[..]].concat(),
-        state_names(masses),
-    );
-    for (a, at) in c.attractors.iter().enumerate() {
-        let mut row = vec![Cell::Int(a as i64 + 1)];
-        row.extend(attractor_cells(&c, a, at, masses));
-        attractor_table.push_row(row);
-    }
+    let attractor_table = table_of(basin_attractor_columns(masses), basin_attractor_rows(&c, masses));
     let out = PyDict::new(py);
     out.set_item("starts", table_to_py(py, &starts_table)?)?;
     out.set_item("basins", table_to_py(py, &basin_table)?)?;
@@ -331,8 +230,7 @@ pub fn basin_starts(
         allow_large: true,
     };
     let options = attractor_options(cell, section_tolerance, match_tolerance, None);
-    let starts = StartRunner::new(settings_of.runner_or(base, DEFAULT_START_PERIODS)?, options)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let starts = starts_of(base, &settings_of, options)?;
     let points = basin_points(&x_values, &y_values);
     let pool = settings_of.pool()?;
     let results = run_starts(py, &pool, &starts, &points, &x, &y)?;
@@ -457,8 +355,7 @@ pub fn attractors<'py>(
         match_tolerance,
         Some(continuation_distance),
     );
-    let starts = StartRunner::new(settings_of.runner_or(base, DEFAULT_START_PERIODS)?, options)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let starts = starts_of(base, &settings_of, options)?;
     let points: Vec<Vec<(&str, f64)>> = values.iter().map(|&v| vec![(param.as_str(), v)]).collect();
     check_points(starts.point_runner(), &points)?;
     let chain = starts.point_runner().base().chain();
@@ -493,62 +390,23 @@ pub fn attractors<'py>(
         signals.result()?;
         r.map_err(|e| PyValueError::new_err(e.to_string()))
     })?;
-    let mut at_table = table(
-        &[
-            &[("param", Kind::Float), ("attractor", Kind::Int)][..],
-            &ATTRACTOR_TAIL[..],
-        ]
-        .concat(),
-        state_names(masses),
+    let at_table = table_of(
+        census_attractor_columns(masses),
+        results.iter().flat_map(|v| census_attractor_rows(v, masses)),
     );
-    let mut expected = table(
-        &[
-            ("param", Kind::Float),
-            ("expected_power_w", Kind::Float),
-            ("expected_power_se_w", Kind::Float),
-            ("attractors", Kind::Int),
-            ("starts", Kind::Int),
-            ("failed", Kind::Int),
-            ("error", Kind::Text),
-        ],
-        Vec::new(),
+    let expected = table_of(
+        columns(&EXPECTED_POWER_COLUMNS, &[], 0),
+        results.iter().map(expected_power_row),
     );
-    for v in &results {
-        let c = &v.classification;
-        let mut order: Vec<usize> = (0..c.attractors.len()).collect();
-        order.sort_by_key(|&k| v.ids[k]);
-        for k in order {
-            let mut row = vec![Cell::Float(v.value), Cell::Int(v.ids[k] as i64 + 1)];
-            row.extend(attractor_cells(c, k, &c.attractors[k], masses));
-            at_table.push_row(row);
-        }
-        expected.push_row(vec![
-            Cell::Float(v.value),
-            opt(v.expected_power.map(|p| p.0)),
-            opt(v.expected_power.map(|p| p.1)),
-            Cell::Int(c.attractors.iter().filter(|a| a.starts > 0).count() as i64),
-            Cell::Int(c.classified() as i64),
-            Cell::Int(v.failed as i64),
-            Cell::Text(v.first_error.clone().unwrap_or_default()),
-        ]);
-    }
     let out = PyDict::new(py);
     out.set_item("attractors", table_to_py(py, &at_table)?)?;
     out.set_item("expected_power", table_to_py(py, &expected)?)?;
-    let o = starts.point_runner().options();
-    let s = PyDict::new(py);
-    s.set_item("command", "attractors")?;
-    s.set_item("param", param)?;
-    s.set_item("values", values)?;
-    s.set_item("samples", samples)?;
-    s.set_item("seed", seed)?;
-    s.set_item("transient_periods", o.transient_periods)?;
-    s.set_item("recorded_periods", o.recorded_periods)?;
-    s.set_item("mechanics_only", mechanics_only)?;
-    s.set_item(
-        "settings",
-        table_to_dict(py, starts.point_runner().base().table())?,
-    )?;
+    let s = StudySettings::new(py, "attractors")?
+        .set("param", param)?
+        .set("values", values)?
+        .set("samples", samples)?
+        .set("seed", seed)?
+        .finish(starts.point_runner())?;
     out.set_item("settings", s)?;
     Ok(out)
 }

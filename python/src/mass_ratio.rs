@@ -12,10 +12,10 @@ use vibrotribo::study::{
 };
 use vibrotribo::sweep::{Cell, Kind, PointColumns, Table, grid};
 
-use crate::config::{config_of, table_to_dict};
+use crate::config::config_of;
 use crate::convert::table_to_py;
 use crate::limits::check_grid;
-use crate::sweep::{PointSettings, check_points, run_grid};
+use crate::sweep::{PointSettings, StudySettings, check_points, run_grid};
 
 /// Refuses an axis the command line refuses (`--{name}-from/-to/-steps`).
 fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> PyResult<()> {
@@ -172,14 +172,10 @@ pub fn optimize_mass_ratio<'py>(
     paper.set_item("b", b)?;
     paper.set_item("c", c)?;
     out.set_item("paper_fit", paper)?;
-    let o = runner.options();
-    let s = PyDict::new(py);
-    s.set_item("command", "optimize-mass-ratio")?;
-    s.set_item("omega_values", omegas)?;
-    s.set_item("mass_ratio_values", ratios)?;
-    s.set_item("transient_periods", o.transient_periods)?;
-    s.set_item("recorded_periods", o.recorded_periods)?;
-    s.set_item("settings", table_to_dict(py, runner.base().table())?)?;
+    let s = StudySettings::new(py, "optimize-mass-ratio")?
+        .set("omega_values", omegas)?
+        .set("mass_ratio_values", ratios)?
+        .finish(&runner)?;
     out.set_item("settings", s)?;
     Ok(out)
 }

@@ -1,6 +1,6 @@
 //! `vibrotribo.simulate`: one run through the library's run layer
 //! ([`vibrotribo::study::simulate`]), its samples and events as numpy arrays and its summary
-//! as `summary.json` holds it ([`vibrotribo::report::run_summary`]).
+//! as `summary.json` holds it ([`vibrotribo::report::RunSummary`]).
 
 use std::time::Instant;
 
@@ -9,14 +9,14 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibrotribo::electrical::LoadKind;
-use vibrotribo::report::{failure_text, motion_json, run_summary};
+use vibrotribo::report::{MeritSummary, RunSummary, failure_text};
 use vibrotribo::study::{
     DEFAULT_SETTLE_CAP, Ending, Recording, RunMotion, SettleMode, limits, settle as settle_run,
     simulate as run,
 };
 
 use crate::config::{config_error, config_of};
-use crate::convert::{array1, array2, json_to_py};
+use crate::convert::{array1, array2, serde_to_py};
 use crate::interrupt::Signals;
 use crate::limits::check_memory;
 
@@ -142,21 +142,18 @@ pub fn simulate<'py>(
     events.set_item("x", array2(py, e.positions, n)?)?;
     events.set_item("v", array2(py, e.velocities, n)?)?;
     out.set_item("events", events)?;
-    let mut summary = run_summary(&config, &spec, &outcome, elapsed);
-    summary["settle"] = settle.as_str().into();
-    if let SettleMode::Auto(a) = &motion.options().settle {
-        summary["settle_cap_periods"] = a.cap_periods.into();
-    }
-    summary["motion"] = motion_json(report.as_ref());
+    let mut summary = RunSummary::new(&config, &spec, &outcome, elapsed);
+    summary.set_settle(&motion.options().settle);
+    summary.set_motion(report.as_ref());
     if let Some(w) = &merit {
         let energy = outcome
             .electrical
             .as_ref()
             .and_then(|e| e.power.as_ref())
             .map(|p| p.energy_per_period_j);
-        vibrotribo::report::insert_merit(&mut summary, w.finish(energy).as_ref());
+        summary.merit = Some(MeritSummary::of(w.finish(energy).as_ref()));
     }
-    out.set_item("summary", json_to_py(py, &summary)?)?;
+    out.set_item("summary", serde_to_py(py, &summary)?)?;
     out.set_item("error", failure_text(&outcome))?;
     Ok(out)
 }

@@ -137,6 +137,37 @@ pub fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'p
     Ok(d)
 }
 
+/// The settings of a study's result as a dict, as its command's manifest records them:
+/// `command` first, the study's own keys ([`StudySettings::set`]), then the point runner's
+/// periods, `mechanics_only` and the configuration ([`StudySettings::finish`]).
+pub struct StudySettings<'py>(Bound<'py, PyDict>);
+
+impl<'py> StudySettings<'py> {
+    /// The settings of a result of `command` (`"basins"`, `"attractors"`, …).
+    pub fn new(py: Python<'py>, command: &str) -> PyResult<Self> {
+        let d = PyDict::new(py);
+        d.set_item("command", command)?;
+        Ok(StudySettings(d))
+    }
+
+    /// Adds the key `key`.
+    pub fn set(self, key: &str, value: impl IntoPyObject<'py>) -> PyResult<Self> {
+        self.0.set_item(key, value)?;
+        Ok(self)
+    }
+
+    /// Adds `transient_periods`, `recorded_periods`, `mechanics_only` and `settings` of the
+    /// points `runner` ran.
+    pub fn finish(self, runner: &PointRunner) -> PyResult<Bound<'py, PyDict>> {
+        let (d, o) = (self.0, runner.options());
+        d.set_item("transient_periods", o.transient_periods)?;
+        d.set_item("recorded_periods", o.recorded_periods)?;
+        d.set_item("mechanics_only", runner.mechanics_only())?;
+        d.set_item("settings", table_to_dict(d.py(), runner.base().table())?)?;
+        Ok(d)
+    }
+}
+
 /// Runs `points` on the pool, handing each point's keys and result to `each` in grid order;
 /// stops at a chunk's end if a signal handler raised.
 pub fn run_grid(

@@ -8,15 +8,17 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
 use vibrotribo::attractors::{
-    AcrossDelivery, AttractorOptions, RandomStarts, StartBox, StartRunner, ValueAttractors, attractors_across,
+    AcrossDelivery, AttractorOptions, EXPECTED_POWER_COLUMNS, RandomStarts, StartBox, StartRunner,
+    ValueAttractors, attractors_across, census_attractor_columns, census_attractor_rows, columns,
+    expected_power_row,
 };
 use vibrotribo::sweep::grid;
 
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
 use crate::job::{RunArgs, check_all, check_distinct, set_threads};
-use crate::manifest::{AttractorTolerances, AttractorsManifest, Kind, StartBoxRecord, read, to_value};
-use crate::output::{CsvFile, check_out_dir, create_dir, csv_text, numbered, read_csv, si, write_json};
+use crate::manifest::{AttractorTolerances, AttractorsManifest, Axis, Kind, StartBoxRecord, read, to_value};
+use crate::output::{CsvFile, check_out_dir, create_dir, read_csv, si, write_json};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};
 
@@ -74,18 +76,6 @@ pub struct AttractorsArgs {
     pub run: RunArgs,
 }
 
-const ATTRACTOR_COLUMNS: [&str; 9] = [
-    "param",
-    "attractor",
-    "period",
-    "starts",
-    "fraction",
-    "fraction_se",
-    "impacts_per_period",
-    "average_power_w",
-    "power_se_w",
-];
-
 /// Runs `vibrotribo attractors`.
 pub fn run(args: &AttractorsArgs) -> Result<()> {
     if args.steps == 0 || args.samples == 0 {
@@ -131,35 +121,8 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
         bounds,
     };
     let masses = chain.len();
-    let o = starts.point_runner().options();
-    crate::job::check_recorded(o)?;
-    let manifest = AttractorsManifest {
-        command: Kind::Attractors,
-        param: args.param.clone(),
-        from: args.from,
-        to: args.to,
-        steps: args.steps,
-        values: values.clone(),
-        samples: args.samples,
-        seed: args.seed,
-        start_box: bounds.map(|b| StartBoxRecord {
-            positions_m: b.positions,
-            velocities_m_s: b.velocities,
-        }),
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        attractor_options: AttractorTolerances {
-            period_tolerance: options.period_tolerance,
-            match_tolerance: options.match_tolerance,
-            cell: options.cell,
-            continuation_distance: options.continuation_distance,
-        },
-        mechanics_only: starts.point_runner().mechanics_only(),
-        settings: serde_json::to_value(starts.point_runner().base().table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-        complete: false,
-        done: 0,
-    };
+    crate::job::check_recorded(starts.point_runner().options())?;
+    let manifest = manifest_of(&starts, &args.param, (args.from, args.to), &values, &sampling)?;
     let mut files = match &args.out {
         Some(dir) => {
             let ours = to_value(&manifest)?;
@@ -168,59 +131,19 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
             })?;
             create_dir(dir)?;
             write_json(&dir.join("attractors.json"), &ours)?;
-            let mut cols: Vec<String> = ATTRACTOR_COLUMNS.map(String::from).to_vec();
-            cols.extend(numbered("x", masses, "_m"));
-            cols.extend(numbered("v", masses, "_m_s"));
-            Some((
-                CsvFile::create(&dir.join("attractors.csv"), &cols)?,
-                CsvFile::create(
-                    &dir.join("expected_power.csv"),
-                    &[
-                        "param",
-                        "expected_power_w",
-                        "expected_power_se_w",
-                        "attractors",
-                        "starts",
-                        "failed",
-                        "error",
-                    ],
-                )?,
-            ))
+            Some(CensusFiles::create(dir, masses)?)
         }
         None => None,
     };
-    let progress = Progress::new((values.len() * args.samples) as u64, "starts", args.run.quiet);
     let started = Instant::now();
-    let mut failure = None;
-    let mut finished = 0;
-    let chunk = rayon::current_num_threads() * 4;
-    let results = attractors_across(&starts, &args.param, &values, &sampling, chunk, |d| match d {
-        AcrossDelivery::Start => {
-            progress.inc(1);
-            ControlFlow::Continue(())
-        }
-        AcrossDelivery::Value(v) => {
-            finished += 1;
-            if let Some((a, e)) = files.as_mut()
-                && let Err(err) = write_value(a, e, v, masses)
-            {
-                failure = Some(err);
-                return ControlFlow::Break(());
-            }
-            ControlFlow::Continue(())
-        }
-        AcrossDelivery::Chunk => {
-            if interrupted() {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        }
-    })?;
-    progress.finish();
-    if let Some(e) = failure {
-        return Err(e);
-    }
+    let (results, finished) = run_census(
+        &starts,
+        &args.param,
+        &values,
+        &sampling,
+        files.as_mut(),
+        args.run.quiet,
+    )?;
     let complete = finished == values.len();
     for v in &results {
         print_value(v, &args.param);
@@ -234,9 +157,8 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
-    if let (Some((mut a, mut e)), Some(dir)) = (files, &args.out) {
-        a.flush()?;
-        e.flush()?;
+    if let (Some(mut files), Some(dir)) = (files, &args.out) {
+        files.flush()?;
         write_json(
             &dir.join("attractors.json"),
             &to_value(&AttractorsManifest {
@@ -273,41 +195,128 @@ fn with_progress(m: &serde_json::Value, complete: bool, done: usize) -> serde_js
     m
 }
 
-fn write_value(a: &mut CsvFile, e: &mut CsvFile, v: &ValueAttractors, masses: usize) -> Result<()> {
-    let c = &v.classification;
-    let mut order: Vec<usize> = (0..c.attractors.len()).collect();
-    order.sort_by_key(|&k| v.ids[k]);
-    for k in order {
-        let at = &c.attractors[k];
-        let (f, se) = c.fraction(k);
-        let mut row = vec![
-            v.value.to_string(),
-            (v.ids[k] + 1).to_string(),
-            at.period.to_string(),
-            at.starts.to_string(),
-            f.to_string(),
-            se.to_string(),
-            at.impacts_per_period.to_string(),
-            at.power_w.map_or(String::new(), |p| p.to_string()),
-            at.power_se.map_or(String::new(), |p| p.to_string()),
-        ];
-        row.extend(at.points[..2 * masses].iter().map(f64::to_string));
-        a.row(row)?;
+/// The manifest (`attractors.json`) of a census of `starts` across `values` of `param`
+/// (the grid from `from` to `to`), its starts drawn by `sampling`; nothing done yet.
+pub fn manifest_of(
+    starts: &StartRunner,
+    param: &str,
+    (from, to): (f64, f64),
+    values: &[f64],
+    sampling: &RandomStarts,
+) -> Result<AttractorsManifest> {
+    let runner = starts.point_runner();
+    let o = runner.options();
+    let options = starts.options();
+    Ok(AttractorsManifest {
+        command: Kind::Attractors,
+        axis: Axis {
+            param: param.to_string(),
+            from,
+            to,
+            steps: values.len(),
+            values: values.to_vec(),
+        },
+        samples: sampling.samples,
+        seed: sampling.seed,
+        start_box: sampling.bounds.map(|b| StartBoxRecord {
+            positions_m: b.positions,
+            velocities_m_s: b.velocities,
+        }),
+        transient_periods: o.transient_periods,
+        recorded_periods: o.recorded_periods,
+        attractor_options: AttractorTolerances {
+            period_tolerance: options.period_tolerance,
+            match_tolerance: options.match_tolerance,
+            cell: options.cell,
+            continuation_distance: options.continuation_distance,
+        },
+        mechanics_only: runner.mechanics_only(),
+        settings: serde_json::to_value(runner.base().table())?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        complete: false,
+        done: 0,
+    })
+}
+
+/// `attractors.csv` and `expected_power.csv` of a census, written value by value.
+pub struct CensusFiles {
+    attractors: CsvFile,
+    expected: CsvFile,
+    masses: usize,
+}
+
+impl CensusFiles {
+    /// Creates the files in `dir` for a chain of `masses` masses.
+    pub fn create(dir: &Path, masses: usize) -> Result<Self> {
+        Ok(CensusFiles {
+            attractors: CsvFile::create(&dir.join("attractors.csv"), &census_attractor_columns(masses).0)?,
+            expected: CsvFile::create(
+                &dir.join("expected_power.csv"),
+                &columns(&EXPECTED_POWER_COLUMNS, &[], 0).0,
+            )?,
+            masses,
+        })
     }
-    let (p, se) = v.expected_power.map_or((String::new(), String::new()), |(p, s)| {
-        (p.to_string(), s.to_string())
-    });
-    e.row([
-        v.value.to_string(),
-        p,
-        se,
-        c.attractors.iter().filter(|a| a.starts > 0).count().to_string(),
-        c.classified().to_string(),
-        v.failed.to_string(),
-        v.first_error.as_deref().map_or(String::new(), csv_text),
-    ])?;
-    a.flush()?;
-    e.flush()
+
+    /// Writes the rows of one value.
+    fn write_value(&mut self, v: &ValueAttractors) -> Result<()> {
+        for row in census_attractor_rows(v, self.masses) {
+            self.attractors.row(row)?;
+        }
+        self.expected.row(expected_power_row(v))?;
+        self.flush()
+    }
+
+    /// Flushes both files.
+    pub fn flush(&mut self) -> Result<()> {
+        self.attractors.flush()?;
+        self.expected.flush()
+    }
+}
+
+/// Runs the census of `starts` across `values` of `param` ([`attractors_across`]), with a
+/// progress bar and a stop on SIGINT/SIGTERM after a chunk, each value's rows written to
+/// `files` as it finishes. Returns the values' attractors and how many values finished.
+pub fn run_census(
+    starts: &StartRunner,
+    param: &str,
+    values: &[f64],
+    sampling: &RandomStarts,
+    mut files: Option<&mut CensusFiles>,
+    quiet: bool,
+) -> Result<(Vec<ValueAttractors>, usize)> {
+    let progress = Progress::new((values.len() * sampling.samples) as u64, "starts", quiet);
+    let mut failure = None;
+    let mut finished = 0;
+    let chunk = rayon::current_num_threads() * 4;
+    let results = attractors_across(starts, param, values, sampling, chunk, |d| match d {
+        AcrossDelivery::Start => {
+            progress.inc(1);
+            ControlFlow::Continue(())
+        }
+        AcrossDelivery::Value(v) => {
+            finished += 1;
+            if let Some(f) = files.as_deref_mut()
+                && let Err(err) = f.write_value(v)
+            {
+                failure = Some(err);
+                return ControlFlow::Break(());
+            }
+            ControlFlow::Continue(())
+        }
+        AcrossDelivery::Chunk => {
+            if interrupted() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        }
+    })?;
+    progress.finish();
+    match failure {
+        Some(e) => Err(e),
+        None => Ok((results, finished)),
+    }
 }
 
 fn print_value(v: &ValueAttractors, param: &str) {
@@ -341,8 +350,8 @@ fn print_value(v: &ValueAttractors, param: &str) {
 /// Draws the fractions (stacked bands) and powers of an `attractors` directory.
 pub fn plot_attractors(dir: &Path) -> Result<()> {
     let m: AttractorsManifest = read(&dir.join("attractors.json"))?;
-    let param = m.param.clone();
-    let values = &m.values[..m.done.min(m.values.len())];
+    let param = m.axis.param.clone();
+    let values = &m.axis.values[..m.done.min(m.axis.values.len())];
     let (h, rows) = read_csv(&dir.join("attractors.csv"))?;
     let col = |name: &str| crate::output::column(&h, name);
     let (cp, ca, cf, cw) = (

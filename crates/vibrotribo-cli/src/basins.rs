@@ -11,7 +11,8 @@ use anyhow::{Context, Result, anyhow, bail};
 use serde::Deserialize;
 use serde_json::Value;
 use vibrotribo::attractors::{
-    AttractorOptions, Classification, Fingerprint, SectionScale, StartRunner, classify,
+    AttractorOptions, BASIN_COLUMNS, Classification, Fingerprint, SectionScale, StartRunner,
+    basin_attractor_columns, basin_attractor_rows, basin_rows, classify, columns,
 };
 use vibrotribo::sweep::grid;
 
@@ -20,7 +21,7 @@ use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::job::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
 use crate::limits;
 use crate::manifest::{Axis, BasinTolerances, BasinsManifest, Kind, SectionScaleRecord, ShardRecord, read};
-use crate::output::{CsvFile, csv_text, numbered, read_csv, si};
+use crate::output::{csv_text, read_csv, si, write_rows};
 use crate::plot::{self, CategoryMap, Figure};
 use crate::progress::Interrupted;
 
@@ -119,7 +120,7 @@ fn check_key(option: &str, key: &str, masses: usize) -> Result<()> {
 }
 
 /// `starts.csv`: one row per start, the fingerprint of where it ended.
-fn layout() -> Layout {
+pub fn layout() -> Layout {
     Layout {
         manifest: "basins.json",
         files: vec![CsvSpec {
@@ -248,44 +249,24 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     let scale = SectionScale::of(starts.point_runner().base().chain());
     let o = starts.point_runner().options();
     crate::job::check_recorded(o)?;
-    let settings = crate::manifest::to_value(&BasinsManifest {
-        command: Kind::Basins,
-        x: Axis {
+    let settings = crate::manifest::to_value(&manifest_of(
+        &starts,
+        Axis {
             param: args.x.clone(),
             from: args.x_from,
             to: args.x_to,
             steps: nx,
             values: xs.clone(),
         },
-        y: Axis {
+        Axis {
             param: args.y.clone(),
             from: args.y_from,
             to: args.y_to,
             steps: ny,
             values: ys.clone(),
         },
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        max_period_detected: o.period_options().max_period,
-        attractor_options: BasinTolerances {
-            period_tolerance: options.period_tolerance,
-            match_tolerance: options.match_tolerance,
-            cell: options.cell,
-        },
-        section_scale: SectionScaleRecord {
-            masses,
-            length_m: scale.length,
-            speed_m_s: scale.speed,
-        },
-        mechanics_only: starts.point_runner().mechanics_only(),
-        shard: args.shard.map(|s| ShardRecord {
-            index: s.index,
-            count: s.count,
-        }),
-        settings: serde_json::to_value(starts.point_runner().base().table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-        complete: false,
-    })?;
+        args.shard,
+    )?)?;
     let keys: Vec<String> = points.iter().map(key_of).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -299,28 +280,13 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
         ),
     };
     let started = Instant::now();
-    let mut fingerprints = Vec::new();
-    let computed = run_chunked(
+    let (computed, fingerprints) = run_starts(
+        &starts,
         &points[skip..],
-        |&(x, y)| {
-            starts
-                .run(&[(xk, x), (yk, y)], None)
-                .map_err(|e| format!("{e:#}"))
-        },
-        ("starts", skip as u64, points.len() as u64),
+        (xk, yk),
+        skip,
         args.run.quiet,
-        |d| {
-            let Some((&(x, y), r)) = d else {
-                return out.as_mut().map_or(Ok(()), GridOutput::commit);
-            };
-            if let Some(out) = out.as_mut() {
-                let mut row = vec![x.to_string(), y.to_string()];
-                row.extend(cells_of(&r));
-                out.row(0, row)?;
-            }
-            fingerprints.push(r.ok());
-            Ok(())
-        },
+        out.as_mut(),
     )?;
     let done = skip + computed;
     let complete = done == points.len();
@@ -369,6 +335,80 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
         .into());
     }
     Ok(())
+}
+
+/// The manifest (`basins.json`) of a basins job of `starts` over the axes `x` and `y`
+/// (the shard `shard` of it, if any).
+pub fn manifest_of(starts: &StartRunner, x: Axis, y: Axis, shard: Option<Shard>) -> Result<BasinsManifest> {
+    let runner = starts.point_runner();
+    let o = runner.options();
+    let options = starts.options();
+    let scale = SectionScale::of(runner.base().chain());
+    Ok(BasinsManifest {
+        command: Kind::Basins,
+        x,
+        y,
+        transient_periods: o.transient_periods,
+        recorded_periods: o.recorded_periods,
+        max_period_detected: o.period_options().max_period,
+        attractor_options: BasinTolerances {
+            period_tolerance: options.period_tolerance,
+            match_tolerance: options.match_tolerance,
+            cell: options.cell,
+        },
+        section_scale: SectionScaleRecord {
+            masses: scale.masses,
+            length_m: scale.length,
+            speed_m_s: scale.speed,
+        },
+        mechanics_only: runner.mechanics_only(),
+        shard: shard.map(|s| ShardRecord {
+            index: s.index,
+            count: s.count,
+        }),
+        settings: serde_json::to_value(runner.base().table())?,
+        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        complete: false,
+    })
+}
+
+/// Runs the starts `points` of `starts` (the keys `xk`, `yk` set to each point's values) in
+/// parallel chunks, in grid order, with a progress bar counting from `skip` and a stop on
+/// SIGINT/SIGTERM after a chunk; each start's row goes to `out` (`starts.csv` of a grid job)
+/// as it comes. Returns how many ran and their fingerprints (`None`: the start failed).
+pub fn run_starts(
+    starts: &StartRunner,
+    points: &[(f64, f64)],
+    (xk, yk): (&str, &str),
+    skip: usize,
+    quiet: bool,
+    mut out: Option<&mut GridOutput>,
+) -> Result<(usize, Vec<Option<Fingerprint>>)> {
+    let mut fingerprints = Vec::new();
+    let total = (skip + points.len()) as u64;
+    let computed = run_chunked(
+        points,
+        |&(x, y)| {
+            starts
+                .run(&[(xk, x), (yk, y)], None)
+                .map_err(|e| format!("{e:#}"))
+        },
+        ("starts", skip as u64, total),
+        quiet,
+        |d| {
+            let Some((&(x, y), r)) = d else {
+                return out.as_deref_mut().map_or(Ok(()), GridOutput::commit);
+            };
+            if let Some(out) = out.as_deref_mut() {
+                let mut row = vec![x.to_string(), y.to_string()];
+                row.extend(cells_of(&r));
+                out.row(0, row)?;
+            }
+            fingerprints.push(r.ok());
+            Ok(())
+        },
+    )?;
+    Ok((computed, fingerprints))
 }
 
 fn print_attractors(c: &Classification) {
@@ -442,67 +482,45 @@ fn read_job(
 /// Classifies a complete directory's starts (grid order) and writes `basins.csv` and
 /// `attractors.csv`.
 pub fn finish(dir: &Path) -> Result<Classification> {
-    let (_, fingerprints, scale, options) = read_job(dir)?;
-    let (_, rows) = read_csv(&dir.join("starts.csv"))?;
+    let (m, fingerprints, scale, options) = read_job(dir)?;
     let c = classify(&fingerprints, &scale, &options);
-    let mut basins = CsvFile::create(
-        &dir.join("basins.csv"),
-        &[
-            "x",
-            "y",
-            "attractor",
-            "period",
-            "impacts_per_period",
-            "average_power_w",
-        ],
+    write_tables(
+        dir,
+        &points_of(&m.x.values, &m.y.values),
+        &fingerprints,
+        &c,
+        scale.masses,
     )?;
-    for ((row, label), f) in rows.iter().zip(&c.labels).zip(&fingerprints) {
-        basins.row([
-            row[0].clone(),
-            row[1].clone(),
-            label.map_or(String::new(), |a| (a + 1).to_string()),
-            f.as_ref().map_or(String::new(), |f| f.period.to_string()),
-            f.as_ref()
-                .map_or(String::new(), |f| f.impacts_per_period.to_string()),
-            f.as_ref()
-                .and_then(|f| f.power_w)
-                .map_or(String::new(), |p| p.to_string()),
-        ])?;
-    }
-    basins.flush()?;
-    let n = scale.masses;
-    let mut cols: Vec<String> = [
-        "attractor",
-        "period",
-        "starts",
-        "fraction",
-        "fraction_se",
-        "impacts_per_period",
-        "average_power_w",
-        "power_se_w",
-    ]
-    .map(String::from)
-    .to_vec();
-    cols.extend(numbered("x", n, "_m"));
-    cols.extend(numbered("v", n, "_m_s"));
-    let mut at = CsvFile::create(&dir.join("attractors.csv"), &cols)?;
-    for (a, attractor) in c.attractors.iter().enumerate() {
-        let (f, se) = c.fraction(a);
-        let mut row = vec![
-            (a + 1).to_string(),
-            attractor.period.to_string(),
-            attractor.starts.to_string(),
-            f.to_string(),
-            se.to_string(),
-            attractor.impacts_per_period.to_string(),
-            attractor.power_w.map_or(String::new(), |p| p.to_string()),
-            attractor.power_se.map_or(String::new(), |p| p.to_string()),
-        ];
-        row.extend(attractor.points[..2 * n].iter().map(f64::to_string));
-        at.row(row)?;
-    }
-    at.flush()?;
     Ok(c)
+}
+
+/// Writes `basins.csv` (each start at `points`, in grid order, with its fingerprint and
+/// attractor) and `attractors.csv` (the attractors of `c`) to `dir`.
+pub fn write_tables(
+    dir: &Path,
+    points: &[(f64, f64)],
+    fingerprints: &[Option<Fingerprint>],
+    c: &Classification,
+    masses: usize,
+) -> Result<()> {
+    if points.len() != fingerprints.len() {
+        bail!(
+            "{}: starts.csv holds {} starts for a grid of {}",
+            dir.display(),
+            fingerprints.len(),
+            points.len()
+        );
+    }
+    write_rows(
+        &dir.join("basins.csv"),
+        &columns(&BASIN_COLUMNS, &[], 0).0,
+        basin_rows(points, fingerprints, c),
+    )?;
+    write_rows(
+        &dir.join("attractors.csv"),
+        &basin_attractor_columns(masses).0,
+        basin_attractor_rows(c, masses),
+    )
 }
 
 /// Draws the basin picture of a complete directory (`basins.png`/`.svg`).

@@ -202,7 +202,7 @@ const MARKS: [(&str, &str, Shape, usize); 7] = [
 ];
 
 /// The legend entry, marker shape and palette colour of a bifurcation's kind (by name).
-fn marker_of(kind: &str) -> (&'static str, Shape, usize) {
+pub fn marker_of(kind: &str) -> (&'static str, Shape, usize) {
     MARKS
         .iter()
         .find(|m| m.0 == kind)

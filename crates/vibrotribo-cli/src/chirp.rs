@@ -280,7 +280,7 @@ fn run_record(r: &ChirpRun) -> ChirpRunRecord {
             size_m: j.size_m,
             relative: j.relative,
         }),
-        base_motion: vibrotribo::report::base_motion_json(&r.config, &r.config.run_spec(true)),
+        base_motion: vibrotribo::report::BaseMotionSummary::of(&r.config, &r.config.run_spec(true)),
     }
 }
 

@@ -5,13 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use serde::{Deserialize, Serialize};
 use vibrotribo::config::Config;
 use vibrotribo::curve::{ConfigCurve, CurveConfigOptions, CurveRequest, curve_config, curve_powers};
 use vibrotribo::orbits::curve::{Codim2Kind, CurveEnd, CurveKind, CurveOptions};
 
 use crate::config::ConfigArgs;
-use crate::output::{CsvFile, create_dir, csv_text, multipliers_text, numbered, write_json};
+use crate::manifest::{Codim2Record, CurveManifest, Kind};
+use crate::output::{CsvFile, create_dir, csv_text, multipliers_text, numbered};
 
 /// Options of `vibrotribo curve`.
 #[derive(Debug, clap::Args)]
@@ -58,68 +58,6 @@ pub struct CurveArgs {
     /// Write curve.csv, codim2.csv and curve.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-}
-
-/// `curve.json`: the settings of a curve and what it found.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct CurveManifest {
-    /// Always `curve`.
-    pub command: String,
-    /// `fold`, `period_doubling`, `neimark_sacker` or `grazing`.
-    pub kind: String,
-    /// The first key, canonical.
-    pub param: String,
-    /// The value the bifurcation was searched near.
-    pub near: f64,
-    /// The second key, canonical.
-    pub param2: String,
-    /// The second key's range.
-    pub from2: f64,
-    /// The second key's range.
-    pub to2: f64,
-    /// Period of the orbits, in excitation periods.
-    pub period: u32,
-    /// Grazing curves: the contact, 1-based.
-    pub contact: Option<usize>,
-    /// Where the bifurcation was located on the branch at `from2`.
-    pub located: f64,
-    /// The width of that location's bracket.
-    pub located_precision: f64,
-    /// Points on the curve.
-    pub points: usize,
-    /// Why the curve ended.
-    pub end: String,
-    /// The codimension-two points (also in codim2.csv).
-    pub codim2: Vec<Codim2Record>,
-    /// Search window, relative.
-    pub window: f64,
-    /// Transient periods at `near`.
-    pub transient_periods: u32,
-    /// Most points.
-    pub max_points: usize,
-    /// Whether the power was left out.
-    pub mechanics_only: bool,
-    /// The configuration.
-    pub settings: serde_json::Value,
-    /// The program's version.
-    pub vibrotribo_version: String,
-}
-
-/// One codimension-two point in `curve.json`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Codim2Record {
-    /// `grazing`, `sequence_change` or `meets_KIND`.
-    pub kind: String,
-    /// The first parameter.
-    pub param: f64,
-    /// The second parameter.
-    pub param2: f64,
-    /// Width of the bracket, scaled parameters.
-    pub precision: f64,
-    /// Grazing: the contact, 1-based.
-    pub contact: Option<usize>,
-    /// Multipliers as [re, im].
-    pub multipliers: Vec<[f64; 2]>,
 }
 
 /// Runs `vibrotribo curve`.
@@ -319,7 +257,7 @@ fn write_files(
     }
     codim.flush()?;
     let manifest = CurveManifest {
-        command: "curve".into(),
+        command: Kind::Curve,
         kind: c.kind.name().into(),
         param: r.key.clone(),
         near: args.near,
@@ -340,5 +278,5 @@ fn write_files(
         settings: serde_json::to_value(config.table())?,
         vibrotribo_version: env!("CARGO_PKG_VERSION").into(),
     };
-    write_json(&dir.join("curve.json"), &serde_json::to_value(&manifest)?)
+    crate::manifest::write(&dir.join("curve.json"), &manifest)
 }

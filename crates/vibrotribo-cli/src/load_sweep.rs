@@ -9,7 +9,7 @@ use vibrotribo::study::{LoadStudyOptions, load_study};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::manifest::{LoadSweepManifest, MarginRecord, read, to_value};
+use crate::manifest::{Kind, LoadSweepManifest, MarginRecord, read, to_value};
 use crate::output::{CsvFile, column, create_dir, read_csv, si, write_json};
 use crate::plot::{self, both};
 use crate::progress::{Interrupted, Progress, Watch};
@@ -161,6 +161,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
         }
         vq.flush()?;
         let manifest = LoadSweepManifest {
+            command: Kind::LoadSweep,
             optimum: best,
             optimum_at_edge: sweep.optimum_at_edge,
             configured_load_ohm: configured,
@@ -172,7 +173,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
             transient_periods: spec.transient_periods,
             harvester,
             settings: serde_json::to_value(config.table())?,
-            base_motion: vibrotribo::report::base_motion_json(&config, &spec),
+            base_motion: vibrotribo::report::BaseMotionSummary::of(&config, &spec),
         };
         write_json(&dir.join("load_sweep.json"), &to_value(&manifest)?)?;
         if args.plot {

@@ -9,7 +9,7 @@ use vibrotribo::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use vibrotribo::study::{Ending, lyapunov_spectrum};
 
 use crate::config::ConfigArgs;
-use crate::manifest::{LyapunovManifest, RunningRecord, finite, finite_all, read, to_value};
+use crate::manifest::{Kind, LyapunovManifest, RunningRecord, finite, finite_all, read, to_value};
 use crate::output::{create_dir, write_json};
 use crate::plot::{self, Figure, Legend, Series};
 use crate::progress::{Interrupted, Progress, Watch};
@@ -141,6 +141,7 @@ fn manifest(
     config: &vibrotribo::config::Config,
 ) -> Result<LyapunovManifest> {
     Ok(LyapunovManifest {
+        command: Kind::Lyapunov,
         exponents: finite_all(&s.exponents),
         spread: finite_all(&s.spread),
         periods: s.periods,

@@ -1,95 +1,34 @@
 //! The manifests of output directories, each a serde type written and read through that one
-//! type, and what a directory holds, told by its manifest's `command` (its kind).
+//! type, and what a directory holds, told by its manifest's `command` (its [`Kind`]).
 //!
 //! A grid job's manifest (`sweep.json`, `map.json`) is its settings; the job machinery
 //! ([`crate::job`]) adds the progress keys `complete`, `done` and `rows` when it writes it,
 //! and the types here ignore them when they read it.
+//!
+//! A command's manifest type lives in its own file here (grid jobs in `grid.rs`, `curve` in
+//! `curve.rs`, `bifmap` in `bifmap.rs`, `response` and `band-response` in `response.rs`, the others in `commands.rs`); its kind is a [`Kind`] and a line of the table
+//! in `kind.rs`, and `plot DIR` draws it by that kind (`plots.rs`).
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
+use serde::Serialize;
 use serde::de::DeserializeOwned;
-use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use vibrotribo::config::Config;
-use vibrotribo::study::{PointOptions, SettleMode};
-use vibrotribo::sweep::Continuation;
 
 mod bifmap;
 mod commands;
+mod curve;
+mod grid;
+mod kind;
 mod response;
 
 pub use bifmap::*;
 pub use commands::*;
+pub use curve::{Codim2Record, CurveManifest};
+pub use grid::{Axis, MapManifest, SettleRecord, ShardRecord, SweepManifest, base_motion_of};
+pub use kind::{Kind, kind_of, shard_kind};
 pub use response::*;
-
-/// What an output directory holds: the command that wrote it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Kind {
-    /// `vibrotribo sweep` (`sweep.json`).
-    Sweep,
-    /// `vibrotribo map` (`map.json`).
-    Map,
-    /// `vibrotribo basins` (`basins.json`).
-    Basins,
-    /// `vibrotribo attractors` (`attractors.json`).
-    Attractors,
-    /// `vibrotribo chirp` (`chirp.json`).
-    Chirp,
-    /// `vibrotribo continue` (`continue.json`).
-    Continue,
-    /// `vibrotribo lyapunov` (`lyapunov.json`, which names no command).
-    Lyapunov,
-    /// `vibrotribo simulate` (`summary.json` beside `trajectory.csv`; it names no command).
-    Simulate,
-    /// `vibrotribo load-sweep` (`load_sweep.json`, which names no command).
-    #[serde(rename = "load-sweep")]
-    LoadSweep,
-    /// `vibrotribo periodic` (`periodic.json`, which names no command).
-    Periodic,
-    /// `vibrotribo optimize-mass-ratio` (`fit.json` beside `optimum.csv`; it names no command).
-    #[serde(rename = "optimize-mass-ratio")]
-    OptimizeMassRatio,
-    /// `vibrotribo optimize` (`optimize.json`, which names no command).
-    Optimize,
-    /// `vibrotribo response` (`response.json`).
-    Response,
-    /// `vibrotribo band-response` (`band_response.json`).
-    #[serde(rename = "band-response")]
-    BandResponse,
-    /// `vibrotribo bifmap` (`bifmap.json`).
-    Bifmap,
-}
-
-/// The manifests that name no command, by file name, with a data file that must sit beside.
-const NAMED_MANIFESTS: [(&str, &str, Kind); 6] = [
-    ("lyapunov.json", "lyapunov.json", Kind::Lyapunov),
-    ("load_sweep.json", "load_sweep.csv", Kind::LoadSweep),
-    ("periodic.json", "periodic.json", Kind::Periodic),
-    ("fit.json", "optimum.csv", Kind::OptimizeMassRatio),
-    ("optimize.json", "evaluations.jsonl", Kind::Optimize),
-    ("summary.json", "trajectory.csv", Kind::Simulate),
-];
-
-/// The manifests that name their command, by file name.
-const COMMAND_MANIFESTS: [(&str, Kind); 9] = [
-    ("sweep.json", Kind::Sweep),
-    ("map.json", Kind::Map),
-    ("basins.json", Kind::Basins),
-    ("attractors.json", Kind::Attractors),
-    ("chirp.json", Kind::Chirp),
-    ("continue.json", Kind::Continue),
-    ("response.json", Kind::Response),
-    ("band_response.json", Kind::BandResponse),
-    ("bifmap.json", Kind::Bifmap),
-];
-
-/// The kind field every command manifest opens with.
-#[derive(Debug, Deserialize)]
-struct Head {
-    command: Option<Kind>,
-}
 
 /// Reads the manifest `path` as `T`; the error names the file and the key at fault.
 pub fn read<T: DeserializeOwned>(path: &Path) -> Result<T> {
@@ -97,261 +36,17 @@ pub fn read<T: DeserializeOwned>(path: &Path) -> Result<T> {
     serde_json::from_str(&text).with_context(|| format!("{} is not a valid manifest", path.display()))
 }
 
-/// What `dir` holds, from the `command` of its manifest (`None`: no vibrotribo results). A
-/// manifest whose command is missing or disagrees with its file name is an error.
-pub fn kind_of(dir: &Path) -> Result<Option<Kind>> {
-    for (file, expected) in COMMAND_MANIFESTS {
-        let path = dir.join(file);
-        if !path.exists() {
-            continue;
-        }
-        let head: Head = read(&path)?;
-        return match head.command {
-            Some(kind) if kind == expected => Ok(Some(kind)),
-            Some(kind) => bail!(
-                "{} names the command {kind:?}, not the one that writes {file}",
-                path.display()
-            ),
-            None => bail!(
-                "{} names no command: it is not a vibrotribo manifest",
-                path.display()
-            ),
-        };
-    }
-    Ok(NAMED_MANIFESTS
-        .iter()
-        .find(|(file, beside, _)| dir.join(file).exists() && dir.join(beside).exists())
-        .map(|(_, _, kind)| *kind))
+/// Reads the manifest of the `kind` directory `dir` as `T`.
+pub fn read_of<T: DeserializeOwned>(dir: &Path, kind: Kind) -> Result<T> {
+    read(&dir.join(kind.manifest()))
 }
 
-fn is_false(b: &bool) -> bool {
-    !*b
-}
-
-/// A shard of a grid job (`--shard I/N`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct ShardRecord {
-    /// This slice, 0 ≤ index < count.
-    pub index: usize,
-    /// Number of slices.
-    pub count: usize,
-}
-
-/// How each point settled before its recorded window.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct SettleRecord {
-    /// `auto` or `fixed`.
-    #[serde(default)]
-    pub settle: String,
-    /// `auto`: most periods run before the recorded window.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settle_cap_periods: Option<u64>,
-    /// `auto`: periods between two checks of the motion.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settle_block_periods: Option<u64>,
-    /// `auto`: whether a geometric approach is finished by Newton shooting.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settle_newton: Option<bool>,
-}
-
-impl SettleRecord {
-    /// The settling of `options`.
-    pub fn of(options: &PointOptions) -> Self {
-        let auto = match &options.settle {
-            SettleMode::Auto(a) => Some(a),
-            SettleMode::Fixed => None,
-        };
-        SettleRecord {
-            settle: options.settle.as_str().to_string(),
-            settle_cap_periods: auto.map(|a| a.cap_periods),
-            settle_block_periods: auto.map(|a| a.block),
-            settle_newton: auto.map(|a| a.shoot),
-        }
-    }
-}
-
-/// The base motion of `config` when it is not the chain's own harmonic (kind, how it was run,
-/// spline accuracy, record scaling).
-pub fn base_motion_of(config: &Config) -> Option<Value> {
-    vibrotribo::report::base_motion_json(config, &config.run_spec(true))
-}
-
-/// `sweep.json`: everything that determines a sweep's output.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SweepManifest {
-    /// Always [`Kind::Sweep`].
-    pub command: Kind,
-    /// The swept key.
-    pub param: String,
-    /// First value.
-    #[serde(default)]
-    pub from: f64,
-    /// Last value.
-    #[serde(default)]
-    pub to: f64,
-    /// Number of values.
-    #[serde(default)]
-    pub steps: usize,
-    /// The values, in grid order.
-    pub values: Vec<f64>,
-    /// How the values start.
-    #[serde(default)]
-    pub continuation: Continuation,
-    /// Transient periods per value.
-    #[serde(default)]
-    pub transient_periods: u64,
-    /// Recorded periods per value.
-    #[serde(default)]
-    pub recorded_periods: u64,
-    /// Relative tolerance of the period detection.
-    #[serde(default)]
-    pub period_tolerance: f64,
-    /// Longest period detected, in excitation periods.
-    #[serde(default)]
-    pub max_period_detected: usize,
-    /// Grazing threshold of the closing speed, relative.
-    #[serde(default)]
-    pub grazing_ratio: f64,
-    /// Periods the charge solver warms up over before its recorded window.
-    #[serde(default)]
-    pub electrical_warmup_periods: u64,
-    /// Mechanics only (no harvester).
-    #[serde(default)]
-    pub mechanics_only: bool,
-    /// The shard, if the job is one.
-    #[serde(default)]
-    pub shard: Option<ShardRecord>,
-    /// The configuration (the library's document).
-    #[serde(default)]
-    pub settings: Value,
-    /// The program's version.
-    #[serde(default)]
-    pub vibrotribo_version: String,
-    /// Whether `summary.csv` has the Floquet column.
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub floquet: bool,
-    /// How each value settled.
-    #[serde(flatten)]
-    pub settle: SettleRecord,
-    /// The base motion, when it is not the chain's own harmonic.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<Value>,
-    /// Whether `summary.csv` has the Lyapunov columns.
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub lyapunov: bool,
-}
-
-/// One axis of a map.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Axis {
-    /// The key along this axis.
-    pub param: String,
-    /// First value.
-    #[serde(default)]
-    pub from: f64,
-    /// Last value.
-    #[serde(default)]
-    pub to: f64,
-    /// Number of values.
-    #[serde(default)]
-    pub steps: usize,
-    /// The values, in grid order.
-    pub values: Vec<f64>,
-}
-
-/// `map.json`: everything that determines a map's output.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MapManifest {
-    /// Always [`Kind::Map`].
-    pub command: Kind,
-    /// The x axis.
-    pub x: Axis,
-    /// The y axis.
-    pub y: Axis,
-    /// Transient periods per point.
-    #[serde(default)]
-    pub transient_periods: u64,
-    /// Recorded periods per point.
-    #[serde(default)]
-    pub recorded_periods: u64,
-    /// Relative tolerance of the period detection.
-    #[serde(default)]
-    pub period_tolerance: f64,
-    /// Mechanics only (no harvester).
-    #[serde(default)]
-    pub mechanics_only: bool,
-    /// The shard, if the job is one.
-    #[serde(default)]
-    pub shard: Option<ShardRecord>,
-    /// The configuration (the library's document).
-    #[serde(default)]
-    pub settings: Value,
-    /// Whether `map.csv` has the Floquet column.
-    #[serde(default, skip_serializing_if = "is_false")]
-    pub floquet: bool,
-    /// How each point settled.
-    #[serde(flatten)]
-    pub settle: SettleRecord,
-    /// The base motion, when it is not the chain's own harmonic.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<Value>,
+/// Writes the manifest `manifest` to `path` (pretty JSON, atomically).
+pub fn write<T: Serialize>(path: &Path, manifest: &T) -> Result<()> {
+    crate::output::write_json(path, &to_value(manifest)?)
 }
 
 /// The manifest of a directory as the JSON value the job machinery writes.
 pub fn to_value<T: Serialize>(manifest: &T) -> Result<Value> {
     serde_json::to_value(manifest).context("cannot write the manifest")
-}
-
-/// The kind of the job whose first shard is `first`, for `merge`.
-pub fn shard_kind(first: &Path) -> Result<Kind> {
-    match kind_of(first)? {
-        Some(kind @ (Kind::Sweep | Kind::Map | Kind::Basins)) => Ok(kind),
-        _ => bail!(
-            "{} holds no shard of a sweep, map or basins job (no sweep.json, map.json or basins.json)",
-            first.display()
-        ),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A manifest as `sweep` wrote it with `json!` (the keys in their order), read and
-    /// written back through the type, gives the same text.
-    #[test]
-    fn sweep_manifest_round_trips_byte_for_byte() {
-        let text = r#"{"command":"sweep","param":"omega_ratio","from":0.5,"to":1.0,"steps":2,"values":[0.5,1.0],"continuation":"none","transient_periods":200,"recorded_periods":50,"period_tolerance":0.0001,"max_period_detected":32,"grazing_ratio":0.001,"electrical_warmup_periods":20,"mechanics_only":true,"shard":null,"settings":{"oscillator":{"gaps":[0.02,0.02]}},"vibrotribo_version":"0.1.0","settle":"auto","settle_cap_periods":2000,"settle_block_periods":50,"settle_newton":true}"#;
-        let m: SweepManifest = serde_json::from_str(text).expect("a sweep manifest");
-        assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
-        let fixed = text.replace(
-            r#""settle":"auto","settle_cap_periods":2000,"settle_block_periods":50,"settle_newton":true"#,
-            r#""floquet":true,"settle":"fixed","base_motion":{"kind":"chirp"},"lyapunov":true"#,
-        );
-        let m: SweepManifest = serde_json::from_str(&fixed).expect("a sweep manifest");
-        assert!(m.floquet && m.lyapunov && m.settle.settle_cap_periods.is_none());
-        assert_eq!(serde_json::to_string(&m).expect("serialises"), fixed);
-    }
-
-    #[test]
-    fn map_manifest_round_trips_byte_for_byte() {
-        let text = r#"{"command":"map","x":{"param":"omega_ratio","from":0.5,"to":1.0,"steps":2,"values":[0.5,1.0]},"y":{"param":"mass_ratio","from":1.0,"to":3.0,"steps":2,"values":[1.0,3.0]},"transient_periods":200,"recorded_periods":50,"period_tolerance":0.0001,"mechanics_only":false,"shard":{"index":1,"count":4},"settings":{},"settle":"fixed"}"#;
-        let m: MapManifest = serde_json::from_str(text).expect("a map manifest");
-        assert_eq!(m.shard, Some(ShardRecord { index: 1, count: 4 }));
-        assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
-    }
-
-    #[test]
-    fn a_directory_is_told_by_its_manifests_command() {
-        let dir = tempfile::tempdir().expect("a temporary directory");
-        assert_eq!(kind_of(dir.path()).expect("readable"), None);
-        std::fs::write(dir.path().join("map.json"), r#"{"command":"map","x":{}}"#).expect("written");
-        assert_eq!(kind_of(dir.path()).expect("readable"), Some(Kind::Map));
-        // A file name that disagrees with its command, or no command at all, is refused.
-        std::fs::write(dir.path().join("map.json"), r#"{"command":"sweep"}"#).expect("written");
-        let e = kind_of(dir.path()).expect_err("a sweep manifest named map.json");
-        assert!(e.to_string().contains("map.json"), "{e}");
-        std::fs::write(dir.path().join("map.json"), r#"{"x":1}"#).expect("written");
-        assert!(kind_of(dir.path()).is_err());
-    }
 }

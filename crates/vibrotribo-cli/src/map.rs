@@ -493,6 +493,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
         }
         o.flush()?;
         let manifest = FitManifest {
+            command: Kind::OptimizeMassRatio,
             fit: fit.as_ref().map(|f| FitRecord {
                 a: f.a,
                 b: f.b,

@@ -25,9 +25,9 @@ pub fn write_boundary(dir: &Path, points: &[BoundaryPoint]) -> Result<()> {
 }
 
 /// Draws `vq_cycle.png/.svg` of a `simulate` directory with a harvester: the run's V–Q
-/// trajectory after the transient, the CMEO cycle of summary.json and the breakdown boundary;
+/// trajectory after the transient, the CMEO cycle `cmeo_cycle` (summary.json's) and the breakdown boundary;
 /// nothing where the directory holds no boundary (a run without a harvester).
-pub fn plot_vq(dir: &Path, summary: &serde_json::Value, transient_s: f64) -> Result<()> {
+pub fn plot_vq(dir: &Path, cmeo_cycle: Option<&[[f64; 2]; 4]>, transient_s: f64) -> Result<()> {
     let boundary = dir.join("breakdown_boundary.csv");
     if !boundary.exists() {
         return Ok(());
@@ -49,14 +49,7 @@ pub fn plot_vq(dir: &Path, summary: &serde_json::Value, transient_s: f64) -> Res
         edge("q_high_c")?,
         edge("v_high_v")?,
     );
-    let corners: Vec<[f64; 2]> = summary["merit"]["cmeo_cycle_vq"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(|p| Some([p.get(0)?.as_f64()?, p.get(1)?.as_f64()?]))
-                .collect()
-        })
-        .unwrap_or_default();
+    let corners: &[[f64; 2]] = cmeo_cycle.map_or(&[], |c| c.as_slice());
     let mut cq: Vec<f64> = corners.iter().map(|c| c[0]).collect();
     let mut cv: Vec<f64> = corners.iter().map(|c| c[1]).collect();
     if let (Some(&q0), Some(&v0)) = (cq.first(), cv.first()) {

@@ -14,6 +14,7 @@ use vibrotribo::optimize::{
 };
 
 use crate::config::ConfigArgs;
+use crate::manifest::Kind;
 use crate::output::{create_dir, si, write_atomic, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
 use crate::progress::{Interrupted, Progress, interrupted};
@@ -97,6 +98,8 @@ struct VariableEntry {
 /// `optimize.json`.
 #[derive(Debug, Serialize)]
 struct Manifest {
+    /// Always [`Kind::Optimize`].
+    command: Kind,
     /// The varied keys and their best values.
     best: serde_json::Map<String, serde_json::Value>,
     /// The best design's objective.
@@ -235,6 +238,7 @@ pub fn run(args: &OptimizeArgs) -> Result<()> {
         best_map.insert(v.key.clone(), serde_json::json!(value));
     }
     let manifest = Manifest {
+        command: Kind::Optimize,
         best: best_map,
         objective: best.objective,
         objective_name: objective,

@@ -143,6 +143,20 @@ impl Fields<'_> {
     }
 }
 
+/// Writes a CSV file of the header `names` and the rows `rows` of the library's table writer
+/// (each cell a CSV field).
+pub fn write_rows(
+    path: &Path,
+    names: &[impl AsRef<str>],
+    rows: impl IntoIterator<Item = Vec<vibrotribo::sweep::Cell>>,
+) -> Result<()> {
+    let mut csv = CsvFile::create(path, names)?;
+    for row in rows {
+        csv.row(row)?;
+    }
+    csv.flush()
+}
+
 /// Writes `value` as pretty JSON to `path`, atomically: a reader (or a later run after a
 /// kill) sees either the old file or the new one, never a part of one.
 pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {

@@ -13,7 +13,7 @@ use vibrotribo::study::ElectricalOutcome;
 use vibrotribo::{ChainState, EventKind, Simulator, UniformSampler};
 
 use crate::config::ConfigArgs;
-use crate::manifest::{OrbitEventRecord, PeriodicManifest, config_of, read, to_value};
+use crate::manifest::{Kind, OrbitEventRecord, PeriodicManifest, config_of, read, to_value};
 use crate::output::{create_dir, numbered, si, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
 use crate::progress::{Interrupted, Progress, orbit_cancel};
@@ -186,6 +186,7 @@ fn manifest(
         .collect();
     let p = power.and_then(|p| p.power.as_ref());
     Ok(PeriodicManifest {
+        command: Kind::Periodic,
         period: orbit.period,
         state,
         state_names: numbered("x", orbit.params.len(), "_m")

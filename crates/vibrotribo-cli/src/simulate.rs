@@ -10,6 +10,7 @@ use vibrotribo::config::Config;
 use vibrotribo::electrical::{HarvesterParams, Load, LoadKind, TransducerMode};
 use vibrotribo::excitation::WorkBudget;
 use vibrotribo::merit::MeritWatch;
+use vibrotribo::report::{MeritSummary, RunSummary};
 use vibrotribo::study::{
     Ending, LyapunovSkipped, Motion, MotionReport, RunMotion, RunObserver, RunOutcome, RunSpec, Sample,
     SettleMode, settle, simulate,
@@ -18,15 +19,17 @@ use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si};
 use crate::progress::{Interrupted, Progress, Watch};
+use crate::run_analyses::RunSections;
 
 /// Options of `vibrotribo simulate`.
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
     #[command(flatten)]
     pub input: ConfigArgs,
-    /// Write events.csv, trajectory.csv and summary.json to this directory.
+    /// Write events.csv, trajectory.csv, the Poincaré sections (poincare_strobe.csv,
+    /// poincare_impacts.csv) and summary.json to this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Mechanics only: skip the triboelectric harvester.
@@ -222,9 +225,20 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         )),
         _ => None,
     };
-    let outcome = match files.as_mut() {
-        Some(f) => simulate(&spec, &mut ((f, &mut merit), (&mut watch, run_motion.observer())))?,
-        None => simulate(&spec, &mut (&mut watch, run_motion.observer()))?,
+    // The Poincaré sections, taken by the run's observers and written beside the files.
+    let mut sections = match &files {
+        Some(_) => Some(RunSections::new(&spec)?),
+        None => None,
+    };
+    let outcome = match (files.as_mut(), sections.as_mut()) {
+        (Some(f), Some(s)) => simulate(
+            &spec,
+            &mut (
+                (f, &mut merit),
+                (s.observer(), (&mut watch, run_motion.observer())),
+            ),
+        )?,
+        _ => simulate(&spec, &mut (&mut watch, run_motion.observer()))?,
     };
     watch.progress.finish();
     // A motion under a base motion that is not periodic is not classified (no period).
@@ -251,22 +265,20 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut plotted = Ok(());
     if let (Some(files), Some(dir)) = (files.as_mut(), &args.out) {
         files.flush()?;
-        let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
-        summary["settle"] = json!(args.settle.as_str());
-        if let SettleMode::Auto(a) = &run_motion.options().settle {
-            summary["settle_cap_periods"] = json!(a.cap_periods);
-        }
-        summary["motion"] = vibrotribo::report::motion_json(motion.as_ref());
-        if classification_stopped {
-            summary["interrupted"] = json!(true);
-        }
+        let mut summary = RunSummary::new(&config, &spec, &outcome, elapsed);
+        summary.set_settle(&run_motion.options().settle);
+        summary.set_motion(motion.as_ref());
+        summary.interrupted |= classification_stopped;
         if let Some(w) = &merit {
-            vibrotribo::report::insert_merit(&mut summary, merit_report.as_ref());
+            summary.merit = Some(MeritSummary::of(merit_report.as_ref()));
             crate::merit::write_boundary(dir, w.boundary())?;
         }
-        write_json(&dir.join("summary.json"), &summary)?;
+        if let Some(s) = &sections {
+            s.write(dir)?;
+        }
+        crate::manifest::write(&dir.join("summary.json"), &summary)?;
         if args.plot {
-            plotted = crate::plots::analyze_run(dir, None);
+            plotted = crate::run_analyses::analyze_run(dir, None);
         }
     }
     print_summary(&spec, &outcome, elapsed, args.out.as_deref());
@@ -491,7 +503,7 @@ fn print_summary(spec: &RunSpec, outcome: &RunOutcome, elapsed: f64, out: Option
     }
     if let Some(dir) = out {
         println!(
-            "  wrote {0}/events.csv, {0}/trajectory.csv, {0}/summary.json",
+            "  wrote {0}/events.csv, {0}/trajectory.csv, {0}/poincare_strobe.csv, {0}/poincare_impacts.csv, {0}/summary.json",
             dir.display()
         );
     }

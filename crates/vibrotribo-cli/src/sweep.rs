@@ -23,7 +23,7 @@ use crate::job::{
     estimate_point_output, header_len, point_columns, run_points, set_threads,
 };
 use crate::limits;
-use crate::manifest::{Kind, SettleRecord, ShardRecord, SweepManifest, base_motion_of, to_value};
+use crate::manifest::{Axis, Kind, SettleRecord, ShardRecord, SweepManifest, base_motion_of, to_value};
 use crate::progress::{Interrupted, Progress, interrupted};
 
 /// Options of `vibrotribo sweep`.
@@ -135,11 +135,13 @@ fn manifest(
     let o = runner.options();
     Ok(SweepManifest {
         command: Kind::Sweep,
-        param: args.param.clone(),
-        from: args.from,
-        to: args.to,
-        steps: args.steps,
-        values: values.to_vec(),
+        axis: Axis {
+            param: args.param.clone(),
+            from: args.from,
+            to: args.to,
+            steps: args.steps,
+            values: values.to_vec(),
+        },
         continuation: args.continuation,
         transient_periods: o.transient_periods,
         recorded_periods: o.recorded_periods,
@@ -358,7 +360,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
 /// The keys (`param` values as written) of a sweep's grid from its `sweep.json`.
 fn sweep_keys(settings: &serde_json::Value) -> Result<Vec<String>> {
     let m = SweepManifest::deserialize(settings).context("sweep.json")?;
-    Ok(m.values.iter().map(f64::to_string).collect())
+    Ok(m.axis.values.iter().map(f64::to_string).collect())
 }
 
 /// Combines the shards of one sweep (`vibrotribo merge` of `sweep.json` directories).

@@ -7,6 +7,7 @@ use serde_json::Value;
 use vibrotribo::electrical::breakdown::BreakdownMargin;
 use vibrotribo::electrical::{HarvesterParams, LoadPoint};
 use vibrotribo::model::ChainParams;
+use vibrotribo::report::BaseMotionSummary;
 
 use super::{Axis, Kind, ShardRecord};
 
@@ -91,16 +92,9 @@ pub struct AttractorTolerances {
 pub struct AttractorsManifest {
     /// Always [`Kind::Attractors`].
     pub command: Kind,
-    /// The varied key.
-    pub param: String,
-    /// First value.
-    pub from: f64,
-    /// Last value.
-    pub to: f64,
-    /// Number of values.
-    pub steps: usize,
-    /// The values, in order.
-    pub values: Vec<f64>,
+    /// The varied key and its values (`param`, `from`, `to`, `steps`, `values`).
+    #[serde(flatten)]
+    pub axis: Axis,
     /// Random starts per value.
     pub samples: usize,
     /// Seed of the starts.
@@ -164,7 +158,7 @@ pub struct ChirpRunRecord {
     /// Its jump, if any.
     pub jump: Option<JumpRecord>,
     /// Its base motion, when it is not the chain's own harmonic.
-    pub base_motion: Option<Value>,
+    pub base_motion: Option<BaseMotionSummary>,
 }
 
 /// The hysteresis of a chirp: the up and down jumps.
@@ -317,6 +311,23 @@ pub struct ContinueManifest {
     pub vibrotribo_version: String,
 }
 
+/// The kinds of the manifests that earlier versions wrote without a `command`.
+fn load_sweep() -> Kind {
+    Kind::LoadSweep
+}
+
+fn periodic() -> Kind {
+    Kind::Periodic
+}
+
+fn optimize_mass_ratio() -> Kind {
+    Kind::OptimizeMassRatio
+}
+
+fn lyapunov() -> Kind {
+    Kind::Lyapunov
+}
+
 /// What a manifest without a `complete` key describes: a finished job.
 fn finished() -> bool {
     true
@@ -334,6 +345,9 @@ pub struct MarginRecord {
 /// `load_sweep.json`: the optimal load and the sweep.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LoadSweepManifest {
+    /// Always [`Kind::LoadSweep`] (files without the key read as such).
+    #[serde(default = "load_sweep")]
+    pub command: Kind,
     /// The best load.
     pub optimum: LoadPoint,
     /// Whether the best grid point is at an end of the range.
@@ -358,7 +372,7 @@ pub struct LoadSweepManifest {
     pub settings: Value,
     /// The base motion, when it is not the chain's own harmonic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<Value>,
+    pub base_motion: Option<BaseMotionSummary>,
 }
 
 /// One event of a periodic orbit.
@@ -379,6 +393,9 @@ pub struct OrbitEventRecord {
 /// `periodic.json`: a periodic orbit, its stability and power.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PeriodicManifest {
+    /// Always [`Kind::Periodic`] (files without the key read as such).
+    #[serde(default = "periodic")]
+    pub command: Kind,
     /// Period in excitation periods.
     pub period: u32,
     /// State at t ≡ 0 (mod T): positions (m) then velocities (m/s).
@@ -454,6 +471,9 @@ pub struct PaperFitRecord {
 /// `fit.json` (`optimize-mass-ratio`): the optima and their quadratic fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitManifest {
+    /// Always [`Kind::OptimizeMassRatio`] (files without the key read as such).
+    #[serde(default = "optimize_mass_ratio")]
+    pub command: Kind,
     /// The fit to the optima.
     pub fit: Option<FitRecord>,
     /// The paper's fit.
@@ -493,6 +513,9 @@ pub struct RunningRecord {
 /// convergence and the settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LyapunovManifest {
+    /// Always [`Kind::Lyapunov`] (files without the key read as such).
+    #[serde(default = "lyapunov")]
+    pub command: Kind,
     /// The exponents, 1/s, largest first.
     pub exponents: Vec<Option<f64>>,
     /// Their batch-means standard errors, 1/s.
@@ -595,7 +618,7 @@ mod tests {
     #[test]
     fn lyapunov_manifest_round_trips_byte_for_byte() {
         let m = round_trips::<LyapunovManifest>(
-            r#"{"exponents":[-3.1202438773260632,null],"spread":[1.6395797461760684,1.6395797461762882],"periods":20,"time_s":1.0260398641294914,"largest":-3.1202438773260632,"largest_spread":1.6395797461760684,"sum":-10.658815658780885,"kaplan_yorke_dimension":0.0,"collapsed":0,"skipped_periods":0,"non_smooth_count":0,"non_smooth":[],"reorthonormalisations":30,"batches":[[1.4302536848834018,-12.089069343665027]],"running":[{"periods":5,"exponents":[1.4302536848834018,-12.089069343665027]}],"transient_periods":10,"seed":1,"interrupted":false,"settings":{}}"#,
+            r#"{"command":"lyapunov","exponents":[-3.1202438773260632,null],"spread":[1.6395797461760684,1.6395797461762882],"periods":20,"time_s":1.0260398641294914,"largest":-3.1202438773260632,"largest_spread":1.6395797461760684,"sum":-10.658815658780885,"kaplan_yorke_dimension":0.0,"collapsed":0,"skipped_periods":0,"non_smooth_count":0,"non_smooth":[],"reorthonormalisations":30,"batches":[[1.4302536848834018,-12.089069343665027]],"running":[{"periods":5,"exponents":[1.4302536848834018,-12.089069343665027]}],"transient_periods":10,"seed":1,"interrupted":false,"settings":{}}"#,
         );
         // A −∞ exponent (a direction collapsed by sticking) is written null.
         assert_eq!(m.exponents, [Some(-3.1202438773260632), None]);
@@ -605,21 +628,36 @@ mod tests {
     #[test]
     fn load_sweep_manifest_round_trips_byte_for_byte() {
         round_trips::<LoadSweepManifest>(
-            r#"{"optimum":{"resistance_ohm":13550799443.411295,"average_power_w":3.127041765618578e-6,"energy_per_period_j":5.613652250477589e-7},"optimum_at_edge":false,"configured_load_ohm":100000.0,"configured_average_power_w":5.468294720027476e-11,"power_ratio_configured_to_optimum":0.00001748711763351124,"air_breakdown_last_period":[{"load_resistance_ohm":100000.0,"air_breakdown":{"worst_ratio":0.5233797000480489,"time_s":1.045750819267165,"gap":1,"gap_voltage_v":33878.99451676965,"gap_m":0.019826468931647315}}],"points":[{"resistance_ohm":1000.0,"average_power_w":5.468303763963152e-13,"energy_per_period_j":9.81667596140803e-14}],"periods":6,"transient_periods":2,"harvester":{"mode":"freestanding","voc_model":"paper","contact":0,"area":0.01,"charge_density":0.000015,"dielectric_thickness":[0.0001,0.0001],"relative_permittivity":[2.0,2.0],"load":"resistor","load_resistance":100000.0,"storage_capacitance":1e-6,"storage_load_resistance":null,"storage_initial_voltage":0.0,"target_voltage":null,"initial_charge":null,"coupling":"one_way","coupling_tolerance":1e-11,"diode_saturation_current":2.52e-9,"diode_ideality":1.752,"diode_series_resistance":0.568,"diode_thermal_voltage":0.025864917007157463,"diode_parallel_conductance":0.0},"settings":{},"base_motion":{"kind":"record","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"2999","duration_s":"2.999e1","record_scale_factor":"9.8e0","record_peak_acceleration_m_s2":"9.800501213296139e0","baseline_acceleration_offset_m_s2":"8.210046330600539e-4","baseline_acceleration_slope_m_s3":"-5.513643740029047e-5","baseline_relative_size":"8.495276781374053e-5","baseline_removed_displacement_m":"4.425899009433706e-2"}}"#,
+            r#"{"command":"load-sweep","optimum":{"resistance_ohm":13550799443.411295,"average_power_w":3.127041765618578e-6,"energy_per_period_j":5.613652250477589e-7},"optimum_at_edge":false,"configured_load_ohm":100000.0,"configured_average_power_w":5.468294720027476e-11,"power_ratio_configured_to_optimum":0.00001748711763351124,"air_breakdown_last_period":[{"load_resistance_ohm":100000.0,"air_breakdown":{"worst_ratio":0.5233797000480489,"time_s":1.045750819267165,"gap":1,"gap_voltage_v":33878.99451676965,"gap_m":0.019826468931647315}}],"points":[{"resistance_ohm":1000.0,"average_power_w":5.468303763963152e-13,"energy_per_period_j":9.81667596140803e-14}],"periods":6,"transient_periods":2,"harvester":{"mode":"freestanding","voc_model":"paper","contact":0,"area":0.01,"charge_density":0.000015,"dielectric_thickness":[0.0001,0.0001],"relative_permittivity":[2.0,2.0],"load":"resistor","load_resistance":100000.0,"storage_capacitance":1e-6,"storage_load_resistance":null,"storage_initial_voltage":0.0,"target_voltage":null,"initial_charge":null,"coupling":"one_way","coupling_tolerance":1e-11,"diode_saturation_current":2.52e-9,"diode_ideality":1.752,"diode_series_resistance":0.568,"diode_thermal_voltage":0.025864917007157463,"diode_parallel_conductance":0.0},"settings":{},"base_motion":{"kind":"record","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"2999","duration_s":"2.999e1","record_scale_factor":"9.8e0","record_peak_acceleration_m_s2":"9.800501213296139e0","baseline_acceleration_offset_m_s2":"8.210046330600539e-4","baseline_acceleration_slope_m_s3":"-5.513643740029047e-5","baseline_relative_size":"8.495276781374053e-5","baseline_removed_displacement_m":"4.425899009433706e-2"}}"#,
         );
     }
 
     #[test]
     fn periodic_manifest_round_trips_byte_for_byte() {
         round_trips::<PeriodicManifest>(
-            r#"{"period":1,"state":[-0.005571166234713745,-0.37889805643949115],"state_names":["x1_m","v1_m_s"],"multipliers":[[-0.15564532462113567,-0.7446897601001882],[-0.15564532462113567,0.7446897601001882]],"multiplier_moduli":[0.7607813785014027,0.7607813785014027],"stable":true,"unstable_dimension":0,"impacts_per_period":1.0,"impacts_per_period_by_contact":[0.0,1.0],"impacts_per_orbit":1,"min_closing_speed_m_s":0.31634845380098503,"min_closing_speed_contact":2,"sticks":false,"average_power_w":null,"energy_per_period_j":null,"residual":7.079712701691433e-14,"residual_history":[7.079712701691433e-14],"events":[{"time_s":0.036188481991832194,"kind":"impact","contact":2,"rel_velocity_m_s":0.31634845380098503,"rel_velocity_after_m_s":0.2530787630407881}],"excitation_period_s":0.051301993206474564,"omega_ratio":2.5,"parameters":{"masses":[0.05],"stiffness":[120.0],"damping":[0.09798],"gaps":[],"restitution":0.6,"excitation":{"amplitude":0.01,"frequency":{"omega_ratio":2.5}},"stops":{"upper":{"gap":0.0,"restitution":0.8,"frame":"fixed"}}},"settings":{}}"#,
+            r#"{"command":"periodic","period":1,"state":[-0.005571166234713745,-0.37889805643949115],"state_names":["x1_m","v1_m_s"],"multipliers":[[-0.15564532462113567,-0.7446897601001882],[-0.15564532462113567,0.7446897601001882]],"multiplier_moduli":[0.7607813785014027,0.7607813785014027],"stable":true,"unstable_dimension":0,"impacts_per_period":1.0,"impacts_per_period_by_contact":[0.0,1.0],"impacts_per_orbit":1,"min_closing_speed_m_s":0.31634845380098503,"min_closing_speed_contact":2,"sticks":false,"average_power_w":null,"energy_per_period_j":null,"residual":7.079712701691433e-14,"residual_history":[7.079712701691433e-14],"events":[{"time_s":0.036188481991832194,"kind":"impact","contact":2,"rel_velocity_m_s":0.31634845380098503,"rel_velocity_after_m_s":0.2530787630407881}],"excitation_period_s":0.051301993206474564,"omega_ratio":2.5,"parameters":{"masses":[0.05],"stiffness":[120.0],"damping":[0.09798],"gaps":[],"restitution":0.6,"excitation":{"amplitude":0.01,"frequency":{"omega_ratio":2.5}},"stops":{"upper":{"gap":0.0,"restitution":0.8,"frame":"fixed"}}},"settings":{}}"#,
         );
+    }
+
+    /// A manifest that an earlier version wrote without its `command` reads as its kind's.
+    #[test]
+    fn manifests_without_a_command_read_as_their_kind() {
+        let m: FitManifest = serde_json::from_str(
+            r#"{"fit":null,"paper_fit":{"a":11.43,"b":-28.46,"c":18.03},"omega_ratio":[],"optimal_mass_ratio":[],"transient_periods":20,"recorded_periods":10,"settings":{}}"#,
+        )
+        .expect("a fit manifest");
+        assert_eq!(m.command, Kind::OptimizeMassRatio);
+        let m: LyapunovManifest = serde_json::from_str(
+            r#"{"exponents":[],"spread":[],"periods":0,"time_s":0.0,"largest":null,"largest_spread":null,"sum":null,"kaplan_yorke_dimension":null,"collapsed":0,"skipped_periods":0,"non_smooth_count":0,"non_smooth":[],"reorthonormalisations":0,"batches":[],"running":[],"transient_periods":0,"seed":1,"interrupted":false,"settings":{}}"#,
+        )
+        .expect("a lyapunov manifest");
+        assert_eq!(m.command, Kind::Lyapunov);
     }
 
     #[test]
     fn fit_manifest_round_trips_byte_for_byte() {
         round_trips::<FitManifest>(
-            r#"{"fit":{"a":-38.248148530029624,"b":46.258965805636095,"c":-8.227063467002559,"r_squared":1.0,"rms_residual":6.409875621278547e-16},"paper_fit":{"a":11.43,"b":-28.46,"c":18.03},"omega_ratio":[0.55,0.75,0.95],"optimal_mass_ratio":[5.6453027957633335,4.9525773390828505,1.2],"transient_periods":20,"recorded_periods":10,"settings":{}}"#,
+            r#"{"command":"optimize-mass-ratio","fit":{"a":-38.248148530029624,"b":46.258965805636095,"c":-8.227063467002559,"r_squared":1.0,"rms_residual":6.409875621278547e-16},"paper_fit":{"a":11.43,"b":-28.46,"c":18.03},"omega_ratio":[0.55,0.75,0.95],"optimal_mass_ratio":[5.6453027957633335,4.9525773390828505,1.2],"transient_periods":20,"recorded_periods":10,"settings":{}}"#,
         );
     }
 }

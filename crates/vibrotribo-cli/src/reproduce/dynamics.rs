@@ -5,11 +5,13 @@
 //! behind Fig. 7's jump, and the expected power of an unknown start across Fig. 20's Ω.
 
 use std::cmp::Ordering;
-use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use vibrotribo::analysis::batch_means_se;
+use vibrotribo::attractors::{
+    AttractorOptions, DEFAULT_START_PERIODS, RandomStarts, SectionScale, StartRunner, basin_points, classify,
+};
 use vibrotribo::config::Config;
 use vibrotribo::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use vibrotribo::study::{PointOptions, PointResult, exponent_sign, lyapunov_spectrum};
@@ -18,10 +20,10 @@ use vibrotribo::sweep::{PointRunner, grid};
 use super::context::{Ctx, Verdict};
 use super::draw::lines;
 use super::runs::{arr, chatter_case, config, f, with};
-use crate::attractors::AttractorsArgs;
-use crate::basins::{BasinsArgs, GridSize};
 use crate::config::ConfigArgs;
-use crate::output::{read_csv, si};
+use crate::job::GridOutput;
+use crate::manifest::{AttractorsManifest, Axis, to_value};
+use crate::output::{create_dir, si, write_json};
 use crate::plot::{Figure, Scale};
 use crate::progress::check_interrupt;
 
@@ -278,49 +280,74 @@ fn power_error_bars(ctx: &mut Ctx) -> Result<()> {
     Ok(())
 }
 
-/// Runs `vibrotribo basins` over x2(0) ∈ `x` and v2(0) ∈ ±3 m/s (m1, m3 at rest) of the
-/// default case with `sets`, into `name/`; returns the grid size and one line per attractor.
+/// The basins over x2(0) ∈ `x` and v2(0) ∈ ±3 m/s (m1, m3 at rest) of the default case with
+/// `sets`, computed by the library ([`StartRunner`], [`classify`]) and written into `name/` as
+/// `vibrotribo basins` writes its directory (its manifest, `starts.csv`, and the tables
+/// `basins.csv`, `attractors.csv` of the one table writer) with its picture; returns the
+/// grid size and one line per attractor.
 fn basins(ctx: &Ctx, name: &str, sets: &[&str], x: (f64, f64)) -> Result<(usize, Vec<String>)> {
     let dir = ctx.path(name);
     let n = if ctx.quick { 24 } else { 60 };
-    let args = BasinsArgs {
-        input: ConfigArgs {
-            config: None,
-            set: sets.iter().map(|s| s.to_string()).collect(),
-        },
-        x: "run.initial_positions[1]".into(),
-        x_from: x.0,
-        x_to: x.1,
-        y: "run.initial_velocities[1]".into(),
-        y_from: -3.0,
-        y_to: 3.0,
-        grid: GridSize { nx: n, ny: n },
-        out: Some(dir.clone()),
-        shard: None,
-        resume: false,
-        plot: true,
-        cell: 0.05,
-        section_tolerance: 1e-3,
+    let base = ConfigArgs {
+        config: None,
+        set: sets.iter().map(|s| s.to_string()).collect(),
+    }
+    .load()?;
+    let options = AttractorOptions {
+        period_tolerance: 1e-3,
         match_tolerance: 3e-3,
-        run: ctx.run_args(true),
+        cell: 0.05,
+        ..AttractorOptions::default()
     };
-    crate::basins::run(&args)?;
-    let (_, rows) = read_csv(&dir.join("attractors.csv"))?;
-    let described = rows
+    let starts = StartRunner::new(
+        ctx.run_args(true).runner_or(base, DEFAULT_START_PERIODS)?,
+        options,
+    )
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (xk, yk) = ("run.initial_positions[1]", "run.initial_velocities[1]");
+    let axis = |param: &str, (from, to): (f64, f64)| Axis {
+        param: param.into(),
+        from,
+        to,
+        steps: n,
+        values: grid(from, to, n),
+    };
+    let (ax, ay) = (axis(xk, x), axis(yk, (-3.0, 3.0)));
+    let points = basin_points(&ax.values, &ay.values);
+    let settings = to_value(&crate::basins::manifest_of(&starts, ax, ay, None)?)?;
+    let mut out = GridOutput::create(&dir, crate::basins::layout(), settings, true)?;
+    let (done, fingerprints) =
+        crate::basins::run_starts(&starts, &points, (xk, yk), 0, true, Some(&mut out))?;
+    out.finish(done == points.len(), done)?;
+    check_interrupt(|| {
+        format!(
+            "after {done} of the {} starts of {name}/; REPORT.md is written only by a complete run",
+            points.len()
+        )
+    })?;
+    let masses = starts.point_runner().base().chain().len();
+    let c = classify(
+        &fingerprints,
+        &SectionScale::of(starts.point_runner().base().chain()),
+        starts.options(),
+    );
+    crate::basins::write_tables(&dir, &points, &fingerprints, &c, masses)?;
+    crate::basins::plot_basins(&dir)?;
+    let described = c
+        .attractors
         .iter()
-        .map(|r| {
-            let get = |i: usize| r.get(i).map_or("", String::as_str);
-            let period = match get(1) {
-                "0" => "non-periodic".to_string(),
-                p => format!("period {p}"),
+        .enumerate()
+        .map(|(a, at)| {
+            let period = if at.period == 0 {
+                "non-periodic".to_string()
+            } else {
+                format!("period {}", at.period)
             };
             format!(
-                "attractor {} ({period}, {} impacts per period): {} of the starts",
-                get(0),
-                get(5).parse::<f64>().map_or("?".into(), |v| format!("{v:.2}")),
-                get(3)
-                    .parse::<f64>()
-                    .map_or("?".into(), |v| format!("{:.0} %", 100.0 * v))
+                "attractor {} ({period}, {:.2} impacts per period): {:.0} % of the starts",
+                a + 1,
+                at.impacts_per_period,
+                100.0 * c.fraction(a).0
             )
         })
         .collect();
@@ -400,26 +427,53 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
         "oscillator.masses=[0.05,0.15,0.05]".to_string(),
         "oscillator.gaps=[0.005,0.005]".to_string(),
     ];
-    let args = AttractorsArgs {
-        input: ConfigArgs { config: None, set },
-        param: "omega_ratio".into(),
-        from: 0.55,
-        to: 0.80,
-        steps,
+    let base = ConfigArgs { config: None, set }.load()?;
+    let options = AttractorOptions {
+        period_tolerance: 1e-3,
+        match_tolerance: 3e-3,
+        cell: 0.05,
+        continuation_distance: 0.25,
+    };
+    let starts = StartRunner::new(
+        ctx.run_args(false).runner_or(base, DEFAULT_START_PERIODS)?,
+        options,
+    )
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (param, range) = ("omega_ratio", (0.55, 0.80));
+    let values = grid(range.0, range.1, steps);
+    let sampling = RandomStarts {
         samples,
         seed: 1,
-        position_range: None,
-        velocity_range: None,
-        out: Some(dir.clone()),
-        plot: true,
-        cell: 0.05,
-        section_tolerance: 1e-3,
-        match_tolerance: 3e-3,
-        continuation_distance: 0.25,
-        run: ctx.run_args(false),
+        bounds: None,
     };
-    crate::attractors::run(&args)?;
-    let (omega, expected, se) = read_expected(&dir.join("expected_power.csv"))?;
+    let manifest = crate::attractors::manifest_of(&starts, param, range, &values, &sampling)?;
+    create_dir(&dir)?;
+    write_json(&dir.join("attractors.json"), &to_value(&manifest)?)?;
+    let masses = starts.point_runner().base().chain().len();
+    let mut files = crate::attractors::CensusFiles::create(&dir, masses)?;
+    let (results, done) =
+        crate::attractors::run_census(&starts, param, &values, &sampling, Some(&mut files), true)?;
+    files.flush()?;
+    write_json(
+        &dir.join("attractors.json"),
+        &to_value(&AttractorsManifest {
+            complete: done == values.len(),
+            done,
+            ..manifest
+        })?,
+    )?;
+    check_interrupt(|| {
+        format!(
+            "after {done} of the {} values of attractors_fig20/; REPORT.md is written only by a complete run",
+            values.len()
+        )
+    })?;
+    crate::attractors::plot_attractors(&dir)?;
+    let omega: Vec<f64> = results.iter().map(|v| v.value).collect();
+    let (expected, se): (Vec<f64>, Vec<f64>) = results
+        .iter()
+        .map(|v| v.expected_power.unwrap_or((f64::NAN, f64::NAN)))
+        .unzip();
     let base = chatter_case()?;
     let from_rest: Vec<f64> = super::runs::sweep(ctx, &base, "omega_ratio", &omega, false)?
         .iter()
@@ -497,28 +551,6 @@ fn start_matters(expected: &[f64], se: &[f64], from_rest: &[f64]) -> Vec<bool> {
 /// every value where the start does not matter it agrees, at none it differs.
 fn one_start_verdict(matters: &[bool]) -> Verdict {
     Verdict::of(matters.iter().filter(|&&m| !m).count(), matters.len())
-}
-
-/// Ω, the expected power and its standard error from `expected_power.csv`.
-fn read_expected(path: &Path) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-    let (header, rows) = read_csv(path)?;
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| h == name)
-            .with_context(|| format!("{} has no column {name}", path.display()))
-    };
-    let (p, e, s) = (
-        col("param")?,
-        col("expected_power_w")?,
-        col("expected_power_se_w")?,
-    );
-    let num = |r: &Vec<String>, i: usize| r.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(f64::NAN);
-    Ok((
-        rows.iter().map(|r| num(r, p)).collect(),
-        rows.iter().map(|r| num(r, e)).collect(),
-        rows.iter().map(|r| num(r, s)).collect(),
-    ))
 }
 
 #[cfg(test)]

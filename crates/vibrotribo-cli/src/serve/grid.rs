@@ -12,7 +12,6 @@ use axum::body::Body;
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 use tokio::sync::mpsc;
 use vibrotribo::analysis::Periodicity;
 use vibrotribo::attractors::{
@@ -141,7 +140,7 @@ struct PointLine {
     x: f64,
     y: Option<f64>,
     strobe: Vec<f64>,
-    motion: Value,
+    motion: Option<vibrotribo::report::MotionRecord>,
     period: Option<usize>,
     average_power_w: Option<f64>,
     impacts_per_period: Option<f64>,
@@ -210,7 +209,7 @@ impl PointLine {
                 x,
                 y,
                 strobe: Vec::new(),
-                motion: Value::Null,
+                motion: None,
                 period: Some(f.period),
                 average_power_w: f.power_w,
                 impacts_per_period: Some(f.impacts_per_period),
@@ -221,7 +220,7 @@ impl PointLine {
                 j,
                 x,
                 y,
-                motion: vibrotribo::report::motion_json(p.motion.as_ref()),
+                motion: p.motion.as_ref().map(vibrotribo::report::MotionRecord::of),
                 period: match p.periodicity {
                     Some(Periodicity::Periodic { period, .. }) => Some(period),
                     _ => None,
@@ -237,7 +236,7 @@ impl PointLine {
                 x,
                 y,
                 strobe: Vec::new(),
-                motion: Value::Null,
+                motion: None,
                 period: None,
                 average_power_w: None,
                 impacts_per_period: None,

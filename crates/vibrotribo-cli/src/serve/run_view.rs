@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
-use serde_json::{Value, json};
+
 use vibrotribo::study::{Ending, RunMotion, RunObserver, Sample, SettleMode, simulate};
 use vibrotribo::{Event, StateView};
 
@@ -74,7 +74,7 @@ pub struct Events {
 #[derive(Debug, Serialize)]
 pub struct RunView {
     /// The run's summary: the object `simulate --out` writes as `summary.json`.
-    pub summary: Value,
+    pub summary: vibrotribo::report::RunSummary,
     /// The average power after the transient, W (`summary.average_power_w`).
     pub average_power_w: Option<f64>,
     /// The samples.
@@ -172,9 +172,8 @@ pub fn run_view(base: &Config, request: &RunRequest, ticket: Ticket) -> Result<R
     let motion = (outcome.ending == Ending::Completed && config.is_periodic())
         .then(|| run_motion.finish(&spec, &outcome.final_state, None));
     let elapsed = started.elapsed().as_secs_f64();
-    let mut summary = vibrotribo::report::run_summary(&config, &spec, &outcome, elapsed);
-    summary["settle"] = json!("fixed");
-    summary["motion"] = vibrotribo::report::motion_json(motion.as_ref());
+    let mut summary = vibrotribo::report::RunSummary::new(&config, &spec, &outcome, elapsed);
+    summary.set_motion(motion.as_ref());
     let average_power_w = outcome
         .electrical
         .as_ref()

@@ -28,6 +28,7 @@ mod resume_checks_files;
 mod serve;
 mod sizes_refused_before_allocation;
 mod stops;
+mod summaries_and_sections;
 mod util;
 
 use std::path::Path;

@@ -242,3 +242,50 @@ fn interrupted_optimal_mass_ratio_names_the_grid_it_kept() {
     assert!(err.contains("power_grid.csv holds the"), "{err}");
     assert!(rows() >= 2);
 }
+
+/// `curve` has no `--plot`: `plot DIR` draws its directory, told by `curve.json`'s command,
+/// the curve of every row of `curve.csv` in the plane of its two keys.
+#[test]
+fn plot_draws_a_bifurcation_curve() {
+    let tmp = tempdir();
+    let dir = tmp.path().join("curve");
+    let io = config_file("impact_oscillator.toml");
+    let o = vibrotribo(&[
+        "curve",
+        io.to_str().unwrap(),
+        "--kind",
+        "period_doubling",
+        "--param",
+        "omega_ratio",
+        "--near",
+        "2.45",
+        "--param2",
+        "oscillator.stops.upper.gap",
+        "--from2",
+        "0.001",
+        "--to2",
+        "0.0012",
+        "--max-points",
+        "5",
+        "--mechanics-only",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "curve: {}", stderr(&o));
+    let o = vibrotribo(&["plot", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "plot of a curve directory: {}", stderr(&o));
+    assert_eq!(
+        pictures(&dir),
+        BTreeSet::from(["curve.png".to_string(), "curve.svg".to_string()])
+    );
+    let rows = std::fs::read_to_string(dir.join("curve.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    let svg = std::fs::read_to_string(dir.join("curve.svg")).unwrap();
+    assert!(
+        svg.contains(&format!("period doubling curve of period 1: {rows} points")),
+        "the picture names another curve than curve.csv's {rows} points"
+    );
+}

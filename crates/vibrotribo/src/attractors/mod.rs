@@ -49,6 +49,8 @@ mod fingerprint;
 #[cfg(feature = "config")]
 mod runs;
 mod starts;
+#[cfg(feature = "config")]
+mod table;
 mod track;
 
 pub use basins::{BasinKeyError, DEFAULT_START_PERIODS, basin_points, initial_condition_index};
@@ -57,4 +59,10 @@ pub use fingerprint::{AttractorOptions, Fingerprint, SectionScale};
 #[cfg(feature = "config")]
 pub use runs::{AcrossDelivery, RandomStarts, StartRunner, ValueAttractors, attractors_across};
 pub use starts::{StartBox, random_start};
+#[cfg(feature = "config")]
+pub use table::{
+    ATTRACTOR_COLUMNS, BASIN_COLUMNS, EXPECTED_POWER_COLUMNS, START_COLUMNS, attractor_cells,
+    basin_attractor_columns, basin_attractor_rows, basin_rows, census_attractor_columns,
+    census_attractor_rows, columns, expected_power_row, start_rows, state_columns, table_of,
+};
 pub use track::AttractorTracker;

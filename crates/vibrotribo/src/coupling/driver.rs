@@ -45,7 +45,7 @@ pub enum CouplingError {
 
 /// Work counters of a coupled run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CouplingStats {
     /// Windows accepted.
     pub windows: u64,

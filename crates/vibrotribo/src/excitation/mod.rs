@@ -44,7 +44,7 @@ pub use pieces::{HarmonicPieces, PIECE_DEGREE, PieceAccuracy, PieceCoefficients,
 pub use random::{MAX_COMPONENTS, Psd, RandomSpec};
 pub use record::{
     BaselineCorrection, MIN_SAMPLES, Quantity, RecordReport, RecordSamples, RecordScaling, parse_record,
-    read_record, record_displacement,
+    read_record, record_displacement, record_reads,
 };
 pub use spline::{EndCondition, PiecewiseCubic, knot_spacing, spline_error_bounds};
 

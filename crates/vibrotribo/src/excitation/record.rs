@@ -2,7 +2,9 @@
 //! integration with a baseline correction for acceleration records, a not-a-knot cubic
 //! spline for displacement records).
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
 
 use super::error::SignalError;
 use super::spline::{EndCondition, PiecewiseCubic};
@@ -64,7 +66,28 @@ pub fn read_record(path: &Path) -> Result<RecordSamples, SignalError> {
         path: shown.clone(),
         message: e.to_string(),
     })?;
+    count_read(path);
     parse_record(&text, &shown)
+}
+
+/// The record files this process has read ([`read_record`]), by canonical path, and how
+/// many times each.
+static READS: Mutex<BTreeMap<PathBuf, u64>> = Mutex::new(BTreeMap::new());
+
+fn count_read(path: &Path) {
+    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut reads = READS.lock().unwrap_or_else(PoisonError::into_inner);
+    *reads.entry(key).or_insert(0) += 1;
+}
+
+/// How many times this process has read the record file `path` with [`read_record`] (paths
+/// compared once made canonical; 0 for a file never read). A configuration reads its record
+/// when it is read, once, and every run made of it (every point of a sweep, every check)
+/// uses those samples: this count shows it.
+pub fn record_reads(path: &Path) -> u64 {
+    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let reads = READS.lock().unwrap_or_else(PoisonError::into_inner);
+    reads.get(&key).copied().unwrap_or(0)
 }
 
 /// [`read_record`] on the text of a file named `path`.

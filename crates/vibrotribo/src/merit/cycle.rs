@@ -233,7 +233,7 @@ impl StateSet {
 
 /// The figures of merit of a run (see the [module](super) docs).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MeritReport {
     /// Energy per cycle of the cycle for maximised energy output over the run's states, J.
     pub cmeo_energy_per_cycle_j: f64,

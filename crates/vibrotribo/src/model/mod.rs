@@ -288,24 +288,36 @@ impl ChainParams {
 
 /// The paper's nondimensional groups derived from a [`ChainParams`].
 #[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NondimGroups {
     /// ζ_i = c_i / (2√(m_i k_i)), dimensionless.
     pub damping_ratios: Vec<f64>,
     /// Ω_i/Ω₁ with Ω_i = √(k_i/m_i), dimensionless.
     pub frequency_ratios: Vec<f64>,
     /// A/δ₁, dimensionless.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "null_as_nan"))]
     pub amplitude_ratio: f64,
     /// Ω = ω/Ω₁, dimensionless.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "null_as_nan"))]
     pub omega_ratio: f64,
     /// R_m = m₂/m₁, dimensionless.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "null_as_nan"))]
     pub mass_ratio: f64,
     /// R_δ = δ₂/δ₁ (None for N = 2), dimensionless.
     pub gap_ratio: Option<f64>,
     /// t_c = √(m₁/k₁), s (τ = t/t_c).
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "null_as_nan"))]
     pub time_scale: f64,
     /// x_c = δ₁, m (X_i = x_i/δ₁).
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "null_as_nan"))]
     pub length_scale: f64,
+}
+
+/// A number written `null` where it is not finite (serde_json writes NaN and ±∞ so), read
+/// back as NaN.
+#[cfg(feature = "serde")]
+fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    <Option<f64> as serde::Deserialize>::deserialize(d).map(|x| x.unwrap_or(f64::NAN))
 }
 
 /// Positions and velocities of all masses.

@@ -63,6 +63,11 @@ use crate::sensitivity::length_scale;
 
 /// The kind of motion of a recorded window (see the module docs of `study/motion.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum Motion {
     /// Repeats with a period.
     Periodic,
@@ -91,6 +96,11 @@ impl Motion {
 
 /// How a periodic label was reached.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum LabelSource {
     /// The run itself repeats within the period tolerance.
     Reached,

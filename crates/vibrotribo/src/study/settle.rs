@@ -117,6 +117,11 @@ impl Default for AutoSettle {
 
 /// How the settling before a recorded window ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "lowercase")
+)]
 pub enum SettleEnding {
     /// A fixed transient ([`SettleMode::Fixed`]).
     Fixed,
