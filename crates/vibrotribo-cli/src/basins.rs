@@ -307,6 +307,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
                 .run(&[(xk, x), (yk, y)], None)
                 .map_err(|e| format!("{e:#}"))
         },
+        |_| false,
         ("starts", skip as u64, points.len() as u64),
         args.run.quiet,
         |d| {

@@ -11,14 +11,14 @@ use vibrotribo::config::Config;
 use vibrotribo::excitation::Sweep;
 use vibrotribo::study::{
     ChirpError, ChirpOptions, ChirpRun, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE, Direction, Ending,
-    run_chirp,
+    PointError, run_chirp,
 };
 
 use crate::config::ConfigArgs;
 use crate::manifest::{ChirpManifest, ChirpRunRecord, HysteresisRecord, JumpRecord, Kind, read, to_value};
 use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
-use crate::progress::{Interrupted, Progress, Watch};
+use crate::progress::{Interrupted, Progress, Watch, orbit_cancel};
 
 /// `--sweep`: how the frequency moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -113,6 +113,7 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         settled_start: !args.from_rest,
         samples_per_cycle: args.samples_per_cycle,
         jump_window: args.jump_window,
+        cancel: orbit_cancel(),
     };
     // Both configurations first: a bad option fails before anything runs.
     let mut periods = 0;
@@ -129,7 +130,13 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
     };
     let mut runs = Vec::new();
     for d in [Direction::Up, Direction::Down] {
-        let r = run_chirp(&config, &options, d, &mut watch).map_err(option_error)?;
+        let r = match run_chirp(&config, &options, d, &mut watch) {
+            Ok(r) => r,
+            // Stopped by a signal while settling at the start frequency: the chirps done are
+            // kept (none for the up chirp).
+            Err(ChirpError::Settle { source, .. }) if matches!(*source, PointError::Stopped { .. }) => break,
+            Err(e) => return Err(option_error(e)),
+        };
         let stop = r.outcome.ending != Ending::Completed;
         runs.push(r);
         if stop {
@@ -160,10 +167,10 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         }
     }
     if runs.len() < 2 || runs.iter().any(|r| r.outcome.ending == Ending::Stopped) {
+        let completed = runs.iter().filter(|r| r.outcome.ending == Ending::Completed).count();
         return Err(Interrupted {
             what: format!(
-                "after {} of {} chirps{}",
-                runs.len().saturating_sub(1),
+                "after {completed} of {} chirps{}",
                 2,
                 if args.out.is_some() {
                     "; the files hold the cycles completed, chirp.json says \"complete\": false"
@@ -181,7 +188,7 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
     let chain = config.chain();
     let hz = chain.omega() / chain.omega_ratio() / std::f64::consts::TAU;
     println!(
-        "vibrotribo chirp: {} masses, Ω from {} to {} ({:.4} to {:.4} Hz), {} s each way ({}), amplitude {} m",
+        "vibrotribo chirp: {} masses, Ω from {} to {} ({:.4} to {:.4} Hz), {} s each way ({}), amplitude {}",
         chain.len(),
         options.from,
         options.to,
@@ -189,7 +196,8 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
         options.to * hz,
         options.duration_s,
         sweep_name(options.sweep),
-        runs.first().map_or(f64::NAN, |r| r.chirp.amplitude),
+        runs.first()
+            .map_or("not reached (no chirp ran)".to_string(), |r| format!("{} m", r.chirp.amplitude)),
     );
     for r in runs {
         match &r.jump {

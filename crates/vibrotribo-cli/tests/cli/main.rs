@@ -24,6 +24,7 @@ mod plot_dir_draws_every_kind;
 mod plot_skips_empty_figures;
 mod resume_checks_files;
 mod serve;
+mod settling_and_long_points_stop_on_signals;
 mod sizes_refused_before_allocation;
 mod stops;
 mod util;
