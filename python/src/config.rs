@@ -214,7 +214,11 @@ impl PyConfig {
 
     /// `config` with the keyword overrides applied (in order, validated as a whole), within
     /// `config`'s budget.
-    pub fn overridden(py: Python<'_>, config: Config, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+    pub fn overridden(
+        py: Python<'_>,
+        config: Config,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Config> {
         let Some(o) = overrides else { return Ok(config) };
         let mut pairs = Vec::new();
         for (k, v) in o.iter() {

@@ -11,14 +11,14 @@ use vibrotribo::config::Config;
 use vibrotribo::excitation::Sweep;
 use vibrotribo::study::{
     ChirpError, ChirpOptions, ChirpRun, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE, Direction, Ending,
-    PointError, run_chirp,
+    run_chirp,
 };
 
 use crate::config::ConfigArgs;
 use crate::manifest::{ChirpManifest, ChirpRunRecord, HysteresisRecord, JumpRecord, Kind, read, to_value};
 use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
-use crate::progress::{Interrupted, Progress, Watch, orbit_cancel};
+use crate::progress::{Interrupted, Progress, Watch, interrupted, orbit_cancel};
 
 /// `--sweep`: how the frequency moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -118,7 +118,16 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
     // Both configurations first: a bad option fails before anything runs.
     let mut periods = 0;
     for d in [Direction::Up, Direction::Down] {
-        let (c, _) = vibrotribo::study::chirp_config(&config, &options, d).map_err(option_error)?;
+        let (c, _) = match vibrotribo::study::chirp_config(&config, &options, d) {
+            Ok(c) => c,
+            Err(_) if interrupted() => {
+                return Err(Interrupted {
+                    what: "while building the chirps' base motion; nothing was written".into(),
+                }
+                .into());
+            }
+            Err(e) => return Err(option_error(e)),
+        };
         periods += c.run().periods;
     }
     if let Some(dir) = &args.out {
@@ -132,9 +141,9 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
     for d in [Direction::Up, Direction::Down] {
         let r = match run_chirp(&config, &options, d, &mut watch) {
             Ok(r) => r,
-            // Stopped by a signal while settling at the start frequency: the chirps done are
-            // kept (none for the up chirp).
-            Err(ChirpError::Settle { source, .. }) if matches!(*source, PointError::Stopped { .. }) => break,
+            // Stopped by a signal while building the chirp's base motion or settling at its
+            // start frequency: the chirps done are kept (none for the up chirp).
+            Err(_) if interrupted() => break,
             Err(e) => return Err(option_error(e)),
         };
         let stop = r.outcome.ending != Ending::Completed;
@@ -167,7 +176,10 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         }
     }
     if runs.len() < 2 || runs.iter().any(|r| r.outcome.ending == Ending::Stopped) {
-        let completed = runs.iter().filter(|r| r.outcome.ending == Ending::Completed).count();
+        let completed = runs
+            .iter()
+            .filter(|r| r.outcome.ending == Ending::Completed)
+            .count();
         return Err(Interrupted {
             what: format!(
                 "after {completed} of {} chirps{}",
@@ -197,7 +209,10 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
         options.duration_s,
         sweep_name(options.sweep),
         runs.first()
-            .map_or("not reached (no chirp ran)".to_string(), |r| format!("{} m", r.chirp.amplitude)),
+            .map_or("not reached (no chirp ran)".to_string(), |r| format!(
+                "{} m",
+                r.chirp.amplitude
+            )),
     );
     for r in runs {
         match &r.jump {

@@ -21,7 +21,9 @@ fn signalled(args: &[&str], after: Duration, signal: &str) -> (ExitStatus, Strin
         .spawn()
         .unwrap();
     std::thread::sleep(after);
-    let _ = Command::new("kill").args([signal, &child.id().to_string()]).status();
+    let _ = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status();
     let asked = Instant::now();
     let status = loop {
         if let Some(s) = child.try_wait().unwrap() {
@@ -44,7 +46,10 @@ fn interrupted(args: &[&str], signal: &str) -> (ExitStatus, String) {
     let mut after = Duration::from_millis(300);
     for _ in 0..8 {
         let (status, err) = signalled(args, after, signal);
-        assert!(!status.success(), "{args:?} finished before {signal}: make it longer");
+        assert!(
+            !status.success(),
+            "{args:?} finished before {signal}: make it longer"
+        );
         if status.code().is_some() {
             return (status, err);
         }
@@ -146,5 +151,34 @@ fn a_sweep_stops_inside_a_long_point_and_writes_nothing_of_it() {
     for name in ["summary.csv", "orbit.csv", "impacts.csv"] {
         let (header, rows) = read_csv(&dir.join(name));
         assert!(!header.is_empty() && rows.is_empty(), "{name}: {rows:?}");
+    }
+}
+
+/// A chirp of 5000 s: its base motion's spline (millions of knots, built for each chirp)
+/// takes longer than the test waits; SIGINT stops the build.
+#[test]
+fn a_chirp_stops_while_building_its_base_motion() {
+    let root = tempdir();
+    let dir = root.path().join("out");
+    let args = [
+        "chirp",
+        "-q",
+        "--from",
+        "0.5",
+        "--to",
+        "1.0",
+        "--duration",
+        "5000",
+        "--mechanics-only",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    let (status, err) = interrupted(&args, "-INT");
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted"), "{err}");
+    // Stopped before the first chirp ran: nothing, or chirp.json marked incomplete.
+    if let Ok(text) = std::fs::read_to_string(dir.join("chirp.json")) {
+        let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(m["complete"], false, "{m}");
     }
 }

@@ -165,8 +165,8 @@ fn hook_from(from: u64) -> (vibrotribo::orbits::Cancel, Arc<std::sync::atomic::A
 /// result as without a hook.
 #[test]
 fn a_sweep_point_stops_in_every_phase_when_its_cancel_hook_asks() {
-    use vibrotribo::study::{AutoSettle, PointError, SettleMode, run_point};
     use vibrotribo::lyapunov::LyapunovOptions;
+    use vibrotribo::study::{AutoSettle, PointError, SettleMode, run_point};
     let cases = [
         // The chatter case: settled and shot onto its period-1 orbit.
         (ChainParams::paper_chatter_case(), ChainState::at_rest(3)),
@@ -204,7 +204,10 @@ fn a_sweep_point_stops_in_every_phase_when_its_cancel_hook_asks() {
         assert_eq!(same, free);
         let total = calls.load(std::sync::atomic::Ordering::Relaxed);
         let last = free.strobe_periods.last().copied().unwrap();
-        println!("{total} polls over {last} periods, motion {:?}", free.motion.as_ref().map(|m| m.motion));
+        println!(
+            "{total} polls over {last} periods, motion {:?}",
+            free.motion.as_ref().map(|m| m.motion)
+        );
         assert!(total > last, "{total} polls, {last} periods");
         for k in 0..=16 {
             let from = (1 + total * k / 16).min(total);
