@@ -15,7 +15,7 @@ use vibrotribo::sweep::{Cell, Kind, Table};
 
 use crate::config::{config_error, config_of, table_to_dict};
 use crate::convert::table_to_py;
-use crate::interrupt::Signals;
+use crate::interrupt::{Signals, cancel_hook, cancel_result};
 
 /// A library error in the words of the Python function (`from_`, `duration`, …).
 fn chirp_error(e: ChirpError) -> PyErr {
@@ -83,6 +83,8 @@ pub fn chirp<'py>(
         }
     };
     let config = config_of(config)?;
+    // The settling at the start frequency runs Python's signal handlers too.
+    let (cancel, settling) = cancel_hook();
     let options = ChirpOptions {
         from: from_,
         to,
@@ -93,6 +95,7 @@ pub fn chirp<'py>(
         settled_start: !from_rest,
         samples_per_cycle,
         jump_window,
+        cancel,
     };
     // Both configurations first: a bad option fails before anything runs.
     for d in [Direction::Up, Direction::Down] {
@@ -116,6 +119,7 @@ pub fn chirp<'py>(
         (Ok(runs), signals)
     });
     signals.result()?;
+    cancel_result(&settling)?;
     let runs = runs.map_err(chirp_error)?;
     let n = config.chain().len();
     let power = !mechanics_only && n > 1;

@@ -8,9 +8,11 @@ use pyo3::exceptions::{PyFileNotFoundError, PyKeyError, PyOSError, PyTypeError, 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use toml::{Table, Value};
-use vibrotribo::config::{Config, ConfigError, DERIVED_KEYS, known_keys, similar_keys};
+use vibrotribo::config::{Config, ConfigError, DERIVED_KEYS, did_you_mean, known_keys};
+use vibrotribo::excitation::WorkBudget;
 
 use crate::convert::json_to_py;
+use crate::interrupt::interruptibly;
 
 /// The exception for a configuration error: `KeyError` for an unknown key, `OSError` for an
 /// unreadable file, `ValueError` for anything else (a bad value, bad TOML). The message
@@ -33,22 +35,13 @@ pub fn config_error(e: ConfigError) -> PyErr {
     }
 }
 
-/// "unknown parameter `key`", with the closest keys ("did you mean …?").
+/// "unknown parameter `key`", with the closest keys ("did you mean …?", the library's
+/// [`did_you_mean`], as the command line says it).
 pub fn unknown_key_message(key: &str) -> String {
-    let similar = similar_keys(key);
-    let hint = if similar.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "; did you mean {}?",
-            similar
-                .iter()
-                .map(|k| format!("`{k}`"))
-                .collect::<Vec<_>>()
-                .join(" or ")
-        )
-    };
-    format!("unknown parameter `{key}`{hint} (Config.keys() lists every key)")
+    format!(
+        "unknown parameter `{key}`{} (Config.keys() lists every key)",
+        did_you_mean(key)
+    )
 }
 
 /// `v` without its `null` entries (tables emptied by that dropped too).
@@ -194,18 +187,24 @@ pub struct PyConfig {
 }
 
 impl PyConfig {
-    fn read(source: Option<&Bound<'_, PyAny>>) -> PyResult<Config> {
+    /// The configuration `source` stands for (see [`config_of`]), its base motion built
+    /// within the documented limit unless `allow_large` (or the source is a `Config` made
+    /// with `allow_large=True`), the build stopped by Ctrl-C ([`read_within`]).
+    fn read(py: Python<'_>, source: Option<&Bound<'_, PyAny>>, allow_large: bool) -> PyResult<Config> {
         let Some(s) = source.filter(|s| !s.is_none()) else {
-            return Ok(Config::default());
+            return Ok(keeping(Config::default(), allow_large));
         };
         if let Ok(c) = s.cast::<PyConfig>() {
-            return Ok(c.get().inner.clone());
+            let c = c.get().inner.clone();
+            let large = allow_large || c.budget().allow_large;
+            return Ok(keeping(c, large));
         }
         if let Ok(d) = s.cast::<PyDict>() {
-            return Config::from_table(to_table(d, None)?).map_err(config_error);
+            let table = to_table(d, None)?;
+            return read_within(py, allow_large, move |b| Config::from_table_within(table, b));
         }
         if let Ok(path) = s.extract::<PathBuf>() {
-            return Config::from_path(&path).map_err(config_error);
+            return read_within(py, allow_large, move |b| Config::from_path_within(&path, b));
         }
         Err(PyTypeError::new_err(format!(
             "Config takes a path to a TOML file, a dict or a Config, not a {}",
@@ -213,8 +212,13 @@ impl PyConfig {
         )))
     }
 
-    /// `config` with the keyword overrides applied (in order, validated as a whole).
-    pub fn overridden(mut config: Config, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+    /// `config` with the keyword overrides applied (in order, validated as a whole), within
+    /// `config`'s budget.
+    pub fn overridden(
+        py: Python<'_>,
+        config: Config,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Config> {
         let Some(o) = overrides else { return Ok(config) };
         let mut pairs = Vec::new();
         for (k, v) in o.iter() {
@@ -222,11 +226,41 @@ impl PyConfig {
             let value = to_toml(&v, &key)?;
             pairs.push((key, value));
         }
-        config
-            .set_all(pairs.iter().map(|(k, v)| (k.as_str(), v.clone())))
-            .map_err(config_error)?;
-        Ok(config)
+        let large = config.budget().allow_large;
+        read_within(py, large, move |budget| {
+            let mut config = config;
+            config.set_budget(budget.clone());
+            config.set_all(pairs.iter().map(|(k, v)| (k.as_str(), v.clone())))?;
+            Ok(config)
+        })
     }
+}
+
+/// `config` whose later base-motion builds (of the configurations derived from it) allow
+/// large ones if `allow_large`.
+fn keeping(mut config: Config, allow_large: bool) -> Config {
+    config.set_budget(WorkBudget {
+        allow_large,
+        stop: None,
+    });
+    config
+}
+
+/// `read` (a configuration's read or change, which may build a random base motion) run with
+/// a budget that allows large builds if `allow_large`, on a worker thread stopped by Ctrl-C
+/// (`KeyboardInterrupt`, [`interruptibly`]); the configuration keeps the budget's limit for
+/// the configurations derived from it.
+fn read_within<F>(py: Python<'_>, allow_large: bool, read: F) -> PyResult<Config>
+where
+    F: FnOnce(&WorkBudget) -> Result<Config, ConfigError> + Send,
+{
+    let read = interruptibly(py, move |flag| {
+        read(&WorkBudget {
+            allow_large,
+            stop: Some(std::sync::Arc::clone(flag)),
+        })
+    })?;
+    Ok(keeping(read.map_err(config_error)?, allow_large))
 }
 
 impl PyConfig {
@@ -282,7 +316,7 @@ impl PyConfig {
 /// to be run: refused, naming the reason, if its base motion cannot drive its chain
 /// (`Config::check_runnable`, as the command line refuses it).
 pub fn config_of(obj: &Bound<'_, PyAny>) -> PyResult<Config> {
-    let config = PyConfig::read(Some(obj))?;
+    let config = PyConfig::read(obj.py(), Some(obj), false)?;
     config.check_runnable().map_err(config_error)?;
     Ok(config)
 }
@@ -290,39 +324,62 @@ pub fn config_of(obj: &Bound<'_, PyAny>) -> PyResult<Config> {
 #[pymethods]
 impl PyConfig {
     #[new]
-    #[pyo3(signature = (source=None, /, **overrides))]
-    fn new(source: Option<&Bound<'_, PyAny>>, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+    #[pyo3(signature = (source=None, /, *, allow_large=false, **overrides))]
+    fn new(
+        py: Python<'_>,
+        source: Option<&Bound<'_, PyAny>>,
+        allow_large: bool,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
         Ok(PyConfig {
-            inner: Self::overridden(Self::read(source)?, overrides)?,
+            inner: Self::overridden(py, Self::read(py, source, allow_large)?, overrides)?,
         })
     }
 
-    /// A configuration from TOML text.
+    /// A configuration from TOML text (`allow_large` as for the constructor).
     #[staticmethod]
-    fn from_toml(text: &str) -> PyResult<Self> {
+    #[pyo3(signature = (text, *, allow_large=false))]
+    fn from_toml(py: Python<'_>, text: String, allow_large: bool) -> PyResult<Self> {
         Ok(PyConfig {
-            inner: Config::from_toml_str(text).map_err(config_error)?,
+            inner: read_within(py, allow_large, move |b| Config::from_toml_str_within(&text, b))?,
+        })
+    }
+
+    /// Whether this configuration's base motion, and those of the configurations derived from
+    /// it, may be built past the documented limit of 10⁹ harmonic evaluations (a random
+    /// excitation's build): `Config(..., allow_large=True)`, the command line's `--allow-large`.
+    #[getter]
+    fn allow_large(&self) -> bool {
+        self.inner.budget().allow_large
+    }
+
+    /// Rebuilds a pickled configuration: its settings and `allow_large`.
+    #[staticmethod]
+    fn _restore(py: Python<'_>, settings: &Bound<'_, PyDict>, allow_large: bool) -> PyResult<Self> {
+        let table = to_table(settings, None)?;
+        Ok(PyConfig {
+            inner: read_within(py, allow_large, move |b| Config::from_table_within(table, b))?,
         })
     }
 
     /// A copy with the keyword overrides applied (same keys as the constructor).
     #[pyo3(signature = (**overrides))]
-    fn replace(&self, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+    fn replace(&self, py: Python<'_>, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         Ok(PyConfig {
-            inner: Self::overridden(self.inner.clone(), overrides)?,
+            inner: Self::overridden(py, self.inner.clone(), overrides)?,
         })
     }
 
     /// A copy with the keyword overrides applied (the same as `replace`).
     #[pyo3(signature = (**changes))]
-    fn with_(&self, changes: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        self.replace(changes)
+    fn with_(&self, py: Python<'_>, changes: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        self.replace(py, changes)
     }
 
     /// A copy with `keys` (`section.name`, or a whole `section`) removed from the settings:
     /// back at their defaults. A key that is not set is refused (`KeyError`).
     #[pyo3(signature = (*keys))]
-    fn without(&self, keys: Vec<String>) -> PyResult<Self> {
+    fn without(&self, py: Python<'_>, keys: Vec<String>) -> PyResult<Self> {
         let mut table = self.inner.table().clone();
         for key in &keys {
             let key = key_of(key);
@@ -350,8 +407,9 @@ impl PyConfig {
                 return Err(PyKeyError::new_err(message));
             }
         }
+        let large = self.inner.budget().allow_large;
         Ok(PyConfig {
-            inner: Config::from_table(table).map_err(config_error)?,
+            inner: read_within(py, large, move |b| Config::from_table_within(table, b))?,
         })
     }
 
@@ -487,11 +545,14 @@ impl PyConfig {
         }
     }
 
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>, bool))> {
         let py = slf.py();
         Ok((
-            slf.get_type().into_any(),
-            (table_to_dict(py, slf.get().inner.table())?,),
+            slf.get_type().getattr("_restore")?,
+            (
+                table_to_dict(py, slf.get().inner.table())?,
+                slf.get().inner.budget().allow_large,
+            ),
         ))
     }
 }

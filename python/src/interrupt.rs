@@ -93,3 +93,51 @@ pub fn cancel_result(signals: &std::sync::Mutex<Signals>) -> PyResult<()> {
         Err(_) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err("interrupted")),
     }
 }
+
+/// Runs `work` (a configuration's read, which may build a long random base motion) on a
+/// worker thread with a stop flag, while this thread waits with the GIL released and runs
+/// Python's signal handlers every [`INTERVAL`]: the exception one raises sets the flag (the
+/// build stops at its next look at it, within 64 intervals of the signal) and is raised here
+/// once the worker has ended.
+pub fn interruptibly<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&std::sync::Arc<std::sync::atomic::AtomicBool>) -> T + Send,
+{
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc::{RecvTimeoutError, channel};
+    let flag = std::sync::Arc::new(AtomicBool::new(false));
+    let (tx, rx) = channel();
+    // Waited on with the GIL released (a receiver is not shared between threads by itself).
+    let rx = std::sync::Mutex::new(rx);
+    let wait = |timeout: Option<Duration>| {
+        let rx = rx.lock().map_err(|_| RecvTimeoutError::Disconnected)?;
+        match timeout {
+            Some(t) => rx.recv_timeout(t),
+            None => rx.recv().map_err(|_| RecvTimeoutError::Disconnected),
+        }
+    };
+    std::thread::scope(|s| {
+        let worker_flag = std::sync::Arc::clone(&flag);
+        s.spawn(move || {
+            let _ = tx.send(work(&worker_flag));
+        });
+        loop {
+            match py.detach(|| wait(Some(INTERVAL))) {
+                Ok(done) => return Ok(done),
+                Err(RecvTimeoutError::Timeout) => {
+                    if let Err(e) = py.check_signals() {
+                        flag.store(true, Ordering::Relaxed);
+                        let _ = py.detach(|| wait(None));
+                        return Err(e);
+                    }
+                }
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                        "the configuration's reader ended without an answer",
+                    ));
+                }
+            }
+        }
+    })
+}

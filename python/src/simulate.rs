@@ -5,19 +5,19 @@
 use std::time::Instant;
 
 use numpy::PyArray1;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibrotribo::electrical::LoadKind;
 use vibrotribo::report::{MeritSummary, RunSummary, failure_text};
 use vibrotribo::study::{
-    DEFAULT_SETTLE_CAP, Ending, Recording, RunMotion, SettleMode, limits, settle as settle_run,
+    DEFAULT_SETTLE_CAP, Ending, PointError, Recording, RunMotion, SettleMode, limits, settle as settle_run,
     simulate as run,
 };
 
 use crate::config::{config_error, config_of};
 use crate::convert::{array1, array2, serde_to_py};
-use crate::interrupt::Signals;
+use crate::interrupt::{Signals, cancel_hook, cancel_result};
 use crate::limits::check_memory;
 
 /// Runs the configuration (see the Python `vibrotribo.simulate`) and returns a dict of
@@ -63,8 +63,11 @@ pub fn simulate<'py>(
         }
     }
     motion.options_mut().settle = mode;
+    // The settling runs Python's signal handlers too.
+    let (cancel, settling) = cancel_hook();
+    motion.options_mut().cancel = cancel;
     let periodic = config.is_periodic();
-    let (outcome, recording, elapsed, signals, report) = py.detach(|| {
+    let computed = py.detach(|| {
         let mut recording = Recording::new(samples);
         let mut signals = Signals::new();
         let started = Instant::now();
@@ -75,7 +78,9 @@ pub fn simulate<'py>(
                         spec.initial = s.state.clone();
                         Some(s)
                     }
-                    Err(e) => return Err(PyValueError::new_err(format!("while settling: {e}"))),
+                    // A stop is the signal handler's exception, raised below.
+                    Err(PointError::Stopped { .. }) => return Err(None),
+                    Err(e) => return Err(Some(PyValueError::new_err(format!("while settling: {e}")))),
                 }
             }
             SettleMode::Fixed => None,
@@ -107,9 +112,18 @@ pub fn simulate<'py>(
             signals,
             (report, merit),
         ))
-    })?;
+    });
+    let (outcome, recording, elapsed, signals, report) = match computed {
+        Ok(c) => c,
+        Err(Some(e)) => return Err(e),
+        Err(None) => {
+            cancel_result(&settling)?;
+            return Err(PyKeyboardInterrupt::new_err("interrupted while settling"));
+        }
+    };
     let (report, merit) = report;
     signals.result()?;
+    cancel_result(&settling)?;
     let outcome = outcome.map_err(|e| PyValueError::new_err(e.to_string()))?;
     let n = spec.chain.len();
     let out = PyDict::new(py);

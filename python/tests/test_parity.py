@@ -127,10 +127,7 @@ PARITY = {
     "lyapunov": (vt.lyapunov, {
         "<CONFIG>": "config", "--periods": "periods", "--transient": "transient", "--seed": "seed",
         "--batches": "batches", "--out": None, "--plot": None, "-q": None,
-        # The program's flag lifts the size limit of a random excitation's build for this
-        # command; in Python that build happens when the Config is made, which has no such
-        # override yet (a too-large excitation is refused there with the sizes named).
-        "--allow-large": None,
+        "--allow-large": "allow_large",
     }),
 }
 
@@ -151,9 +148,7 @@ REASONS = {"--force": "CLI only: writes over another job's files; a Python resul
            "--out": FILES, "--plot": PLOT, "-q": QUIET, "--shard": SHARD, "--resume": RESUME,
            "--name": "CLI only: the netlist's file name; SpiceExport.write(path) writes it anywhere",
            "--diagram-steps": PLOT, "--mass": PLOT,
-           "--mechanics-only": "refused by the command (the optimum maximises power)",
-           "--allow-large": "lyapunov's flag lifts the limit of a random excitation's build, which "
-                            "Python does when the Config is made; Config has no override for it yet"}
+           "--mechanics-only": "refused by the command (the optimum maximises power)"}
 
 
 def help_text(cli, *args):

@@ -129,8 +129,13 @@ def _count(value: Optional[int], name: str, *, least: int = 0) -> Optional[int]:
     return int(value)
 
 
-def _config(config: ConfigLike) -> Config:
-    return config if isinstance(config, Config) else Config(config)
+def _config(config: ConfigLike, allow_large: bool = False) -> Config:
+    """``config`` as a :class:`Config`; with ``allow_large`` a path or dict whose random
+    excitation costs more than the documented limit is built (as ``Config(...,
+    allow_large=True)``), as the command line's ``--allow-large`` allows it."""
+    if isinstance(config, Config) and (config.allow_large or not allow_large):
+        return config
+    return Config(config, allow_large=allow_large)
 
 
 def _values(values: Iterable[float], name: str) -> list:
@@ -169,7 +174,7 @@ def simulate(
     per-period statistics would need more than 4 GiB is refused with ``MemoryError`` before
     anything is allocated (``allow_large=True`` runs it; ``samples=False`` keeps no samples).
     """
-    cfg = _config(config)
+    cfg = _config(config, allow_large)
     raw = _vibrotribo.simulate(
         cfg,
         mechanics_only=mechanics_only,
@@ -227,7 +232,7 @@ def sweep(
     memory above 4 GiB ``MemoryError`` (``allow_large=True`` runs it).
     """
     raw = _vibrotribo.sweep(
-        _config(config),
+        _config(config, allow_large),
         param,
         _values(values, "values"),
         continuation=continuation,
@@ -268,7 +273,7 @@ def map(  # noqa: A001 - the command's name
     ``run.initial_velocities[i]``), a start whose masses interpenetrate is a row with its
     ``error`` (as ``vibrotribo basins`` skips it) instead of failing the map."""
     raw = _vibrotribo.map(
-        _config(config),
+        _config(config, allow_large),
         x,
         _values(x_values, "x_values"),
         y,
@@ -305,7 +310,7 @@ def load_sweep(
     run instead (the power at a load is what :func:`simulate` reports with it). Returns a
     :class:`LoadSweep` equal to the command's files."""
     raw = _vibrotribo.load_sweep(
-        _config(config),
+        _config(config, allow_large),
         resistances=None if resistances is None else _values(resistances, "resistances"),
         low=low,
         high=high,
@@ -508,16 +513,19 @@ def lyapunov(
     transient: int = 300,
     seed: int = 1,
     batches: int = 10,
+    allow_large: bool = False,
 ) -> Lyapunov:
     """All 2N Lyapunov exponents of the configuration's run (mechanics), through impacts,
     sticking and chatter, from the exact state-transition matrix: ``transient`` periods
     (the motion settles and the tangent vectors align), then ``periods`` averaged over in
     ``batches`` batches (the spread is their batch-means standard error). ``seed`` seeds the
     initial tangent basis. The same numbers as ``vibrotribo lyapunov``. Ctrl-C raises
-    ``KeyboardInterrupt`` within a second.
+    ``KeyboardInterrupt`` within a second. ``allow_large=True`` builds a random excitation
+    of a path or dict past the limit of 10⁹ harmonic evaluations (as ``--allow-large``;
+    ``Config(..., allow_large=True)`` does the same for a configuration made first).
     """
     raw = _vibrotribo.lyapunov(
-        _config(config),
+        _config(config, allow_large),
         periods=_count(periods, "periods", least=1),
         transient=_count(transient, "transient"),
         seed=_count(seed, "seed"),
@@ -603,7 +611,7 @@ def basins(
     command line. Returns :class:`Basins` equal to its ``basins.csv`` and ``attractors.csv``."""
     nx, ny = grid
     raw = _vibrotribo.basins(
-        _config(config),
+        _config(config, allow_large),
         x,
         float(x_from),
         float(x_to),
@@ -657,7 +665,7 @@ def attractors(
     with their basin fractions and power, followed from value to value, and the expected
     power of an unknown start (:class:`Attractors`)."""
     raw = _vibrotribo.attractors(
-        _config(config),
+        _config(config, allow_large),
         param,
         _values(values, "values"),
         samples=_count(samples, "samples", least=1),
@@ -817,7 +825,7 @@ def optimize_mass_ratio(
     ``rm_to``, the best ratio at each Ω refined by a parabola, and a quadratic fit through
     them compared with the paper's (:class:`MassRatioOptimum`)."""
     raw = _vibrotribo.optimize_mass_ratio(
-        _config(config),
+        _config(config, allow_large),
         omega_from=float(omega_from),
         omega_to=float(omega_to),
         omega_steps=_count(omega_steps, "omega_steps", least=1),
@@ -851,7 +859,7 @@ def export_spice(
     ``dt_fraction`` of a period (every impact also a breakpoint): the text ``vibrotribo
     export-spice RUN_DIR`` writes for the same run. ``check=True`` also runs ngspice and
     compares the energy delivered (:class:`SpiceExport`). ``result.write(path)`` writes it."""
-    cfg = config.config if isinstance(config, Simulation) else _config(config)
+    cfg = config.config if isinstance(config, Simulation) else _config(config, allow_large)
     raw = _vibrotribo.export_spice(
         cfg,
         from_period=_count(from_period, "from_period"),

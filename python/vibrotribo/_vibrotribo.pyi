@@ -26,18 +26,27 @@ class Config:
     """A configuration: the paper's default case, a TOML file (str or path), or a dict
     shaped like one, with keys overridden by keyword arguments (`__` for `.`:
     `excitation__omega_ratio=0.6`, or `**{"oscillator.gaps[1]": 0.03}`; derived keys such
-    as `mass_ratio` as they are). SI units. Unknown keys raise KeyError, bad values
-    ValueError, a missing file FileNotFoundError; messages name the key or file."""
+    as `mass_ratio` as they are). SI units. Unknown keys raise KeyError (with the closest
+    keys), bad values ValueError, a missing file FileNotFoundError; messages name the key or
+    file. A random excitation costlier to build than 10⁹ harmonic evaluations is refused
+    with its size unless `allow_large=True` (the command line's `--allow-large`); the
+    configurations derived from this one keep the setting. Ctrl-C stops a build with
+    KeyboardInterrupt."""
 
     def __init__(
         self,
         source: Union["Config", Mapping[str, Any], str, "os.PathLike[str]", None] = None,
         /,
+        *,
+        allow_large: bool = False,
         **overrides: Any,
     ) -> None: ...
     @staticmethod
-    def from_toml(text: str) -> "Config":
+    def from_toml(text: str, *, allow_large: bool = False) -> "Config":
         """A configuration from TOML text."""
+    @property
+    def allow_large(self) -> bool:
+        """Whether the base motion may be built past the limit of 10⁹ harmonic evaluations."""
     def replace(self, **overrides: Any) -> "Config":
         """A copy with the overrides applied."""
     def to_dict(self) -> Dict[str, Any]:

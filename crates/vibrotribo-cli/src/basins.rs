@@ -393,6 +393,7 @@ pub fn run_starts(
                 .run(&[(xk, x), (yk, y)], None)
                 .map_err(|e| format!("{e:#}"))
         },
+        |_| false,
         ("starts", skip as u64, total),
         quiet,
         |d| {

@@ -18,7 +18,7 @@ use crate::config::ConfigArgs;
 use crate::manifest::{ChirpManifest, ChirpRunRecord, HysteresisRecord, JumpRecord, Kind, read, to_value};
 use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
-use crate::progress::{Interrupted, Progress, Watch};
+use crate::progress::{Interrupted, Progress, Watch, interrupted, orbit_cancel};
 
 /// `--sweep`: how the frequency moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -113,11 +113,21 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         settled_start: !args.from_rest,
         samples_per_cycle: args.samples_per_cycle,
         jump_window: args.jump_window,
+        cancel: orbit_cancel(),
     };
     // Both configurations first: a bad option fails before anything runs.
     let mut periods = 0;
     for d in [Direction::Up, Direction::Down] {
-        let (c, _) = vibrotribo::study::chirp_config(&config, &options, d).map_err(option_error)?;
+        let (c, _) = match vibrotribo::study::chirp_config(&config, &options, d) {
+            Ok(c) => c,
+            Err(_) if interrupted() => {
+                return Err(Interrupted {
+                    what: "while building the chirps' base motion; nothing was written".into(),
+                }
+                .into());
+            }
+            Err(e) => return Err(option_error(e)),
+        };
         periods += c.run().periods;
     }
     if let Some(dir) = &args.out {
@@ -129,7 +139,13 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
     };
     let mut runs = Vec::new();
     for d in [Direction::Up, Direction::Down] {
-        let r = run_chirp(&config, &options, d, &mut watch).map_err(option_error)?;
+        let r = match run_chirp(&config, &options, d, &mut watch) {
+            Ok(r) => r,
+            // Stopped by a signal while building the chirp's base motion or settling at its
+            // start frequency: the chirps done are kept (none for the up chirp).
+            Err(_) if interrupted() => break,
+            Err(e) => return Err(option_error(e)),
+        };
         let stop = r.outcome.ending != Ending::Completed;
         runs.push(r);
         if stop {
@@ -160,10 +176,13 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         }
     }
     if runs.len() < 2 || runs.iter().any(|r| r.outcome.ending == Ending::Stopped) {
+        let completed = runs
+            .iter()
+            .filter(|r| r.outcome.ending == Ending::Completed)
+            .count();
         return Err(Interrupted {
             what: format!(
-                "after {} of {} chirps{}",
-                runs.len().saturating_sub(1),
+                "after {completed} of {} chirps{}",
                 2,
                 if args.out.is_some() {
                     "; the files hold the cycles completed, chirp.json says \"complete\": false"
@@ -181,7 +200,7 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
     let chain = config.chain();
     let hz = chain.omega() / chain.omega_ratio() / std::f64::consts::TAU;
     println!(
-        "vibrotribo chirp: {} masses, Ω from {} to {} ({:.4} to {:.4} Hz), {} s each way ({}), amplitude {} m",
+        "vibrotribo chirp: {} masses, Ω from {} to {} ({:.4} to {:.4} Hz), {} s each way ({}), amplitude {}",
         chain.len(),
         options.from,
         options.to,
@@ -189,7 +208,11 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
         options.to * hz,
         options.duration_s,
         sweep_name(options.sweep),
-        runs.first().map_or(f64::NAN, |r| r.chirp.amplitude),
+        runs.first()
+            .map_or("not reached (no chirp ran)".to_string(), |r| format!(
+                "{} m",
+                r.chirp.amplitude
+            )),
     );
     for r in runs {
         match &r.jump {

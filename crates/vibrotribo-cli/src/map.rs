@@ -127,7 +127,11 @@ pub fn run(args: &MapArgs) -> Result<()> {
             args.y
         );
     }
-    let runner = args.run.runner(base)?;
+    // A point stops part-way on SIGINT/SIGTERM (and is not written).
+    let runner = args
+        .run
+        .runner(base)?
+        .with_cancel(crate::progress::orbit_cancel());
     let (xs, ys) = (
         grid(args.x_from, args.x_to, args.x_steps),
         grid(args.y_from, args.y_to, args.y_steps),
@@ -348,7 +352,11 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
     }
     set_threads(args.run.threads)?;
     let base = args.input.load_within(args.run.allow_large)?;
-    let runner = args.run.runner(base)?;
+    // A point stops part-way on SIGINT/SIGTERM (and is not written).
+    let runner = args
+        .run
+        .runner(base)?
+        .with_cancel(crate::progress::orbit_cancel());
     let contacts = runner.contacts();
     let (omegas, ratios) = (
         grid(args.omega_from, args.omega_to, args.omega_steps),

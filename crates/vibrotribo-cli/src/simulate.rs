@@ -12,15 +12,15 @@ use vibrotribo::excitation::WorkBudget;
 use vibrotribo::merit::MeritWatch;
 use vibrotribo::report::{MeritSummary, RunSummary};
 use vibrotribo::study::{
-    Ending, LyapunovSkipped, Motion, MotionReport, RunMotion, RunObserver, RunOutcome, RunSpec, Sample,
-    SettleMode, settle, simulate,
+    Ending, LyapunovSkipped, Motion, MotionReport, PointError, RunMotion, RunObserver, RunOutcome, RunSpec,
+    Sample, SettleMode, settle, simulate,
 };
 use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si};
-use crate::progress::{Interrupted, Progress, Watch};
+use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si, write_json};
+use crate::progress::{Interrupted, Progress, Watch, orbit_cancel};
 use crate::run_analyses::RunSections;
 
 /// Options of `vibrotribo simulate`.
@@ -194,19 +194,28 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         config.check_periodic("simulate --settle auto (settling to a periodic motion)")?;
     }
     run_motion.options_mut().settle = mode;
+    run_motion.options_mut().cancel = orbit_cancel();
     let settled = match &mode {
         SettleMode::Auto(auto) => {
             if args.settle_cap == 0 {
                 anyhow::bail!("--settle-cap must be at least 1");
             }
-            let s = settle(
+            let s = match settle(
                 &spec.chain,
                 &spec.initial,
                 &spec.options,
                 run_motion.options(),
                 auto,
-            )
-            .map_err(|e| anyhow::anyhow!("while settling: {e}"))?;
+            ) {
+                Ok(s) => s,
+                Err(PointError::Stopped { periods }) => {
+                    if let Some(f) = files.as_mut() {
+                        f.flush()?;
+                    }
+                    return stopped_while_settling(&config, &spec, args, periods, started);
+                }
+                Err(e) => anyhow::bail!("while settling: {e}"),
+            };
             spec.initial = s.state.clone();
             Some(s)
         }
@@ -329,6 +338,49 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .into());
     }
     Ok(())
+}
+
+/// A run stopped by SIGINT/SIGTERM while settling, after `periods` settling periods: with
+/// --out, `summary.json` says so (`"interrupted": true`, no period of the configured run
+/// computed; events.csv and trajectory.csv hold their headers only); the error is the
+/// signal's.
+fn stopped_while_settling(
+    config: &Config,
+    spec: &RunSpec,
+    args: &SimulateArgs,
+    periods: u64,
+    started: Instant,
+) -> Result<()> {
+    if let Some(dir) = &args.out {
+        let summary = json!({
+            "command": "simulate",
+            "periods": 0,
+            "periods_requested": spec.periods,
+            "transient_periods": spec.transient_periods,
+            "settle": args.settle.as_str(),
+            "settle_cap_periods": args.settle_cap,
+            "settle_periods": periods,
+            "interrupted": true,
+            "interrupted_while": "settling",
+            "motion": null,
+            "error": null,
+            "settings": config.table(),
+            "wall_time_s": started.elapsed().as_secs_f64(),
+        });
+        write_json(&dir.join("summary.json"), &summary)?;
+    }
+    Err(Interrupted {
+        what: format!(
+            "while settling, after {periods} of at most {} periods, before the configured run{}",
+            args.settle_cap,
+            if args.out.is_some() {
+                "; summary.json says \"interrupted\": true, events.csv and trajectory.csv hold no rows"
+            } else {
+                ""
+            }
+        ),
+    }
+    .into())
 }
 
 /// One line of the figures of merit ([`vibrotribo::merit`]).

@@ -13,7 +13,7 @@ use vibrotribo::ChainState;
 use vibrotribo::lyapunov::LyapunovOptions;
 use vibrotribo::study::{PointOptions, PointResult};
 use vibrotribo::sweep::{
-    Cell, Continuation, IMPACT_COLUMNS, PointColumns, PointRunner, SweepError, grid, impact_rows,
+    Cell, Continuation, IMPACT_COLUMNS, PointColumns, PointRunner, SweepError, grid, impact_rows, is_stopped,
     orbit_columns, orbit_rows, run_continued,
 };
 
@@ -24,7 +24,7 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{Axis, Kind, SettleRecord, ShardRecord, SweepManifest, base_motion_of, to_value};
-use crate::progress::{Interrupted, Progress, interrupted};
+use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
 
 /// Options of `vibrotribo sweep`.
 #[derive(Debug, clap::Args)]
@@ -190,7 +190,8 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         // phase of the base motion only if the motion is periodic.
         base.check_periodic("sweep --continuation")?;
     }
-    let mut runner = args.run.runner(base)?;
+    // A point stops part-way on SIGINT/SIGTERM (and is not written).
+    let mut runner = args.run.runner(base)?.with_cancel(orbit_cancel());
     if args.lyapunov {
         let options = PointOptions {
             lyapunov: Some(LyapunovOptions::default()),
@@ -289,7 +290,10 @@ pub fn run(args: &SweepArgs) -> Result<()> {
                 Progress::new(order.len() as u64, "values", args.run.quiet).starting_at(skip as u64);
             let mut written = 0usize;
             let mut failure = None;
-            let (done, _) = run_continued(&runner, key, &values, todo, state, |j, r, state| {
+            run_continued(&runner, key, &values, todo, state, |j, r, state| {
+                if is_stopped(&r) {
+                    return Ok(ControlFlow::Break(()));
+                }
                 failed += usize::from(r.is_err());
                 written += 1;
                 if let Some(o) = out.as_mut() {
@@ -311,7 +315,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
             if let Some(e) = failure {
                 return Err(e);
             }
-            done
+            written
         }
     };
     let done = skip + computed;

@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 
 use anyhow::{Context, Result, anyhow, bail};
 use vibrotribo::study::PointResult;
-use vibrotribo::sweep::{Delivery, PointRunner, SweepError, run_chunks};
+use vibrotribo::sweep::{Delivery, PointRunner, SweepError, is_stopped, run_chunks};
 
 use crate::limits;
 use crate::progress::{Progress, interrupted};
@@ -31,8 +31,9 @@ pub fn check_all<'k, P>(
 
 /// Runs `points` in parallel chunks (see [`vibrotribo::sweep::run_grid`]), calling `write`
 /// with each point's result in grid order and with `None` after each chunk, ticking a
-/// progress bar (label, points done before, points in all) and stopping after the current
-/// chunk on SIGINT/SIGTERM, keeping what was written. Returns how many were written.
+/// progress bar (label, points done before, points in all) and stopping on SIGINT/SIGTERM
+/// after the current chunk, or at the first point the runner's cancel hook stopped (not
+/// written), keeping what was written. Returns how many were written.
 pub fn run_points<'k, P, W>(
     runner: &PointRunner,
     points: &[P],
@@ -48,6 +49,7 @@ where
     run_chunked(
         points,
         |p| runner.run(&keys(p), None),
+        is_stopped,
         progress,
         quiet,
         |d| match d {
@@ -60,10 +62,13 @@ where
 /// Runs `work` on `points` in parallel chunks ([`vibrotribo::sweep::run_chunks`]), calling
 /// `write` with each result in order and with `None` after each chunk, with a progress bar
 /// (label, points done before, points in all) and a stop after the current chunk on
-/// SIGINT/SIGTERM. Returns how many were written.
+/// SIGINT/SIGTERM, or at the first result that `stopped` says holds nothing (a point its
+/// work stopped part-way: neither it nor any after it is written). Returns how many were
+/// written.
 pub fn run_chunked<P, R, W, F>(
     points: &[P],
     work: W,
+    stopped: impl Fn(&R) -> bool,
     (what, before, total): (&str, u64, u64),
     quiet: bool,
     mut write: F,
@@ -76,10 +81,13 @@ where
 {
     let progress = Progress::new(total, what, quiet).starting_at(before);
     let mut failure = None;
-    let done = run_chunks(points, rayon::current_num_threads() * 4, work, |d| {
+    let mut done = 0;
+    run_chunks(points, rayon::current_num_threads() * 4, work, |d| {
         let (written, checkpoint) = match d {
+            Delivery::Point(_, r) if stopped(&r) => return ControlFlow::Break(()),
             Delivery::Point(p, r) => {
                 progress.inc(1);
+                done += 1;
                 (write(Some((p, r))), false)
             }
             Delivery::Chunk(_) => (write(None), true),

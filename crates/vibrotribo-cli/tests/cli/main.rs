@@ -26,6 +26,7 @@ mod plot_skips_empty_figures;
 mod response;
 mod resume_checks_files;
 mod serve;
+mod settling_and_long_points_stop_on_signals;
 mod sizes_refused_before_allocation;
 mod stops;
 mod summaries_and_sections;

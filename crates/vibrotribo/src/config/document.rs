@@ -202,10 +202,22 @@ impl Config {
         self.budget = budget;
     }
 
+    /// The budget this configuration's base-motion builds are held to
+    /// ([`set_budget`](Self::set_budget)).
+    pub fn budget(&self) -> &WorkBudget {
+        &self.budget
+    }
+
     /// Reads a configuration from TOML text (a record's relative path is relative to the
     /// working directory).
     pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
         Self::parse(text, "the configuration", None, &WorkBudget::default())
+    }
+
+    /// [`from_toml_str`](Self::from_toml_str) with the base motion built within `budget` (see
+    /// [`from_path_within`](Self::from_path_within)).
+    pub fn from_toml_str_within(text: &str, budget: &WorkBudget) -> Result<Self, ConfigError> {
+        Self::parse(text, "the configuration", None, budget)
     }
 
     fn parse(
@@ -233,6 +245,13 @@ impl Config {
     /// record's relative path is relative to the working directory.
     pub fn from_table(table: Table) -> Result<Self, ConfigError> {
         Self::from_table_in(table, None)
+    }
+
+    /// [`from_table`](Self::from_table) with the base motion built within `budget` (see
+    /// [`from_path_within`](Self::from_path_within)); the configurations derived from this one
+    /// keep the budget.
+    pub fn from_table_within(table: Table, budget: &WorkBudget) -> Result<Self, ConfigError> {
+        Self::read_table(table, None, budget)
     }
 
     /// [`from_table`](Self::from_table) with relative record paths relative to `base_dir`.

@@ -26,7 +26,7 @@ pub enum ConfigError {
         message: String,
     },
     /// A key is not part of the configuration.
-    #[error("unknown parameter `{key}`; known keys: {known}")]
+    #[error("unknown parameter `{key}`{}; known keys: {known}", super::keys::did_you_mean(.key))]
     UnknownKey {
         /// The key as given.
         key: String,

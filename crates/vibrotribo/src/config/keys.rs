@@ -432,23 +432,64 @@ pub fn apply_overrides<S: AsRef<str>>(config: &mut Config, assignments: &[S]) ->
     config.set_all(parsed)
 }
 
-/// The keys (of the schema and derived) closest to `key` in edit distance, best first: the
-/// "did you mean" of an unknown key (at most three, none farther than a third of its length).
+/// The keys (of the schema and derived) closest to `key`, best first: the "did you mean" of
+/// an unknown key (at most three, none farther than a third of its length, and at least 2).
+///
+/// A key `section.name` is split at its last dot. A candidate's distance is the smallest of:
+/// the edit distance between the whole keys; that between `key` and the candidate's name (a
+/// key given without its section); 0 where the candidate ends with `.key` (a key given
+/// without its leading sections); the distance between the names, or 1 where the given
+/// name begins a candidate's (three letters or more: `f_low` for `f_low_hz`), plus 1 where
+/// the sections differ. Ties go to the candidate whose section is closest (in edit
+/// distance) to the given one, then to the longest prefix shared with `key`, then in
+/// alphabetical order.
 pub fn similar_keys(key: &str) -> Vec<String> {
     let mut known = known_keys();
     known.extend(DERIVED_KEYS.iter().map(|(k, _)| k.to_string()));
     let limit = (key.chars().count() / 3).max(2);
-    let mut scored: Vec<(usize, String)> = known
+    let (section, name) = split_section(key);
+    let mut scored: Vec<((usize, usize, std::cmp::Reverse<usize>), String)> = known
         .into_iter()
-        .map(|k| {
-            // The last part alone matches a key given without its section.
-            let tail = k.rsplit('.').next().unwrap_or(&k).to_string();
-            (edit_distance(key, &k).min(edit_distance(key, &tail)), k)
+        .filter_map(|k| {
+            let (k_section, k_name) = split_section(&k);
+            let moved = usize::from(!section.is_empty() && section != k_section);
+            let by_name = if name.chars().count() >= 3 && k_name.starts_with(name) && name != k_name {
+                1
+            } else {
+                edit_distance(name, k_name)
+            };
+            let mut d = edit_distance(key, &k).min(edit_distance(key, k_name));
+            if k.strip_suffix(key).is_some_and(|head| head.ends_with('.')) {
+                d = 0;
+            }
+            d = d.min(by_name + moved);
+            let shared = key.chars().zip(k.chars()).take_while(|(a, b)| a == b).count();
+            (d <= limit).then(|| {
+                (
+                    (d, edit_distance(section, k_section), std::cmp::Reverse(shared)),
+                    k.clone(),
+                )
+            })
         })
-        .filter(|(d, _)| *d <= limit)
         .collect();
     scored.sort();
     scored.into_iter().take(3).map(|(_, k)| k).collect()
+}
+
+/// `"; did you mean `a` or `b`?"` with the [`similar_keys`] of an unknown `key`, or nothing
+/// where none is close: the hint the command line and Python give after "unknown parameter".
+pub fn did_you_mean(key: &str) -> String {
+    let similar = similar_keys(key);
+    if similar.is_empty() {
+        return String::new();
+    }
+    let names: Vec<String> = similar.iter().map(|k| format!("`{k}`")).collect();
+    format!("; did you mean {}?", names.join(" or "))
+}
+
+/// `section.name` split at its last dot (`("", key)` without one).
+fn split_section(key: &str) -> (&str, &str) {
+    key.rsplit_once('.').unwrap_or(("", key))
 }
 
 /// The Levenshtein distance between `a` and `b` (in characters).
@@ -479,5 +520,38 @@ mod tests {
         assert!(similar_keys("omega_ratoi").contains(&"omega_ratio".to_string()));
         assert!(similar_keys("masses").contains(&"oscillator.masses".to_string()));
         assert!(similar_keys("completely_unrelated_words").is_empty());
+    }
+
+    /// Typos of real keys, each with the ranking a reader expects (checked against the key
+    /// lists, not against the code's own order).
+    #[test]
+    fn typos_of_real_keys_rank_the_meant_key_first() {
+        let first = |typo: &str| similar_keys(typo).into_iter().next().unwrap_or_default();
+        // A transposition within a section.
+        assert_eq!(first("excitation.amplitdue"), "excitation.amplitude");
+        assert_eq!(first("oscillator.dampnig"), "oscillator.damping");
+        // A misspelt section.
+        assert_eq!(first("oscilator.masses"), "oscillator.masses");
+        // A missing letter, and a name cut short: the completion in the same section wins
+        // over a same-length neighbour (`rtol`).
+        assert_eq!(first("run.period"), "run.periods");
+        assert_eq!(first("electrical.atol"), "electrical.atol_voltage");
+        assert_eq!(first("excitation.f_low"), "excitation.f_low_hz");
+        // A key without its section, or without its leading sections.
+        assert_eq!(first("stiffnes"), "oscillator.stiffness");
+        assert_eq!(first("stops.upper.gap"), "oscillator.stops.upper.gap");
+        // Equally close: the derived key named without a section before the one inside
+        // `excitation` (alphabetical order put `excitation.omega_ratio` first).
+        assert_eq!(
+            similar_keys("omega_ratoi")[..2],
+            ["omega_ratio".to_string(), "excitation.omega_ratio".to_string()]
+        );
+        // A key put in the wrong section: the same name elsewhere, the closest section first.
+        let moved = similar_keys("harvester.restitution");
+        assert_eq!(moved[0], "oscillator.restitution", "{moved:?}");
+        assert!(moved.contains(&"restitution".to_string()), "{moved:?}");
+        // The hint reads as a sentence.
+        assert_eq!(did_you_mean("run.period"), "; did you mean `run.periods`?");
+        assert_eq!(did_you_mean("completely_unrelated_words"), "");
     }
 }

@@ -25,7 +25,9 @@ mod reference;
 pub use document::Config;
 pub use error::ConfigError;
 pub use excitation::{DEFAULT_SPLINE_TOLERANCE, MAX_HARMONICS};
-pub use keys::{DERIVED_KEYS, apply_overrides, known_keys, parse_override, parse_value, similar_keys};
+pub use keys::{
+    DERIVED_KEYS, apply_overrides, did_you_mean, known_keys, parse_override, parse_value, similar_keys,
+};
 pub use param::Param;
 pub use reference::{
     Allowed, KEY_DOCS, KeyDoc, default_values, reference_markdown, stale_entries, undocumented_keys,

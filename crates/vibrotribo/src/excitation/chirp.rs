@@ -3,8 +3,9 @@
 
 use std::f64::consts::TAU;
 
+use super::budget::WorkBudget;
 use super::error::SignalError;
-use super::harmonics::{SplineAccuracy, intervals_for, sample_smooth};
+use super::harmonics::{SplineAccuracy, intervals_for, sample_smooth_within};
 use super::spline::PiecewiseCubic;
 
 /// How the instantaneous frequency moves from its start to its end value.
@@ -129,9 +130,19 @@ impl Chirp {
     /// the displacement error is at most `tolerance` (m) by the bound of
     /// [`spline_error_bounds`](super::spline_error_bounds), and the bounds achieved.
     pub fn to_spline(&self, tolerance: f64) -> Result<(PiecewiseCubic, SplineAccuracy), SignalError> {
+        self.to_spline_within(tolerance, &WorkBudget::unlimited())
+    }
+
+    /// [`to_spline`](Self::to_spline) stopped by `budget`'s flag ([`SignalError::Stopped`];
+    /// a spline of millions of knots takes seconds).
+    pub fn to_spline_within(
+        &self,
+        tolerance: f64,
+        budget: &WorkBudget,
+    ) -> Result<(PiecewiseCubic, SplineAccuracy), SignalError> {
         let n = self.intervals_needed(tolerance)?;
         let m4 = self.fourth_derivative_bound();
-        let spline = sample_smooth(|t| self.displacement_velocity(t), self.duration, n)?;
+        let spline = sample_smooth_within(|t| self.displacement_velocity(t), self.duration, n, budget)?;
         Ok((spline, SplineAccuracy::new(self.duration / n as f64, m4)))
     }
 }

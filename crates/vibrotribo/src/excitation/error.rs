@@ -44,7 +44,7 @@ pub enum SignalError {
     #[error(
         "the signal has {harmonics} harmonics over {intervals} intervals: about {:.1e} harmonic evaluations to build, \
          more than the limit of {:.0e} (about half a minute); narrow the band (f_low_hz, f_high_hz), \
-         shorten the duration or raise spline_tolerance, or allow large jobs (--allow-large)",
+         shorten the duration or raise spline_tolerance, or allow large jobs (--allow-large, allow_large=True)",
         super::budget::build_cost(*harmonics, *intervals),
         super::MAX_PIECE_EVALUATIONS
     )]

@@ -1,6 +1,7 @@
 //! [`Harmonic`]: one sinusoidal component of the base displacement, sums of them
 //! (multisines), and their sampling into a clamped cubic spline within a stated error.
 
+use super::budget::WorkBudget;
 use super::error::SignalError;
 use super::spline::{EndCondition, PiecewiseCubic, knot_spacing, spline_error_bounds};
 
@@ -101,10 +102,30 @@ pub(crate) fn sample_smooth(
     end: f64,
     intervals: usize,
 ) -> Result<PiecewiseCubic, SignalError> {
+    sample_smooth_within(f, end, intervals, &WorkBudget::unlimited())
+}
+
+/// Knots sampled between two looks at the stop flag ([`sample_smooth_within`]).
+const POLL_KNOTS: usize = 1 << 14;
+
+/// [`sample_smooth`] stopped by `budget`'s flag (read every 16 384 knots:
+/// [`SignalError::Stopped`]).
+pub(crate) fn sample_smooth_within(
+    f: impl Fn(f64) -> [f64; 2],
+    end: f64,
+    intervals: usize,
+    budget: &WorkBudget,
+) -> Result<PiecewiseCubic, SignalError> {
     let times: Vec<f64> = (0..=intervals)
         .map(|k| end * k as f64 / intervals as f64)
         .collect();
-    let values: Vec<f64> = times.iter().map(|&t| f(t)[0]).collect();
+    let mut values = Vec::with_capacity(times.len());
+    for (k, &t) in times.iter().enumerate() {
+        if k % POLL_KNOTS == 0 && budget.stopped() {
+            return Err(SignalError::Stopped { done: k, intervals });
+        }
+        values.push(f(t)[0]);
+    }
     let ends = EndCondition::Clamped {
         start_slope: f(0.0)[1],
         end_slope: f(end)[1],

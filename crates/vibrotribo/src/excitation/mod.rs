@@ -149,14 +149,14 @@ impl ExcitationSpec {
     }
 
     /// [`build`](Self::build) within `budget`: a random signal costlier than
-    /// [`MAX_PIECE_EVALUATIONS`] is refused unless it allows large builds, and its build
-    /// stops when its stop flag is set ([`SignalError::Stopped`]).
+    /// [`MAX_PIECE_EVALUATIONS`] is refused unless it allows large builds, and its build (and
+    /// a chirp's spline) stops when its stop flag is set ([`SignalError::Stopped`]).
     pub fn build_within(&self, harmonic: Harmonic, budget: &WorkBudget) -> Result<BaseMotion, SignalError> {
         Ok(match self {
             ExcitationSpec::Harmonic => BaseMotion::Harmonics(vec![harmonic]),
             ExcitationSpec::Multisine(h) => BaseMotion::Harmonics(h.clone()),
             ExcitationSpec::Chirp { chirp, tolerance } => {
-                let (displacement, accuracy) = chirp.to_spline(*tolerance)?;
+                let (displacement, accuracy) = chirp.to_spline_within(*tolerance, budget)?;
                 BaseMotion::Spline(SplineMotion {
                     displacement,
                     accuracy: Some(accuracy),

@@ -22,6 +22,7 @@ use crate::config::{Config, ConfigError};
 use crate::dynamics::{Event, EventKind, StateView};
 use crate::electrical::Load;
 use crate::excitation::{Chirp, ExcitationKind, ExcitationSpec, Sweep};
+use crate::orbits::Cancel;
 
 /// The default [`ChirpOptions::samples_per_cycle`].
 pub const DEFAULT_SAMPLES_PER_CYCLE: u64 = 200;
@@ -60,6 +61,11 @@ pub struct ChirpOptions {
     /// Cycles on each side of a boundary whose median amplitudes are compared to find the
     /// jump ([`largest_jump`]).
     pub jump_window: usize,
+    /// Polled at every period and Newton iteration of the settling at the start frequency
+    /// ([`settled_start`](Self::settled_start)): when it asks, the chirp stops with
+    /// [`ChirpError::Settle`] holding [`PointError::Stopped`]. (The chirp itself stops where
+    /// the observer given to [`run_chirp`] says.) Default: never.
+    pub cancel: Cancel,
 }
 
 impl ChirpOptions {
@@ -76,6 +82,7 @@ impl ChirpOptions {
             settled_start: true,
             samples_per_cycle: DEFAULT_SAMPLES_PER_CYCLE,
             jump_window: DEFAULT_JUMP_WINDOW,
+            cancel: Cancel::never(),
         }
     }
 }
@@ -380,14 +387,22 @@ pub fn chirp_config(
 }
 
 /// The steady state of `config`'s harmonic motion at Ω = `omega_ratio`, at a period's end
-/// (mechanics only; [`settle`](super::settle) with the defaults of a sweep point).
-fn settled_state(config: &Config, omega_ratio: f64) -> Result<crate::model::ChainState, ChirpError> {
+/// (mechanics only; [`settle`](super::settle) with the defaults of a sweep point), stopped
+/// by `cancel`.
+fn settled_state(
+    config: &Config,
+    omega_ratio: f64,
+    cancel: &Cancel,
+) -> Result<crate::model::ChainState, ChirpError> {
     let harmonic = config.with("omega_ratio", Value::Float(omega_ratio))?;
     let s = super::settle::settle(
         harmonic.chain(),
         harmonic.initial_state(),
         harmonic.sim_options(),
-        &super::point::PointOptions::default(),
+        &super::point::PointOptions {
+            cancel: cancel.clone(),
+            ..super::point::PointOptions::default()
+        },
         &super::settle::AutoSettle::default(),
     )
     .map_err(|e| ChirpError::Settle {
@@ -609,7 +624,7 @@ pub fn run_chirp<O: RunObserver + ?Sized>(
             Direction::Up => options.from,
             Direction::Down => options.to,
         };
-        spec.initial = settled_state(config, start)?;
+        spec.initial = settled_state(config, start, &options.cancel)?;
     }
     let f_max = chirp.f_start_hz.max(chirp.f_end_hz);
     spec.sampling = Some(Sampling::Uniform {

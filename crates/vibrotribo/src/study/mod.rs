@@ -6,6 +6,7 @@
 //! the charge solver and the statistics together itself.
 
 mod chirp;
+mod floquet;
 pub mod limits;
 mod loads;
 mod lyapunov;
@@ -27,6 +28,7 @@ pub use chirp::{
     ChirpError, ChirpOptions, ChirpRun, ChirpStudy, Cycle, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE,
     Direction, Jump, MIN_CYCLES, check_options, chirp_config, chirp_study, largest_jump, run_chirp,
 };
+pub use floquet::FloquetError;
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};
 pub use lyapunov::{LyapunovRun, lyapunov_spectrum};
 pub use mass_ratio::{

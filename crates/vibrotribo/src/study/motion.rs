@@ -59,6 +59,7 @@ use crate::analysis::{Periodicity, amplitude, closed_curve_ratio, contracting_di
 use crate::excitation::WorkBudget;
 use crate::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
+use crate::orbits::Cancel;
 use crate::sensitivity::length_scale;
 
 /// The kind of motion of a recorded window (see the module docs of `study/motion.rs`).
@@ -208,12 +209,13 @@ impl std::fmt::Display for LyapunovSkipped {
     }
 }
 
-/// A run observer that stops the run at a period's end once the budget's flag is set.
-struct Poll<'a>(&'a WorkBudget);
+/// A run observer that stops the run at a period's end once the budget's flag is set or the
+/// cancel hook asks.
+struct Poll<'a>(&'a WorkBudget, &'a Cancel);
 
 impl RunObserver for Poll<'_> {
     fn period(&mut self, _periods: u64, _state: &StateView<'_>) -> ControlFlow<()> {
-        if self.0.stopped() {
+        if self.0.stopped() || self.1.requested() {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
@@ -259,7 +261,8 @@ impl<'a> Window<'a> {
 /// `options.transient_periods`; `spectrum` the Lyapunov spectrum over the window if one was
 /// computed. Without one, a window that is neither periodic nor settling gets the spectrum
 /// over `options.recorded_periods` periods from its final state (mechanics only), within
-/// `budget` ([`MAX_CLASSIFY_WORK`] unless it allows large jobs; stopped by its flag).
+/// `budget` ([`MAX_CLASSIFY_WORK`] unless it allows large jobs; stopped by its flag or by
+/// `options.cancel`).
 pub fn classify(
     params: &ChainParams,
     sim_options: &SimOptions,
@@ -356,7 +359,12 @@ pub fn classify(
             spec.initial = window.final_state.clone();
             spec.options = sim_options.clone();
             spec.transient_periods = WARMUP;
-            let run = lyapunov_spectrum(&spec, &LyapunovOptions::default(), &mut Poll(budget)).ok();
+            let run = lyapunov_spectrum(
+                &spec,
+                &LyapunovOptions::default(),
+                &mut Poll(budget, &options.cancel),
+            )
+            .ok();
             if run.as_ref().is_some_and(|r| r.outcome.ending == Ending::Stopped) {
                 report.motion = Motion::Undetermined;
                 report.lyapunov_skipped = Some(LyapunovSkipped::Stopped);

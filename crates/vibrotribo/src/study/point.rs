@@ -13,8 +13,9 @@ use std::sync::Arc;
 
 use thiserror::Error;
 
+use super::floquet::{FloquetError, floquet};
 use super::motion::{Motion, MotionReport, WARMUP as MOTION_WARMUP, Window, classify};
-use super::observer::{Mechanics, RunObserver};
+use super::observer::{Checkpoint, Mechanics, RunObserver};
 use super::settings::{ElectricalFailure, Harvester, RunSettings, RunSpec};
 use super::settle::{AutoSettle, SettleEnding, SettleMode, settle};
 use super::simulate::{Ending, StudyError, simulate};
@@ -25,7 +26,7 @@ use crate::error::SimError;
 use crate::excitation::{BaseMotion, BaseMotionError};
 use crate::lyapunov::{LyapunovError, LyapunovObserver, LyapunovOptions, LyapunovSpectrum};
 use crate::model::{ChainParams, ChainState, SimOptions};
-use crate::orbits::{OrbitError, ShootingOptions, find_periodic_orbit};
+use crate::orbits::Cancel;
 
 /// The default of [`PointOptions::period_tolerance`], 1e-4 (relative).
 pub const DEFAULT_PERIOD_TOLERANCE: f64 = 1e-4;
@@ -61,6 +62,10 @@ pub struct PointOptions {
     /// Also classify the motion of the recorded window ([`PointResult::motion`]; may run a
     /// Lyapunov spectrum for a point that is neither periodic nor settling). Default false.
     pub classify: bool,
+    /// Polled at every period of the point's runs (the settling, the recorded window, the
+    /// classification's Lyapunov run) and at every Newton iteration of its shots: when it
+    /// asks, the point stops with [`PointError::Stopped`]. Default: never.
+    pub cancel: Cancel,
 }
 
 impl Default for PointOptions {
@@ -75,6 +80,7 @@ impl Default for PointOptions {
             lyapunov: None,
             settle: SettleMode::Fixed,
             classify: false,
+            cancel: Cancel::never(),
         }
     }
 }
@@ -148,8 +154,10 @@ pub struct PointResult {
     pub final_state: ChainState,
     /// With [`PointOptions::floquet`] and a detected period: the largest modulus of the
     /// Floquet multipliers of the periodic orbit of that period found by shooting from the
-    /// final state (`Err` with the reason where shooting failed, e.g. at a grazing point).
-    pub max_abs_multiplier: Option<Result<f64, OrbitError>>,
+    /// final state, where that orbit is the window's own (`Err` with the reason where
+    /// shooting failed, e.g. at a grazing point, or converged to an orbit the run is not on;
+    /// see the module docs of `study/floquet.rs`).
+    pub max_abs_multiplier: Option<Result<f64, FloquetError>>,
     /// The Lyapunov spectrum over the recorded periods, if [`PointOptions::lyapunov`] asked
     /// for it.
     pub lyapunov: Option<Result<LyapunovSpectrum, LyapunovError>>,
@@ -197,6 +205,23 @@ pub enum PointError {
     /// is not positive and finite).
     #[error(transparent)]
     Analysis(#[from] crate::analysis::AnalysisError),
+    /// [`PointOptions::cancel`] asked the point to stop; nothing of it is kept.
+    #[error("stopped after {periods} periods")]
+    Stopped {
+        /// Excitation periods the point had run (settling and recorded window).
+        periods: u64,
+    },
+}
+
+impl PointError {
+    /// This error, with `periods` more counted in a [`Stopped`](Self::Stopped) one (the
+    /// periods run before the part that stopped).
+    pub(super) fn after(self, periods: u64) -> Self {
+        match self {
+            PointError::Stopped { periods: p } => PointError::Stopped { periods: p + periods },
+            e => e,
+        }
+    }
 }
 
 /// Records impacts after the transient and flags grazing.
@@ -284,7 +309,7 @@ pub fn run_point(
                 ));
                 no_period_while_settling(&mut r);
             }
-            return Ok(r);
+            return finish(params, sim_options, options, r);
         }
         SettleMode::Auto(a) => a,
     };
@@ -303,7 +328,7 @@ pub fn run_point(
             cap_periods: auto.cap_periods.saturating_sub(before).max(1),
             ..*auto
         };
-        let mut settled = settle(params, &start, sim_options, &this, &left)?;
+        let mut settled = settle(params, &start, sim_options, &this, &left).map_err(|e| e.after(before))?;
         settled.periods += before;
         // A motion the settling found irregular will need its Lyapunov exponent: take it
         // over the recorded window itself, the warm-up aligning the tangent vectors.
@@ -350,12 +375,40 @@ pub fn run_point(
             && round < MAX_ROUNDS
             && end < auto.cap_periods;
         if !again {
-            return Ok(r);
+            return finish(params, sim_options, options, r);
         }
         round += 1;
         before = end;
         start = r.final_state;
     }
+}
+
+/// The end of a point: with [`PointOptions::floquet`] its orbit's largest multiplier
+/// modulus, and a stable orbit the shots found that the run is not on as the motion's
+/// coexisting orbit (where the settling found none); a stop asked meanwhile discards it.
+fn finish(
+    params: &ChainParams,
+    sim_options: &SimOptions,
+    options: &PointOptions,
+    mut r: PointResult,
+) -> Result<PointResult, PointError> {
+    let periods = r.strobe_periods.last().copied().unwrap_or(0);
+    let stopped = || PointError::Stopped { periods };
+    if options.floquet {
+        // A window settling onto an orbit is not searched: the shots would find that orbit.
+        let search = r.motion.as_ref().is_none_or(|m| m.motion != Motion::Settling);
+        let f = floquet(params, sim_options, options, &r, search).map_err(|_| stopped())?;
+        r.max_abs_multiplier = f.max_abs_multiplier;
+        if let (Some(m), Some(o)) = (r.motion.as_mut(), f.coexisting)
+            && m.coexisting.is_none()
+        {
+            m.coexisting = Some((o.period, o.spectral_radius));
+        }
+    }
+    if options.cancel.requested() {
+        return Err(stopped());
+    }
+    Ok(r)
 }
 
 /// Whether `harvester`'s forces act on the masses (two-way coupling).
@@ -474,7 +527,12 @@ fn record(
         None => None,
     };
     let mut watch = (
-        Mechanics::new(strobe),
+        (
+            Mechanics::new(strobe),
+            Checkpoint {
+                stop: |_| options.cancel.requested(),
+            },
+        ),
         (
             Mechanics::new(lyapunov),
             Impacts {
@@ -490,9 +548,14 @@ fn record(
     match outcome.ending {
         Ending::Failed(StudyError::Sim(e)) => return Err(e.into()),
         Ending::Failed(e) => return Err(PointError::Study(e)),
-        Ending::Completed | Ending::Stopped => {}
+        Ending::Stopped => {
+            return Err(PointError::Stopped {
+                periods: offset + outcome.periods,
+            });
+        }
+        Ending::Completed => {}
     }
-    let (strobe, (lyapunov, impacts)) = (watch.0.inner, (watch.1.0.inner, watch.1.1));
+    let (strobe, (lyapunov, impacts)) = (watch.0.0.inner, (watch.1.0.inner, watch.1.1));
     let average_power_se_w = outcome
         .electrical
         .as_ref()
@@ -512,19 +575,6 @@ fn record(
         None
     };
     let stats = &outcome.stats;
-    let period = periodicity.and_then(|p| p.period()).unwrap_or(0);
-    let max_abs_multiplier = (options.floquet && period > 0).then(|| {
-        find_periodic_orbit(
-            params,
-            &outcome.final_state,
-            period as u32,
-            &ShootingOptions {
-                sim: sim_options.clone(),
-                ..ShootingOptions::default()
-            },
-        )
-        .map(|o| o.spectral_radius())
-    });
     let grazing = impacts.grazing;
     let mut impacts = impacts.records;
     let mut strobe_periods = strobe.indices;
@@ -550,7 +600,7 @@ fn record(
         average_power_w,
         electrical_error,
         final_state: outcome.final_state,
-        max_abs_multiplier,
+        max_abs_multiplier: None,
         lyapunov: lyapunov.map(LyapunovObserver::finish),
         average_power_se_w,
         motion: None,

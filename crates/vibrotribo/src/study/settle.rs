@@ -26,7 +26,7 @@
 //! (`transient_periods`) has passed, so an irregular motion costs no more than before; the
 //! cap ends it otherwise.
 
-use super::observer::Mechanics;
+use super::observer::{Checkpoint, Mechanics};
 use super::point::{PointError, PointOptions};
 use super::settings::RunSpec;
 use super::simulate::{Ending, StudyError, simulate};
@@ -35,7 +35,7 @@ use crate::analysis::{
     converging_lag, detect_period,
 };
 use crate::model::{ChainParams, ChainState, SimOptions};
-use crate::orbits::{PeriodicOrbit, ShootingOptions, find_periodic_orbit};
+use crate::orbits::{Cancel, PeriodicOrbit, ShootingOptions, find_periodic_orbit};
 
 /// How long a sweep point runs before its recorded window.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -204,12 +204,14 @@ pub(super) fn section_states<'a>(
 }
 
 /// Runs the mechanics of `params` from `state` for `periods` excitation periods: the
-/// stroboscopic samples at t = T, 2T, … (from the start) and the final state.
-fn strobe_run(
+/// stroboscopic samples at t = T, 2T, … (from the start) and the final state; stopped by
+/// `cancel` at a period's end ([`PointError::Stopped`], counting this run's periods).
+pub(super) fn strobe_run(
     params: &ChainParams,
     sim_options: &SimOptions,
     state: &ChainState,
     periods: u64,
+    cancel: &Cancel,
 ) -> Result<(StroboscopicSection, ChainState), PointError> {
     let mut spec = RunSpec::new(params.clone(), periods);
     spec.initial = state.clone();
@@ -223,12 +225,20 @@ fn strobe_run(
             transient_periods: 1,
         },
     )?;
-    let mut watch = Mechanics::new(strobe);
+    let mut watch = (
+        Mechanics::new(strobe),
+        Checkpoint {
+            stop: |_| cancel.requested(),
+        },
+    );
     let outcome = simulate(&spec, &mut watch)?;
     match outcome.ending {
         Ending::Failed(StudyError::Sim(e)) => Err(e.into()),
         Ending::Failed(e) => Err(PointError::Study(e)),
-        Ending::Completed | Ending::Stopped => Ok((watch.inner, outcome.final_state)),
+        Ending::Stopped => Err(PointError::Stopped {
+            periods: outcome.periods,
+        }),
+        Ending::Completed => Ok((watch.0.inner, outcome.final_state)),
     }
 }
 
@@ -247,7 +257,9 @@ const SHOT_MIN_DAMPING: f64 = 1.0 / 32.0;
 /// Settles `params` from `initial` (see the module docs of `study/settle.rs`): runs `sim_options`'
 /// mechanics in blocks until the period test of `options` passes on the trailing returns,
 /// Newton shooting finishes a geometric approach, the returns prove irregular after
-/// `options.transient_periods`, or `auto.cap_periods` is reached.
+/// `options.transient_periods`, or `auto.cap_periods` is reached. `options.cancel` is polled
+/// at every period and Newton iteration: when it asks, the settling stops with
+/// [`PointError::Stopped`], counting the periods it ran.
 pub fn settle(
     params: &ChainParams,
     initial: &ChainState,
@@ -275,7 +287,8 @@ pub fn settle(
         }
         .min(auto.cap_periods.saturating_sub(done))
         .max(1);
-        let (strobe, last) = strobe_run(params, sim_options, &state, len)?;
+        let (strobe, last) =
+            strobe_run(params, sim_options, &state, len, &options.cancel).map_err(|e| e.after(done))?;
         done += len;
         state = last;
         history.extend_from_slice(&strobe.positions);
@@ -321,9 +334,13 @@ pub fn settle(
                         sim_options,
                         scale,
                         tolerance: options.period_tolerance,
+                        cancel: &options.cancel,
                     };
                     let budget = auto.cap_periods.saturating_sub(done);
-                    match shot.try_orbit(&state, fit_period, &fit, budget)? {
+                    match shot
+                        .try_orbit(&state, fit_period, &fit, budget)
+                        .map_err(|e| e.after(done))?
+                    {
                         Verdict::Confirmed(orbit, residual) => {
                             return Ok(Settled {
                                 shot: Some((orbit.period, residual)),
@@ -357,12 +374,13 @@ enum Verdict {
 }
 
 /// The settings a shot needs: the chain, the simulator's options, the amplitude the
-/// distances are measured against, and the period tolerance.
-struct Shot<'a> {
-    params: &'a ChainParams,
-    sim_options: &'a SimOptions,
-    scale: f64,
-    tolerance: f64,
+/// distances are measured against, the period tolerance and the hook that stops it.
+pub(super) struct Shot<'a> {
+    pub(super) params: &'a ChainParams,
+    pub(super) sim_options: &'a SimOptions,
+    pub(super) scale: f64,
+    pub(super) tolerance: f64,
+    pub(super) cancel: &'a Cancel,
 }
 
 impl Shot<'_> {
@@ -376,51 +394,80 @@ impl Shot<'_> {
         fit: &Convergence,
         budget: u64,
     ) -> Result<Verdict, PointError> {
-        let Ok(orbit) = find_periodic_orbit(
+        let Some(orbit) = self.shoot(state, p as u32)? else {
+            return Ok(Verdict::Unknown);
+        };
+        let q = fit.rate().powi(p as i32);
+        if self.distance(state, &orbit.state) > 4.0 * fit.distance / (1.0 - q) {
+            return Ok(Verdict::Unknown);
+        }
+        Ok(match self.approaches(state, &orbit, budget)? {
+            None => Verdict::Unknown,
+            Some(true) => Verdict::Confirmed(self.minimal(&orbit)?, orbit.residual),
+            Some(false) => Verdict::Elsewhere(self.minimal(&orbit)?),
+        })
+    }
+
+    /// The periodic orbit of period `p` that Newton shooting from `state` converges to within
+    /// [`SHOT_ITERATIONS`] (`None` where it does not); a stop asked meanwhile is
+    /// [`PointError::Stopped`].
+    pub(super) fn shoot(&self, state: &ChainState, p: u32) -> Result<Option<PeriodicOrbit>, PointError> {
+        let found = find_periodic_orbit(
             self.params,
             state,
-            p as u32,
+            p,
             &ShootingOptions {
                 sim: self.sim_options.clone(),
                 max_iterations: SHOT_ITERATIONS,
                 min_damping: SHOT_MIN_DAMPING,
+                cancel: self.cancel.clone(),
                 ..ShootingOptions::default()
             },
-        ) else {
-            return Ok(Verdict::Unknown);
-        };
-        let q = fit.rate().powi(p as i32);
-        let near = self.distance(state, &orbit.state) <= 4.0 * fit.distance / (1.0 - q);
-        let rho = orbit.spectral_radius();
-        if !orbit.stable || !near || rho.is_nan() || rho <= 0.0 {
-            return Ok(Verdict::Unknown);
+        );
+        if self.cancel.requested() {
+            return Err(PointError::Stopped { periods: 0 });
         }
-        // Orbit periods over which the multipliers predict a fourfold shrink.
+        Ok(found.ok())
+    }
+
+    /// Whether `state`, simulated on, approaches the stable `orbit` at the rate of its
+    /// multipliers: over K orbit periods, K the smallest count over which the largest
+    /// multiplier modulus ρ predicts a fourfold shrink (ρ^K ≤ 1/4), its distance to the orbit
+    /// (in the section states the fit reads) must shrink to 2·ρ^K of what it was (or below
+    /// a hundredth of the period tolerance). `None` for an orbit that is not stable, or where
+    /// the check would take more than `budget` periods.
+    pub(super) fn approaches(
+        &self,
+        state: &ChainState,
+        orbit: &PeriodicOrbit,
+        budget: u64,
+    ) -> Result<Option<bool>, PointError> {
+        let rho = orbit.spectral_radius();
+        if !orbit.stable || rho.is_nan() || rho <= 0.0 {
+            return Ok(None);
+        }
         let k = ((0.25f64).ln() / rho.ln()).ceil().max(1.0);
         let periods = k * f64::from(orbit.period);
         if periods > budget as f64 {
-            return Ok(Verdict::Unknown);
+            return Ok(None);
         }
         let ends = self.run_states(state, periods as u64)?;
         let Some(last) = ends.last() else {
-            return Ok(Verdict::Unknown);
+            return Ok(None);
         };
         let (start, end) = (
             self.distance(state, &orbit.state),
             self.distance(last, &orbit.state),
         );
-        let found = self.minimal(&orbit)?;
-        if end <= (2.0 * rho.powf(k) * start).max(0.01 * self.tolerance) {
-            Ok(Verdict::Confirmed(found, orbit.residual))
-        } else {
-            Ok(Verdict::Elsewhere(found))
-        }
+        Ok(Some(
+            end <= (2.0 * rho.powf(k) * start).max(0.01 * self.tolerance),
+        ))
     }
 
     /// The orbit at its minimal period: the smallest divisor d of its period whose d-period
     /// return `φ_d(z)` is within the period tolerance of z (relative to the amplitude), its
     /// multiplier modulus taken over d periods.
-    fn minimal(&self, orbit: &PeriodicOrbit) -> Result<ShotOrbit, PointError> {
+    pub(super) fn minimal(&self, orbit: &PeriodicOrbit) -> Result<ShotOrbit, PointError> {
         let p = orbit.period;
         let returns = self.run_states(&orbit.state, u64::from(p))?;
         let d = (1..p)
@@ -446,7 +493,7 @@ impl Shot<'_> {
     /// The states of a run from `state` at the ends of its first `periods` excitation periods.
     fn run_states(&self, state: &ChainState, periods: u64) -> Result<Vec<ChainState>, PointError> {
         let n = self.params.len();
-        let (s, _) = strobe_run(self.params, self.sim_options, state, periods)?;
+        let (s, _) = strobe_run(self.params, self.sim_options, state, periods, self.cancel)?;
         Ok(s.positions
             .chunks_exact(n)
             .zip(s.velocities.chunks_exact(n))

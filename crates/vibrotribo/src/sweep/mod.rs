@@ -11,7 +11,8 @@ mod table;
 
 pub use request::{PointRequest, PointRequestError};
 pub use runner::{
-    Continuation, Delivery, PointRunner, SweepError, grid, run_chunks, run_continued, run_grid, run_grid_on,
+    Continuation, Delivery, PointRunner, SweepError, grid, is_stopped, run_chunks, run_continued, run_grid,
+    run_grid_on,
 };
 pub use table::{
     Cell, Column, IMPACT_COLUMNS, Kind, LYAPUNOV_COLUMNS, MOTION_COLUMNS, PointColumns, SweepColumns, Table,

@@ -96,6 +96,13 @@ impl PointRunner {
         }
     }
 
+    /// This runner with its points stopped by `cancel` ([`PointOptions::cancel`]): a point
+    /// it stops ends in [`PointError::Stopped`] (see [`is_stopped`]).
+    pub fn with_cancel(mut self, cancel: crate::orbits::Cancel) -> Self {
+        self.options.cancel = cancel;
+        self
+    }
+
     /// The point options in use.
     pub fn options(&self) -> &PointOptions {
         &self.options
@@ -175,6 +182,12 @@ impl PointRunner {
             spec.base_motion.as_ref(),
         )?)
     }
+}
+
+/// Whether a point's result is a stop ([`PointError::Stopped`]) rather than a result: it
+/// holds nothing of the point, and a job that writes its points in order stops writing there.
+pub fn is_stopped(result: &Result<PointResult, SweepError>) -> bool {
+    matches!(result, Err(SweepError::Point(PointError::Stopped { .. })))
 }
 
 /// What [`run_grid`] (and [`run_chunks`]) hands over, in grid order (handed over once, by

@@ -148,3 +148,97 @@ fn a_piecewise_build_has_a_cost_and_a_stop() {
         other => panic!("expected a stop, got {:?}", other.map(|p| p.accuracy())),
     }
 }
+
+/// A cancel hook that counts its calls and asks to stop from call `from` on.
+fn hook_from(from: u64) -> (vibrotribo::orbits::Cancel, Arc<std::sync::atomic::AtomicU64>) {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let calls = Arc::new(AtomicU64::new(0));
+    let seen = Arc::clone(&calls);
+    let cancel = vibrotribo::orbits::Cancel::new(move || seen.fetch_add(1, Ordering::Relaxed) + 1 >= from);
+    (cancel, calls)
+}
+
+/// Settling, the recorded window, the Lyapunov spectrum, the classification and the Floquet
+/// shots of a sweep point ran to their end whatever was asked: `simulate --settle auto` and a
+/// sweep's long points ignored SIGINT. A point polls its cancel hook throughout and,
+/// stopped anywhere, gives no result but [`PointError::Stopped`]; never stopped, the same
+/// result as without a hook.
+#[test]
+fn a_sweep_point_stops_in_every_phase_when_its_cancel_hook_asks() {
+    use vibrotribo::lyapunov::LyapunovOptions;
+    use vibrotribo::study::{AutoSettle, PointError, SettleMode, run_point};
+    let cases = [
+        // The chatter case: settled and shot onto its period-1 orbit.
+        (ChainParams::paper_chatter_case(), ChainState::at_rest(3)),
+        // Fig. 19's non-periodic window: irregular settling, a Lyapunov classification, the
+        // Floquet search at close returns.
+        (
+            ChainParams {
+                masses: vec![0.05, 0.2105, 0.05],
+                excitation: vibrotribo::Excitation {
+                    frequency: vibrotribo::Frequency::OmegaRatio(0.3),
+                    ..ChainParams::default().excitation
+                },
+                ..ChainParams::default()
+            },
+            ChainState::at_rest(3),
+        ),
+    ];
+    for (params, start) in cases {
+        let options = PointOptions {
+            transient_periods: 100,
+            recorded_periods: 60,
+            floquet: true,
+            lyapunov: Some(LyapunovOptions::default()),
+            settle: SettleMode::Auto(AutoSettle::default()),
+            classify: true,
+            ..PointOptions::default()
+        };
+        let free = run_point(&params, &start, &SimOptions::default(), None, &options).unwrap();
+        let (cancel, calls) = hook_from(u64::MAX);
+        let counted = PointOptions {
+            cancel,
+            ..options.clone()
+        };
+        let same = run_point(&params, &start, &SimOptions::default(), None, &counted).unwrap();
+        assert_eq!(same, free);
+        let total = calls.load(std::sync::atomic::Ordering::Relaxed);
+        let last = free.strobe_periods.last().copied().unwrap();
+        println!(
+            "{total} polls over {last} periods, motion {:?}",
+            free.motion.as_ref().map(|m| m.motion)
+        );
+        assert!(total > last, "{total} polls, {last} periods");
+        for k in 0..=16 {
+            let from = (1 + total * k / 16).min(total);
+            let (cancel, _) = hook_from(from);
+            let stopped = PointOptions {
+                cancel,
+                ..options.clone()
+            };
+            match run_point(&params, &start, &SimOptions::default(), None, &stopped) {
+                Err(PointError::Stopped { periods }) => assert!(periods <= last, "{periods} > {last}"),
+                other => panic!("stopped at poll {from} of {total}: {other:?}"),
+            }
+        }
+    }
+}
+
+/// The chirp's settling at its start frequency is stopped by the chirp's cancel hook.
+#[test]
+fn a_chirps_settling_stops_when_its_cancel_hook_asks() {
+    use vibrotribo::study::{ChirpError, ChirpOptions, Direction, PointError, run_chirp};
+    let (cancel, _) = hook_from(1);
+    let options = ChirpOptions {
+        cancel,
+        mechanics_only: true,
+        ..ChirpOptions::new(0.6, 0.8, 20.0)
+    };
+    let config = vibrotribo::config::Config::default();
+    match run_chirp(&config, &options, Direction::Up, &mut ()) {
+        Err(ChirpError::Settle { source, .. }) => {
+            assert!(matches!(*source, PointError::Stopped { .. }), "{source}")
+        }
+        other => panic!("{:?}", other.map(|r| r.cycles.len())),
+    }
+}

@@ -11,21 +11,21 @@ use vibrotribo::config::Config;
 use vibrotribo::study::{AutoSettle, Motion, PointOptions, PointResult, SettleMode, run_point};
 use vibrotribo::{ChainParams, ChainState, SimOptions};
 
-fn config(base: Config, keys: &[(&str, toml::Value)]) -> Config {
+pub(crate) fn config(base: Config, keys: &[(&str, toml::Value)]) -> Config {
     let mut c = base;
     c.set_all(keys.iter().map(|(k, v)| (*k, v.clone()))).unwrap();
     c
 }
 
-fn float(x: f64) -> toml::Value {
+pub(crate) fn float(x: f64) -> toml::Value {
     toml::Value::Float(x)
 }
 
-fn array(v: &[f64]) -> toml::Value {
+pub(crate) fn array(v: &[f64]) -> toml::Value {
     toml::Value::Array(v.iter().map(|&x| toml::Value::Float(x)).collect())
 }
 
-fn options(transient: u64, settle: SettleMode) -> PointOptions {
+pub(crate) fn options(transient: u64, settle: SettleMode) -> PointOptions {
     PointOptions {
         transient_periods: transient,
         recorded_periods: 100,
@@ -37,7 +37,11 @@ fn options(transient: u64, settle: SettleMode) -> PointOptions {
 
 /// The default sweep's point (`--settle auto`, 300 + 100 periods) and the plain run of 3000
 /// transient and 100 recorded periods from the same start.
-fn judged(params: &ChainParams, start: &ChainState, sim: &SimOptions) -> (PointResult, PointResult) {
+pub(crate) fn judged(
+    params: &ChainParams,
+    start: &ChainState,
+    sim: &SimOptions,
+) -> (PointResult, PointResult) {
     let auto = run_point(
         params,
         start,
@@ -52,7 +56,7 @@ fn judged(params: &ChainParams, start: &ChainState, sim: &SimOptions) -> (PointR
 
 /// The label agrees with the long run: the same minimal period and impacts per period where
 /// the long run is periodic, not periodic where it is not.
-fn assert_agrees(what: &str, auto: &PointResult, long: &PointResult) {
+pub(crate) fn assert_agrees(what: &str, auto: &PointResult, long: &PointResult) {
     let (a, l) = (auto.motion.as_ref().unwrap(), long.motion.as_ref().unwrap());
     println!(
         "{what}: auto {} period {} ({:?}, coexisting {:?}, {} settling periods), long {} period {}",
@@ -102,7 +106,7 @@ fn chatter_chain_at_omega_1_19_is_labelled_with_the_orbit_its_run_reaches() {
 }
 
 /// Fig. 7's chain (m = 90, 120, 90 g, Ω = 0.70) at spacing ratio `r`.
-fn fig7(r: f64) -> Config {
+pub(crate) fn fig7(r: f64) -> Config {
     config(
         Config::default(),
         &[
@@ -114,7 +118,7 @@ fn fig7(r: f64) -> Config {
 
 /// The final state of a continuation in R_δ from `from` (from rest) to 1.09 in 5 steps of
 /// 300 + 100 periods: on the four-impact orbit from 1.0, on the two-impact one from 1.2.
-fn continued(from: f64) -> ChainState {
+pub(crate) fn continued(from: f64) -> ChainState {
     let mut state = ChainState::at_rest(3);
     for k in 0..=5 {
         let c = fig7(from + (1.09 - from) * k as f64 / 5.0);

@@ -26,6 +26,7 @@ mod excitation_energy;
 mod excitation_engine;
 mod excitation_signals;
 mod external_forces;
+mod floquet_labels;
 mod flow_vs_integrator;
 mod issue_breakdown_depends_on_sampling;
 mod issue_charge_solver_underflow;
