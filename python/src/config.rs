@@ -153,6 +153,10 @@ pub fn table_to_dict<'py>(py: Python<'py>, t: &Table) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+/// What `Config.__reduce__` hands pickle: the restoring function and its arguments (the
+/// settings and whether large runs are allowed).
+type Reduced<'py> = (Bound<'py, PyAny>, (Bound<'py, PyDict>, bool));
+
 /// A configuration: the paper's default case, a TOML file, or a dict shaped like one, with
 /// keys overridden by keyword arguments.
 ///
@@ -545,7 +549,7 @@ impl PyConfig {
         }
     }
 
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>, bool))> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Reduced<'py>> {
         let py = slf.py();
         Ok((
             slf.get_type().getattr("_restore")?,

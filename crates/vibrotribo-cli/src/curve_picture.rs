@@ -10,6 +10,9 @@ use crate::manifest::{CurveManifest, Kind, read_of};
 use crate::output::{column, numbers, read_csv};
 use crate::plot::{self, Figure, Legend, Series, both};
 
+/// One legend entry of codimension-two points: its label, marker, colour and coordinates.
+type Marks = (String, plot::Shape, usize, Vec<f64>, Vec<f64>);
+
 /// Draws `curve.png`/`.svg` of the `curve` directory `dir`: the curve's points joined in
 /// their order along it, and each codimension-two point marked by its kind.
 pub fn plot_curve(dir: &Path) -> Result<()> {
@@ -27,7 +30,7 @@ pub fn plot_curve(dir: &Path) -> Result<()> {
     let mut kinds: Vec<&str> = m.codim2.iter().map(|p| p.kind.as_str()).collect();
     kinds.sort_unstable();
     kinds.dedup();
-    let marks: Vec<(String, plot::Shape, usize, Vec<f64>, Vec<f64>)> = kinds
+    let marks: Vec<Marks> = kinds
         .iter()
         .map(|k| {
             let (_, shape, colour) = marker_of(k.trim_start_matches("meets_"));

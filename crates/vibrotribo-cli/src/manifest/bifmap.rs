@@ -120,7 +120,7 @@ pub struct BifmapManifest {
     pub settings: Value,
     /// The base motion, when it is not the chain's own harmonic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<Value>,
+    pub base_motion: Option<vibrotribo::report::BaseMotionSummary>,
     /// The program's version.
     pub vibrotribo_version: String,
 }

@@ -43,7 +43,7 @@ pub struct ResponseManifest {
     pub settings: Value,
     /// The base motion, when it is not the chain's own harmonic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<Value>,
+    pub base_motion: Option<vibrotribo::report::BaseMotionSummary>,
     /// The program's version.
     pub vibrotribo_version: String,
 }
@@ -72,7 +72,7 @@ pub struct BandResponseManifest {
     pub settings: Value,
     /// The base motion (the configuration's band; each run moves it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<Value>,
+    pub base_motion: Option<vibrotribo::report::BaseMotionSummary>,
     /// The program's version.
     pub vibrotribo_version: String,
 }

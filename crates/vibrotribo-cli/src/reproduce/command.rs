@@ -74,7 +74,7 @@ pub fn run(args: &ReproduceArgs) -> Result<()> {
         failures: std::sync::Mutex::new(Vec::new()),
     };
     let started = Instant::now();
-    let steps: [(&str, Step); 14] = [
+    let steps: [(&str, Step); 15] = [
         ("Figs. 5–6: mass configurations", figs_5_6),
         ("Figs. 7–11: asymmetric spacing R_δ", figs_7_11),
         ("Fig. 12: symmetric spacing δ", fig_12),

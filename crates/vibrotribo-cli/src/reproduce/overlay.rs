@@ -79,9 +79,11 @@ fn on_segment(s: &Stretch, j: usize, v: f64, samples: &[f64], tolerance: f64) ->
 
 /// The segments of `s` that bracket `v`, with whether both ends are stable.
 fn brackets(s: &Stretch, v: f64) -> impl Iterator<Item = (usize, bool)> + '_ {
-    s.parameter.windows(2).enumerate().filter_map(move |(j, w)| {
-        ((w[0] - v) * (w[1] - v) <= 0.0).then(|| (j, s.stable[j] && s.stable[j + 1]))
-    })
+    s.parameter
+        .windows(2)
+        .enumerate()
+        .filter(move |(_, w)| (w[0] - v) * (w[1] - v) <= 0.0)
+        .map(|(j, _)| (j, s.stable[j] && s.stable[j + 1]))
 }
 
 /// The class of each value of the diagram.

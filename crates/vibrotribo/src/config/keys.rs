@@ -432,6 +432,10 @@ pub fn apply_overrides<S: AsRef<str>>(config: &mut Config, assignments: &[S]) ->
     config.set_all(parsed)
 }
 
+/// How close a known key is to a given one, smaller first: the distance, the sections'
+/// distance, the shared prefix (longer first).
+type Rank = (usize, usize, std::cmp::Reverse<usize>);
+
 /// The keys (of the schema and derived) closest to `key`, best first: the "did you mean" of
 /// an unknown key (at most three, none farther than a third of its length, and at least 2).
 ///
@@ -448,7 +452,7 @@ pub fn similar_keys(key: &str) -> Vec<String> {
     known.extend(DERIVED_KEYS.iter().map(|(k, _)| k.to_string()));
     let limit = (key.chars().count() / 3).max(2);
     let (section, name) = split_section(key);
-    let mut scored: Vec<((usize, usize, std::cmp::Reverse<usize>), String)> = known
+    let mut scored: Vec<(Rank, String)> = known
         .into_iter()
         .filter_map(|k| {
             let (k_section, k_name) = split_section(&k);

@@ -241,11 +241,11 @@ pub(crate) fn solve_unpivoted_many<const N: usize, const K: usize>(
         }
         inv_diag[col] = inv;
         let pivot = m[col];
-        for r in col + 1..N {
-            let f = m[r][col] * inv;
-            m[r][col] = f;
+        for row in m.iter_mut().skip(col + 1) {
+            let f = row[col] * inv;
+            row[col] = f;
             for j in col + 1..N {
-                m[r][j] -= f * pivot[j];
+                row[j] -= f * pivot[j];
             }
         }
     }

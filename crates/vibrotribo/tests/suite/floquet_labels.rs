@@ -84,6 +84,9 @@ fn decay_rate(
     ((disc + pq[0]) * 0.5).norm().max(((-disc + pq[0]) * 0.5).norm())
 }
 
+/// A run's impacts per period and the decay rate of a perturbation of its orbit.
+type Rate = (f64, f64);
+
 #[test]
 fn fig7_chain_reports_the_multiplier_of_the_orbit_each_run_reaches() {
     let (up, down) = (continued(1.0), continued(1.2));
@@ -103,7 +106,7 @@ fn fig7_chain_reports_the_multiplier_of_the_orbit_each_run_reaches() {
     };
     let c = fig7(1.09);
     let params = c.chain();
-    let mut rates = Vec::new();
+    let mut rates: Vec<Rate> = Vec::new();
     for (what, start) in [
         ("up", &up),
         ("down", &down),
@@ -127,7 +130,7 @@ fn fig7_chain_reports_the_multiplier_of_the_orbit_each_run_reaches() {
     }
     // The two attractors' multipliers differ by more than the check's tolerance, so a
     // multiplier taken from the other orbit would fail it.
-    let (four, two): (Vec<&(f64, f64)>, Vec<&(f64, f64)>) = rates.iter().partition(|(i, _)| *i > 3.0);
+    let (four, two): (Vec<&Rate>, Vec<&Rate>) = rates.iter().partition(|(i, _)| *i > 3.0);
     assert!(!four.is_empty() && !two.is_empty(), "{rates:?}");
     assert!((four[0].1 - two[0].1).abs() > 2e-3, "{rates:?}");
 }

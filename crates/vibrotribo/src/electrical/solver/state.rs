@@ -35,7 +35,7 @@ impl Grid {
     /// false exactly where it would return `None` at once, changing nothing.
     #[inline]
     pub(super) fn due(&self, tb: f64) -> bool {
-        !self.last.is_some_and(|l| self.next > l)
+        self.last.is_none_or(|l| self.next <= l)
             && self.t0 + self.span * (self.next as f64 / self.per as f64) <= tb
     }
 
