@@ -46,7 +46,10 @@ CHILD = textwrap.dedent(
         n = sum(executed.values())
         time.sleep(1.0)
         later = sum(client.run(plugin_count).values())
-        print("left", left, "executed", n, "later", later, "of", len(values), flush=True)
+        time.sleep(1.0)
+        last = sum(client.run(plugin_count).values())
+        print("left", left, "executed", n, "later", later, "last", last, "of", len(values),
+              flush=True)
     """
 )
 
@@ -58,10 +61,12 @@ def test_an_interrupt_cancels_the_tasks_of_a_live_cluster():
     assert p.returncode == 0, p.stdout + p.stderr
     words = p.stdout.split()
     assert words[:1] == ["left"], p.stdout + p.stderr
-    left, executed, later, total = (int(words[k]) for k in (1, 3, 5, 7))
+    left, executed, later, last, total = (int(words[k]) for k in (1, 3, 5, 7, 9))
     assert left == 0, p.stdout
-    # Cut short: far fewer tasks ran than were submitted, and none after the cancel.
+    # Cut short: far fewer tasks ran than were submitted. The one task on the worker's thread
+    # when the scheduler forgot the rest may finish after the first count; none starts after.
     assert executed < total, p.stdout
-    assert later == executed, p.stdout
+    assert executed <= later <= executed + 1, p.stdout
+    assert last == later, p.stdout
     assert "never retrieved" not in p.stderr, p.stderr
     assert "Traceback" not in p.stderr, p.stderr

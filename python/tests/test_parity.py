@@ -72,6 +72,14 @@ PARITY = {
         "--window": "window", "--transient": "transient", "--max-points": "max_points",
         "--mechanics-only": "mechanics_only", "--out": None,
     }),
+    "bifmap": (vt.bifmap, {
+        "<CONFIG>": "config", "--x": "x", "--x-from": "x_values", "--x-to": "x_values",
+        "--x-steps": "x_values", "--y": "y", "--y-from": "y_values", "--y-to": "y_values",
+        "--y-steps": "y_values", "--seeds": "seeds", "--x-starts": "x_starts", "--kinds": "kinds",
+        "--period": "period", "--doublings": "doublings", "--orbit-transient": "orbit_transient",
+        "--branch-points": "branch_points", "--curve-points": "curve_points",
+        "--max-curves": "max_curves", "--out": None, "--plot": None, **RUN,
+    }),
     "sweep": (vt.sweep, {
         "<CONFIG>": "config", "--param": "param", "--from": "values", "--to": "values",
         "--steps": "values", "--continuation": "continuation", "--shard": None, "--out": None,
