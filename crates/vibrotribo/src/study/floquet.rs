@@ -228,8 +228,10 @@ mod tests {
 
     /// Fig. 7's chain (m = 90, 120, 90 g, Ω = 0.70) at spacing ratio `r`.
     fn fig7(r: f64) -> ChainParams {
-        let mut p = ChainParams::default();
-        p.masses = vec![0.09, 0.12, 0.09];
+        let mut p = ChainParams {
+            masses: vec![0.09, 0.12, 0.09],
+            ..ChainParams::default()
+        };
         p.gaps[1] = r * p.gaps[0];
         p
     }

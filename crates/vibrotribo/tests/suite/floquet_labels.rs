@@ -127,7 +127,7 @@ fn fig7_chain_reports_the_multiplier_of_the_orbit_each_run_reaches() {
     }
     // The two attractors' multipliers differ by more than the check's tolerance, so a
     // multiplier taken from the other orbit would fail it.
-    let (four, two): (Vec<&(f64, f64)>, Vec<&(f64, f64)>) = rates.iter().partition(|(i, _)| *i > 3.0);
+    let (four, two) = rates.iter().partition::<Vec<&(f64, f64)>, _>(|(i, _)| *i > 3.0);
     assert!(!four.is_empty() && !two.is_empty(), "{rates:?}");
     assert!((four[0].1 - two[0].1).abs() > 2e-3, "{rates:?}");
 }
