@@ -183,6 +183,12 @@ type Reduced<'py> = (Bound<'py, PyAny>, (Bound<'py, PyDict>, bool));
 /// file. Two configurations are equal when
 /// their effective values are. `with_(**changes)` (or `replace`) returns a changed copy,
 /// `without(*keys)` a copy with keys back at their defaults.
+///
+/// A random excitation costlier to build than 10⁹ harmonic evaluations is refused
+/// (`ValueError` with its harmonics and intervals) unless `allow_large=True`, the command
+/// line's `--allow-large`; the configurations derived from this one (and a pickled copy)
+/// keep the setting, which is not a key and leaves equality alone. Ctrl-C stops a build with
+/// `KeyboardInterrupt`.
 #[pyclass(module = "vibrotribo", name = "Config", frozen)]
 #[derive(Clone)]
 pub struct PyConfig {
@@ -324,6 +330,10 @@ pub fn config_of(obj: &Bound<'_, PyAny>) -> PyResult<Config> {
     config.check_runnable().map_err(config_error)?;
     Ok(config)
 }
+
+/// What pickling a [`PyConfig`] stores: `Config._restore` and its arguments (the table as a
+/// dict, and `allow_large`).
+type Reduced<'py> = (Bound<'py, PyAny>, (Bound<'py, PyDict>, bool));
 
 #[pymethods]
 impl PyConfig {

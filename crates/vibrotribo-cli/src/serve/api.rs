@@ -15,6 +15,7 @@ use super::branches::{BranchRequest, branches as continue_branches};
 use super::cancel::Lane;
 use super::error::ApiError;
 use super::grid::{GridJob, GridKind, GridRequest};
+use super::memory::release_soon;
 use super::request::{Overrides, body, configure};
 use super::run_view::{RunRequest, run_view};
 use super::schema::schema;
@@ -111,10 +112,11 @@ pub async fn run(State(state): State<Shared>, bytes: Bytes) -> Result<Response, 
     let request: RunRequest = body(&bytes)?;
     let (ticket, _guard) = state.runs.take(request.seq)?;
     let shared = Arc::clone(&state);
-    let view = tokio::task::spawn_blocking(move || run_view(&shared.base, &request, ticket))
-        .await
-        .map_err(ApiError::failed)??;
-    Ok(Json(view).into_response())
+    let view = tokio::task::spawn_blocking(move || run_view(&shared.base, &request, ticket)).await;
+    // The view is serialised (and freed) first; a superseded one is freed here.
+    let response = view.map_err(ApiError::failed)?.map(|v| Json(v).into_response());
+    release_soon();
+    response
 }
 
 /// `POST /api/orbit` (one axis), `POST /api/map` and `POST /api/basins` (two axes): the
@@ -155,8 +157,8 @@ pub async fn branches(State(state): State<Shared>, bytes: Bytes) -> Result<Respo
     let request: BranchRequest = body(&bytes)?;
     let (ticket, _guard) = state.continuations.take(request.seq)?;
     let shared = Arc::clone(&state);
-    let view = tokio::task::spawn_blocking(move || continue_branches(&shared.base, &request, &ticket))
-        .await
-        .map_err(ApiError::failed)??;
-    Ok(Json(view).into_response())
+    let view = tokio::task::spawn_blocking(move || continue_branches(&shared.base, &request, &ticket)).await;
+    let response = view.map_err(ApiError::failed)?.map(|v| Json(v).into_response());
+    release_soon();
+    response
 }

@@ -498,7 +498,11 @@ impl GridJob {
     /// the response is dropped (the guard goes with it) or the ticket is superseded.
     pub fn stream(self, ticket: Ticket, guard: Guard) -> Response {
         let (tx, rx) = mpsc::channel::<String>(256);
-        tokio::task::spawn_blocking(move || self.produce(&tx, &ticket));
+        tokio::task::spawn_blocking(move || {
+            self.produce(&tx, &ticket);
+            drop(self);
+            super::memory::release_soon();
+        });
         let lines = futures_util::stream::unfold((rx, guard), |(mut rx, guard)| async move {
             let line = rx.recv().await?;
             Some((Ok::<_, Infallible>(line), (rx, guard)))

@@ -11,6 +11,7 @@ mod branches;
 mod cancel;
 mod error;
 mod grid;
+mod memory;
 mod request;
 mod run_view;
 mod schema;

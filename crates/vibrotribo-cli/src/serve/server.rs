@@ -93,6 +93,7 @@ pub fn run(args: &ServeArgs) -> Result<()> {
         basins: Lane::default(),
         continuations: Lane::default(),
     };
+    super::memory::limit_arenas();
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         // Computations run on blocking threads; a burst of superseded requests waits for a

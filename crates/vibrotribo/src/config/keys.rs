@@ -448,6 +448,9 @@ type Rank = (usize, usize, std::cmp::Reverse<usize>);
 /// distance) to the given one, then to the longest prefix shared with `key`, then in
 /// alphabetical order.
 pub fn similar_keys(key: &str) -> Vec<String> {
+    /// A candidate's rank, lowest first: its distance, its section's distance, and the
+    /// length of the prefix it shares with `key` (longest first).
+    type Rank = (usize, usize, std::cmp::Reverse<usize>);
     let mut known = known_keys();
     known.extend(DERIVED_KEYS.iter().map(|(k, _)| k.to_string()));
     let limit = (key.chars().count() / 3).max(2);
