@@ -118,7 +118,7 @@ enum Line<'a> {
         masses: usize,
     },
     /// A finished point.
-    Point(PointLine),
+    Point(Box<PointLine>),
     /// Basins, when every start has run: the classification of `basins` (grid order: x
     /// fastest, as `basins.csv`).
     Classes(ClassesLine),
@@ -469,7 +469,7 @@ impl GridJob {
                         if let Ok(Outcome::Start(f)) = r {
                             fingerprints[j * nx + i] = Some(f);
                         }
-                        if !send(&Line::Point(line)) || ticket.stopped() {
+                        if !send(&Line::Point(Box::new(line))) || ticket.stopped() {
                             ControlFlow::Break(())
                         } else {
                             ControlFlow::Continue(())
