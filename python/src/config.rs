@@ -153,10 +153,6 @@ pub fn table_to_dict<'py>(py: Python<'py>, t: &Table) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
-/// What `Config.__reduce__` hands pickle: the restoring function and its arguments (the
-/// settings and whether large runs are allowed).
-type Reduced<'py> = (Bound<'py, PyAny>, (Bound<'py, PyDict>, bool));
-
 /// A configuration: the paper's default case, a TOML file, or a dict shaped like one, with
 /// keys overridden by keyword arguments.
 ///

@@ -120,28 +120,15 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
         seed: args.seed,
         bounds,
     };
-    let masses = chain.len();
     crate::job::check_recorded(starts.point_runner().options())?;
     let manifest = manifest_of(&starts, &args.param, (args.from, args.to), &values, &sampling)?;
-    let mut files = match &args.out {
-        Some(dir) => {
-            let ours = to_value(&manifest)?;
-            check_out_dir(dir, "attractors.json", args.run.force, |old| {
-                with_progress(old, false, 0) == ours
-            })?;
-            create_dir(dir)?;
-            write_json(&dir.join("attractors.json"), &ours)?;
-            Some(CensusFiles::create(dir, masses)?)
-        }
-        None => None,
-    };
     let started = Instant::now();
-    let (results, finished) = run_census(
+    let (results, finished) = write_census(
         &starts,
-        &args.param,
-        &values,
+        manifest,
         &sampling,
-        files.as_mut(),
+        args.out.as_deref(),
+        args.run.force,
         args.run.quiet,
     )?;
     let complete = finished == values.len();
@@ -157,16 +144,7 @@ pub fn run(args: &AttractorsArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         rayon::current_num_threads()
     );
-    if let (Some(mut files), Some(dir)) = (files, &args.out) {
-        files.flush()?;
-        write_json(
-            &dir.join("attractors.json"),
-            &to_value(&AttractorsManifest {
-                complete,
-                done: finished,
-                ..manifest
-            })?,
-        )?;
+    if let Some(dir) = &args.out {
         if complete && args.plot {
             plot_attractors(dir)?;
         }
@@ -239,7 +217,7 @@ pub fn manifest_of(
 }
 
 /// `attractors.csv` and `expected_power.csv` of a census, written value by value.
-pub struct CensusFiles {
+struct CensusFiles {
     attractors: CsvFile,
     expected: CsvFile,
     masses: usize,
@@ -247,7 +225,7 @@ pub struct CensusFiles {
 
 impl CensusFiles {
     /// Creates the files in `dir` for a chain of `masses` masses.
-    pub fn create(dir: &Path, masses: usize) -> Result<Self> {
+    fn create(dir: &Path, masses: usize) -> Result<Self> {
         Ok(CensusFiles {
             attractors: CsvFile::create(&dir.join("attractors.csv"), &census_attractor_columns(masses).0)?,
             expected: CsvFile::create(
@@ -268,16 +246,59 @@ impl CensusFiles {
     }
 
     /// Flushes both files.
-    pub fn flush(&mut self) -> Result<()> {
+    fn flush(&mut self) -> Result<()> {
         self.attractors.flush()?;
         self.expected.flush()
     }
 }
 
+/// Runs the census of `starts` whose manifest is `manifest` (its parameter and values), its
+/// starts drawn by `sampling`, into `dir` if given as `attractors --out DIR` writes it: the
+/// manifest first (an older job there is replaced only with `force` or the same settings),
+/// each value's rows of `attractors.csv` and `expected_power.csv` as it finishes, then the
+/// manifest with how many values finished. Returns the values' attractors and that count.
+pub fn write_census(
+    starts: &StartRunner,
+    manifest: AttractorsManifest,
+    sampling: &RandomStarts,
+    dir: Option<&Path>,
+    force: bool,
+    quiet: bool,
+) -> Result<(Vec<ValueAttractors>, usize)> {
+    let masses = starts.point_runner().base().chain().len();
+    let mut files = match dir {
+        Some(dir) => {
+            let ours = to_value(&manifest)?;
+            check_out_dir(dir, "attractors.json", force, |old| {
+                with_progress(old, false, 0) == ours
+            })?;
+            create_dir(dir)?;
+            write_json(&dir.join("attractors.json"), &ours)?;
+            Some(CensusFiles::create(dir, masses)?)
+        }
+        None => None,
+    };
+    let (param, values) = (&manifest.axis.param, &manifest.axis.values);
+    let (results, finished) = run_census(starts, param, values, sampling, files.as_mut(), quiet)?;
+    if let (Some(mut files), Some(dir)) = (files, dir) {
+        files.flush()?;
+        let complete = finished == values.len();
+        write_json(
+            &dir.join("attractors.json"),
+            &to_value(&AttractorsManifest {
+                complete,
+                done: finished,
+                ..manifest
+            })?,
+        )?;
+    }
+    Ok((results, finished))
+}
+
 /// Runs the census of `starts` across `values` of `param` ([`attractors_across`]), with a
 /// progress bar and a stop on SIGINT/SIGTERM after a chunk, each value's rows written to
 /// `files` as it finishes. Returns the values' attractors and how many values finished.
-pub fn run_census(
+fn run_census(
     starts: &StartRunner,
     param: &str,
     values: &[f64],

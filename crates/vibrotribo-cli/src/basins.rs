@@ -245,28 +245,21 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
             .map(|(_, p)| p)
             .collect();
     }
-    let (xk, yk) = (args.x.as_str(), args.y.as_str());
-    let scale = SectionScale::of(starts.point_runner().base().chain());
     let o = starts.point_runner().options();
     crate::job::check_recorded(o)?;
-    let settings = crate::manifest::to_value(&manifest_of(
-        &starts,
-        Axis {
-            param: args.x.clone(),
-            from: args.x_from,
-            to: args.x_to,
-            steps: nx,
-            values: xs.clone(),
-        },
-        Axis {
-            param: args.y.clone(),
-            from: args.y_from,
-            to: args.y_to,
-            steps: ny,
-            values: ys.clone(),
-        },
-        args.shard,
-    )?)?;
+    let axis = |param: &String, from: f64, to: f64, values: Vec<f64>| Axis {
+        param: param.clone(),
+        from,
+        to,
+        steps: values.len(),
+        values,
+    };
+    let grid = BasinGrid {
+        starts,
+        x: axis(&args.x, args.x_from, args.x_to, xs),
+        y: axis(&args.y, args.y_from, args.y_to, ys),
+    };
+    let settings = crate::manifest::to_value(&grid.manifest(args.shard)?)?;
     let keys: Vec<String> = points.iter().map(key_of).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -280,14 +273,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
         ),
     };
     let started = Instant::now();
-    let (computed, fingerprints) = run_starts(
-        &starts,
-        &points[skip..],
-        (xk, yk),
-        skip,
-        args.run.quiet,
-        out.as_mut(),
-    )?;
+    let (computed, fingerprints) = grid.run(&points[skip..], skip, args.run.quiet, out.as_mut())?;
     let done = skip + computed;
     let complete = done == points.len();
     println!(
@@ -320,7 +306,7 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
             }
         }
         _ if complete && args.shard.is_none() => {
-            print_attractors(&classify(&fingerprints, &scale, &options));
+            print_attractors(&grid.classify(&fingerprints));
         }
         _ => {}
     }
@@ -337,79 +323,123 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     Ok(())
 }
 
-/// The manifest (`basins.json`) of a basins job of `starts` over the axes `x` and `y`
-/// (the shard `shard` of it, if any).
-pub fn manifest_of(starts: &StartRunner, x: Axis, y: Axis, shard: Option<Shard>) -> Result<BasinsManifest> {
-    let runner = starts.point_runner();
-    let o = runner.options();
-    let options = starts.options();
-    let scale = SectionScale::of(runner.base().chain());
-    Ok(BasinsManifest {
-        command: Kind::Basins,
-        x,
-        y,
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        max_period_detected: o.period_options().max_period,
-        attractor_options: BasinTolerances {
-            period_tolerance: options.period_tolerance,
-            match_tolerance: options.match_tolerance,
-            cell: options.cell,
-        },
-        section_scale: SectionScaleRecord {
-            masses: scale.masses,
-            length_m: scale.length,
-            speed_m_s: scale.speed,
-        },
-        mechanics_only: runner.mechanics_only(),
-        shard: shard.map(|s| ShardRecord {
-            index: s.index,
-            count: s.count,
-        }),
-        settings: serde_json::to_value(runner.base().table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-        complete: false,
-    })
+/// A grid of starts: the runner of one start and the two initial-condition axes it spans.
+pub struct BasinGrid {
+    /// The runner of one start and the options that tell its attractors apart.
+    pub starts: StartRunner,
+    /// The initial condition along x and its values.
+    pub x: Axis,
+    /// The initial condition along y and its values.
+    pub y: Axis,
 }
 
-/// Runs the starts `points` of `starts` (the keys `xk`, `yk` set to each point's values) in
-/// parallel chunks, in grid order, with a progress bar counting from `skip` and a stop on
-/// SIGINT/SIGTERM after a chunk; each start's row goes to `out` (`starts.csv` of a grid job)
-/// as it comes. Returns how many ran and their fingerprints (`None`: the start failed).
-pub fn run_starts(
-    starts: &StartRunner,
-    points: &[(f64, f64)],
-    (xk, yk): (&str, &str),
-    skip: usize,
-    quiet: bool,
-    mut out: Option<&mut GridOutput>,
-) -> Result<(usize, Vec<Option<Fingerprint>>)> {
-    let mut fingerprints = Vec::new();
-    let total = (skip + points.len()) as u64;
-    let computed = run_chunked(
-        points,
-        |&(x, y)| {
-            starts
-                .run(&[(xk, x), (yk, y)], None)
-                .map_err(|e| format!("{e:#}"))
-        },
-        |_| false,
-        ("starts", skip as u64, total),
-        quiet,
-        |d| {
-            let Some((&(x, y), r)) = d else {
-                return out.as_deref_mut().map_or(Ok(()), GridOutput::commit);
-            };
-            if let Some(out) = out.as_deref_mut() {
-                let mut row = vec![x.to_string(), y.to_string()];
-                row.extend(cells_of(&r));
-                out.row(0, row)?;
-            }
-            fingerprints.push(r.ok());
-            Ok(())
-        },
-    )?;
-    Ok((computed, fingerprints))
+impl BasinGrid {
+    /// Every start of the grid, in grid order (x fastest).
+    pub fn points(&self) -> Vec<(f64, f64)> {
+        points_of(&self.x.values, &self.y.values)
+    }
+
+    /// The grid's manifest (`basins.json`; the shard `shard` of it, if any), nothing done.
+    pub fn manifest(&self, shard: Option<Shard>) -> Result<BasinsManifest> {
+        let runner = self.starts.point_runner();
+        let o = runner.options();
+        let options = self.starts.options();
+        let scale = SectionScale::of(runner.base().chain());
+        Ok(BasinsManifest {
+            command: Kind::Basins,
+            x: self.x.clone(),
+            y: self.y.clone(),
+            transient_periods: o.transient_periods,
+            recorded_periods: o.recorded_periods,
+            max_period_detected: o.period_options().max_period,
+            attractor_options: BasinTolerances {
+                period_tolerance: options.period_tolerance,
+                match_tolerance: options.match_tolerance,
+                cell: options.cell,
+            },
+            section_scale: SectionScaleRecord {
+                masses: scale.masses,
+                length_m: scale.length,
+                speed_m_s: scale.speed,
+            },
+            mechanics_only: runner.mechanics_only(),
+            shard: shard.map(|s| ShardRecord {
+                index: s.index,
+                count: s.count,
+            }),
+            settings: serde_json::to_value(runner.base().table())?,
+            vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+            complete: false,
+        })
+    }
+
+    /// Runs the starts `points` (the two keys set to each point's values) in parallel chunks,
+    /// in grid order, with a progress bar counting from `skip` and a stop on SIGINT/SIGTERM
+    /// after a chunk; each start's row goes to `out` (`starts.csv` of a grid job) as it
+    /// comes. Returns how many ran and their fingerprints (`None`: the start failed).
+    pub fn run(
+        &self,
+        points: &[(f64, f64)],
+        skip: usize,
+        quiet: bool,
+        mut out: Option<&mut GridOutput>,
+    ) -> Result<(usize, Vec<Option<Fingerprint>>)> {
+        let (xk, yk) = (self.x.param.as_str(), self.y.param.as_str());
+        let mut fingerprints = Vec::new();
+        let total = (skip + points.len()) as u64;
+        let computed = run_chunked(
+            points,
+            |&(x, y)| {
+                self.starts
+                    .run(&[(xk, x), (yk, y)], None)
+                    .map_err(|e| format!("{e:#}"))
+            },
+            |_| false,
+            ("starts", skip as u64, total),
+            quiet,
+            |d| {
+                let Some((&(x, y), r)) = d else {
+                    return out.as_deref_mut().map_or(Ok(()), GridOutput::commit);
+                };
+                if let Some(out) = out.as_deref_mut() {
+                    let mut row = vec![x.to_string(), y.to_string()];
+                    row.extend(cells_of(&r));
+                    out.row(0, row)?;
+                }
+                fingerprints.push(r.ok());
+                Ok(())
+            },
+        )?;
+        Ok((computed, fingerprints))
+    }
+
+    /// The attractors of the starts' `fingerprints` (grid order), classified in that order.
+    pub fn classify(&self, fingerprints: &[Option<Fingerprint>]) -> Classification {
+        let chain = self.starts.point_runner().base().chain();
+        classify(fingerprints, &SectionScale::of(chain), self.starts.options())
+    }
+}
+
+/// Runs every start of `grid` into the directory `dir` as `basins --out DIR` writes it
+/// (`basins.json`, `starts.csv` start by start; an older job there is replaced) and, once
+/// every start has run, classifies them in grid order into `basins.csv` and
+/// `attractors.csv`. Returns how many starts ran and the classification, `None` when a
+/// signal stopped the run (the directory then holds the starts that finished, marked
+/// incomplete).
+pub fn write_grid(grid: &BasinGrid, dir: &Path, quiet: bool) -> Result<(usize, Option<Classification>)> {
+    let points = grid.points();
+    let settings = crate::manifest::to_value(&grid.manifest(None)?)?;
+    let mut out = GridOutput::create(dir, layout(), settings, true)?;
+    let (done, fingerprints) = grid.run(&points, 0, quiet, Some(&mut out))?;
+    let complete = done == points.len();
+    out.finish(complete, done)?;
+    if !complete {
+        return Ok((done, None));
+    }
+    let c = grid.classify(&fingerprints);
+    let masses = grid.starts.point_runner().base().chain().len();
+    write_tables(dir, &points, &fingerprints, &c, masses)?;
+    Ok((done, Some(c)))
 }
 
 fn print_attractors(c: &Classification) {

@@ -10,8 +10,14 @@ use crate::manifest::{CurveManifest, Kind, read_of};
 use crate::output::{column, numbers, read_csv};
 use crate::plot::{self, Figure, Legend, Series, both};
 
-/// One legend entry of codimension-two points: its label, marker, colour and coordinates.
-type Marks = (String, plot::Shape, usize, Vec<f64>, Vec<f64>);
+/// The codimension-two points of one kind: their legend label, marker, colour and places.
+struct Marks {
+    label: String,
+    shape: plot::Shape,
+    colour: usize,
+    px: Vec<f64>,
+    py: Vec<f64>,
+}
 
 /// Draws `curve.png`/`.svg` of the `curve` directory `dir`: the curve's points joined in
 /// their order along it, and each codimension-two point marked by its kind.
@@ -44,7 +50,13 @@ pub fn plot_curve(dir: &Path) -> Result<()> {
                 Some(other) => format!("meets a {} curve", marker_of(other).0),
                 None => marker_of(k).0.to_string(),
             };
-            (label, shape, colour, px, py)
+            Marks {
+                label,
+                shape,
+                colour,
+                px,
+                py,
+            }
         })
         .collect();
     // The point the curve was located at, then the codimension-two points.
@@ -53,11 +65,11 @@ pub fn plot_curve(dir: &Path) -> Result<()> {
             .colour(7)
             .marker(plot::Shape::Circle, 9),
     ];
-    points.extend(
-        marks.iter().map(|(label, shape, colour, px, py)| {
-            Series::new(label, px, py).colour(*colour).marker(*shape, 11)
-        }),
-    );
+    points.extend(marks.iter().map(|m| {
+        Series::new(&m.label, &m.px, &m.py)
+            .colour(m.colour)
+            .marker(m.shape, 11)
+    }));
     let mut fig = Figure::new(
         format!("The {line_label} of period {}: {} points", m.period, m.points),
         m.param.clone(),

@@ -288,17 +288,10 @@ fn draw_impact_section(dir: &Path, masses: usize) -> Result<()> {
 }
 
 /// The power spectral density of mass `i`'s positions `x` sampled at `fs`, Hz (Welch, Hann
-/// window): `psd_x{i}.csv` and its picture; a note and nothing else where it cannot be taken.
+/// window, segments by [`WelchOptions::for_record`]): `psd_x{i}.csv` and its picture; a note
+/// and nothing else where it cannot be taken.
 fn draw_psd(dir: &Path, i: usize, x: &[f64], fs: f64) -> Result<()> {
-    let segment = (x.len() / 4)
-        .next_power_of_two()
-        .min(x.len().next_power_of_two() / 2)
-        .max(16);
-    let options = WelchOptions {
-        segment_len: segment.min(x.len()),
-        ..WelchOptions::default()
-    };
-    let psd = match welch_psd(x, fs, &options) {
+    let psd = match welch_psd(x, fs, &WelchOptions::for_record(x.len())) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("no PSD of x{}: {e}", i + 1);

@@ -9,9 +9,7 @@ use std::cmp::Ordering;
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use vibrotribo::analysis::batch_means_se;
-use vibrotribo::attractors::{
-    AttractorOptions, DEFAULT_START_PERIODS, RandomStarts, SectionScale, StartRunner, basin_points, classify,
-};
+use vibrotribo::attractors::{AttractorOptions, DEFAULT_START_PERIODS, RandomStarts, StartRunner};
 use vibrotribo::config::Config;
 use vibrotribo::lyapunov::{LyapunovOptions, LyapunovSpectrum};
 use vibrotribo::study::{PointOptions, PointResult, exponent_sign, lyapunov_spectrum};
@@ -20,12 +18,12 @@ use vibrotribo::sweep::{PointRunner, grid};
 use super::context::{Ctx, Verdict};
 use super::draw::lines;
 use super::runs::{arr, chatter_case, config, f, with};
+use crate::basins::BasinGrid;
 use crate::config::ConfigArgs;
-use crate::job::GridOutput;
-use crate::manifest::{AttractorsManifest, Axis, to_value};
-use crate::output::{create_dir, si, write_json};
+use crate::manifest::Axis;
+use crate::output::si;
 use crate::plot::{Figure, Scale};
-use crate::progress::check_interrupt;
+use crate::progress::{Interrupted, check_interrupt};
 
 /// How a motion's largest Lyapunov exponent classifies it (the sweeps' rule,
 /// [`exponent_sign`]): clearly positive (beyond three batch-means standard errors) is
@@ -281,9 +279,8 @@ fn power_error_bars(ctx: &mut Ctx) -> Result<()> {
 }
 
 /// The basins over x2(0) ∈ `x` and v2(0) ∈ ±3 m/s (m1, m3 at rest) of the default case with
-/// `sets`, computed by the library ([`StartRunner`], [`classify`]) and written into `name/` as
-/// `vibrotribo basins` writes its directory (its manifest, `starts.csv`, and the tables
-/// `basins.csv`, `attractors.csv` of the one table writer) with its picture; returns the
+/// `sets`, computed by the library ([`StartRunner`]) and written into `name/` as `vibrotribo
+/// basins` writes its directory ([`crate::basins::write_grid`]) with its picture; returns the
 /// grid size and one line per attractor.
 fn basins(ctx: &Ctx, name: &str, sets: &[&str], x: (f64, f64)) -> Result<(usize, Vec<String>)> {
     let dir = ctx.path(name);
@@ -293,18 +290,11 @@ fn basins(ctx: &Ctx, name: &str, sets: &[&str], x: (f64, f64)) -> Result<(usize,
         set: sets.iter().map(|s| s.to_string()).collect(),
     }
     .load()?;
-    let options = AttractorOptions {
-        period_tolerance: 1e-3,
-        match_tolerance: 3e-3,
-        cell: 0.05,
-        ..AttractorOptions::default()
-    };
     let starts = StartRunner::new(
         ctx.run_args(true).runner_or(base, DEFAULT_START_PERIODS)?,
-        options,
+        AttractorOptions::default(),
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (xk, yk) = ("run.initial_positions[1]", "run.initial_velocities[1]");
     let axis = |param: &str, (from, to): (f64, f64)| Axis {
         param: param.into(),
         from,
@@ -312,26 +302,21 @@ fn basins(ctx: &Ctx, name: &str, sets: &[&str], x: (f64, f64)) -> Result<(usize,
         steps: n,
         values: grid(from, to, n),
     };
-    let (ax, ay) = (axis(xk, x), axis(yk, (-3.0, 3.0)));
-    let points = basin_points(&ax.values, &ay.values);
-    let settings = to_value(&crate::basins::manifest_of(&starts, ax, ay, None)?)?;
-    let mut out = GridOutput::create(&dir, crate::basins::layout(), settings, true)?;
-    let (done, fingerprints) =
-        crate::basins::run_starts(&starts, &points, (xk, yk), 0, true, Some(&mut out))?;
-    out.finish(done == points.len(), done)?;
-    check_interrupt(|| {
-        format!(
-            "after {done} of the {} starts of {name}/; REPORT.md is written only by a complete run",
-            points.len()
-        )
-    })?;
-    let masses = starts.point_runner().base().chain().len();
-    let c = classify(
-        &fingerprints,
-        &SectionScale::of(starts.point_runner().base().chain()),
-        starts.options(),
-    );
-    crate::basins::write_tables(&dir, &points, &fingerprints, &c, masses)?;
+    let grid = BasinGrid {
+        starts,
+        x: axis("run.initial_positions[1]", x),
+        y: axis("run.initial_velocities[1]", (-3.0, 3.0)),
+    };
+    let (done, classified) = crate::basins::write_grid(&grid, &dir, true)?;
+    let Some(c) = classified else {
+        return Err(Interrupted {
+            what: format!(
+                "after {done} of the {} starts of {name}/; REPORT.md is written only by a complete run",
+                n * n
+            ),
+        }
+        .into());
+    };
     crate::basins::plot_basins(&dir)?;
     let described = c
         .attractors
@@ -428,15 +413,9 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
         "oscillator.gaps=[0.005,0.005]".to_string(),
     ];
     let base = ConfigArgs { config: None, set }.load()?;
-    let options = AttractorOptions {
-        period_tolerance: 1e-3,
-        match_tolerance: 3e-3,
-        cell: 0.05,
-        continuation_distance: 0.25,
-    };
     let starts = StartRunner::new(
         ctx.run_args(false).runner_or(base, DEFAULT_START_PERIODS)?,
-        options,
+        AttractorOptions::default(),
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     let (param, range) = ("omega_ratio", (0.55, 0.80));
@@ -447,21 +426,8 @@ fn expected_power(ctx: &mut Ctx) -> Result<()> {
         bounds: None,
     };
     let manifest = crate::attractors::manifest_of(&starts, param, range, &values, &sampling)?;
-    create_dir(&dir)?;
-    write_json(&dir.join("attractors.json"), &to_value(&manifest)?)?;
-    let masses = starts.point_runner().base().chain().len();
-    let mut files = crate::attractors::CensusFiles::create(&dir, masses)?;
     let (results, done) =
-        crate::attractors::run_census(&starts, param, &values, &sampling, Some(&mut files), true)?;
-    files.flush()?;
-    write_json(
-        &dir.join("attractors.json"),
-        &to_value(&AttractorsManifest {
-            complete: done == values.len(),
-            done,
-            ..manifest
-        })?,
-    )?;
+        crate::attractors::write_census(&starts, manifest, &sampling, Some(&dir), true, true)?;
     check_interrupt(|| {
         format!(
             "after {done} of the {} values of attractors_fig20/; REPORT.md is written only by a complete run",

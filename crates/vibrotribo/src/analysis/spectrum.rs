@@ -114,6 +114,23 @@ impl WelchOptions {
         Ok(())
     }
 
+    /// The options for a record of `len` samples that sets no segment length of its own
+    /// (a run's positions after its transient): segments of a power of two near a quarter of
+    /// the record, at least 16 samples, at most half the record's next power of two and never
+    /// longer than the record, so that several overlapping segments are averaged; Hann
+    /// window, half overlap, each segment's mean removed. A record shorter than 2 samples
+    /// gives a segment [`welch_psd`] refuses.
+    pub fn for_record(len: usize) -> Self {
+        let segment = (len / 4)
+            .next_power_of_two()
+            .min(len.next_power_of_two() / 2)
+            .max(16);
+        WelchOptions {
+            segment_len: segment.min(len),
+            ..WelchOptions::default()
+        }
+    }
+
     /// Samples between the starts of consecutive segments, `N − ⌊overlap·N⌋` (≥ 1).
     pub fn step(&self) -> usize {
         let shared = (self.overlap * self.segment_len as f64).floor() as usize;
@@ -269,6 +286,30 @@ mod tests {
                 parts.iter().map(|&(a, f, ph)| a * (TAU * f * t + ph).sin()).sum()
             })
             .collect()
+    }
+
+    #[test]
+    fn a_records_options_resolve_its_tone_and_average_segments() {
+        // Segment lengths by the rule: a power of two near a quarter of the record.
+        let lengths = [(4096, 1024), (5000, 2048), (100, 32), (20, 16), (10, 10), (1, 1)];
+        for (len, segment) in lengths {
+            assert_eq!(
+                WelchOptions::for_record(len).segment_len,
+                segment,
+                "record of {len}"
+            );
+        }
+        // A tone of amplitude 0.3 at 12.5 Hz: its peak within a bin, its power A²/2
+        // (Parseval), several segments averaged.
+        let (fs, len) = (100.0, 3000);
+        let x = sines(fs, len, &[(0.3, 12.5, 0.4)]);
+        let psd = welch_psd(&x, fs, &WelchOptions::for_record(len)).unwrap();
+        assert!(psd.segments >= 4, "{} segments", psd.segments);
+        let (f, _) = psd.peak_above(0.0).unwrap();
+        assert!((f - 12.5).abs() <= psd.resolution, "peak at {f} Hz");
+        assert_relative_eq!(psd.band_power(10.0, 15.0), 0.045, max_relative = 2e-2);
+        // Too short a record is refused by the estimate, not by the rule.
+        assert!(welch_psd(&[1.0], fs, &WelchOptions::for_record(1)).is_err());
     }
 
     /// Fixed-seed standard normal samples (LCG + Box–Muller).

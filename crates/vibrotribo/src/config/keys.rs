@@ -432,10 +432,6 @@ pub fn apply_overrides<S: AsRef<str>>(config: &mut Config, assignments: &[S]) ->
     config.set_all(parsed)
 }
 
-/// How close a known key is to a given one, smaller first: the distance, the sections'
-/// distance, the shared prefix (longer first).
-type Rank = (usize, usize, std::cmp::Reverse<usize>);
-
 /// The keys (of the schema and derived) closest to `key`, best first: the "did you mean" of
 /// an unknown key (at most three, none farther than a third of its length, and at least 2).
 ///
