@@ -306,6 +306,11 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
             d.set_item("parameter", parameter)?;
             "stopped"
         }
+        BranchEnd::Rejoined { parameter, branch } => {
+            d.set_item("parameter", parameter)?;
+            d.set_item("branch", branch)?;
+            "rejoined"
+        }
         _ => "other",
     };
     d.set_item("reason", reason)?;
@@ -332,6 +337,9 @@ fn branch_to_py<'py>(
         e.set_item("v", array1(py, bif.point.state.velocities.clone()))?;
         e.set_item("multipliers", complex_array(py, &bif.point.multipliers))?;
         e.set_item("child", bif.child)?;
+        if bif.kind == BifurcationKind::BranchPoint {
+            e.set_item("other_child", bif.other_child)?;
+        }
         if let Some(after) = &bif.after {
             e.set_item("multipliers_after", complex_array(py, &after.multipliers))?;
         }

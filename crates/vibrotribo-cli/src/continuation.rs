@@ -197,7 +197,10 @@ pub fn end_text(end: &BranchEnd) -> String {
             format!("could not switch onto the doubled branch at {parameter}")
         }
         BranchEnd::Collapsed { parameter } => format!("fell back onto the half-period orbit at {parameter}"),
-        BranchEnd::Closed { parameter } => format!("a closed curve, back at its start at {parameter}"),
+        BranchEnd::Closed { parameter } => format!("closes on itself at {parameter} (followed once round)"),
+        BranchEnd::Rejoined { parameter, branch } => {
+            format!("reaches the branch point of branch {branch} at {parameter}, followed from there")
+        }
         BranchEnd::Stopped { parameter } => format!("stopped by a signal after {parameter}"),
         other => format!("{other:?}"),
     }
@@ -355,6 +358,7 @@ fn write_files(
             "crossing",
             "nordmark",
             "multipliers_after",
+            "other_child_branch",
         ],
     )?;
     let mut listed = Vec::new();
@@ -383,6 +387,7 @@ fn write_files(
                 f.after
                     .as_ref()
                     .map_or(String::new(), |a| csv_text(&multipliers_text(&a.multipliers))),
+                f.other_child.map_or(String::new(), |c| c.to_string()),
             ])?;
             listed.push(bifurcation_record(i, f));
         }
@@ -436,6 +441,7 @@ fn bifurcation_record(branch: usize, f: &Bifurcation) -> BifurcationRecord {
         param: f.parameter,
         precision: f.precision,
         child_branch: f.child,
+        other_child_branch: f.other_child,
         multipliers: pairs(&f.point),
         crossing: f.crossing.map(|c| c.kind.name().to_string()),
         nordmark: f.crossing.and_then(|c| c.nordmark).map(|n| n.name().to_string()),

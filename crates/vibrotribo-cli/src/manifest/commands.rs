@@ -254,6 +254,9 @@ pub struct BifurcationRecord {
     pub precision: f64,
     /// The branch it starts (0-based).
     pub child_branch: Option<usize>,
+    /// At a branch point: the branch that leaves it the other way (0-based).
+    #[serde(default)]
+    pub other_child_branch: Option<usize>,
     /// Floquet multipliers there, `[re, im]`.
     pub multipliers: Vec<[f64; 2]>,
     /// The kind of a grazing crossing.
@@ -611,7 +614,7 @@ mod tests {
     #[test]
     fn continue_manifest_round_trips_byte_for_byte() {
         round_trips::<ContinueManifest>(
-            r#"{"command":"continue","complete":true,"param":"omega_ratio","from":0.7,"to":1.0,"transient_periods":200,"doublings":0,"max_points":2000,"mechanics_only":true,"branches":[{"period":1,"parent":null,"points":445,"end":"range end at 0.7"}],"bifurcations":[{"branch":0,"kind":"fold","detail":"","param":0.800850586304854,"precision":2.7024081030575457e-10,"child_branch":null,"multipliers":[[1.0671300722619446,0.0],[1.000010318521307,0.0],[0.8584749550410304,-0.07662192062756869],[0.8584749550410304,0.07662192062756869],[0.1302838658389211,0.0],[0.018015857594404754,0.0]],"crossing":null,"nordmark":null,"multipliers_after":null,"state":[0.01,-0.02,0.5,-0.25]}],"cascade":{"period_doublings":[],"feigenbaum_ratios":[]},"settings":{},"vibrotribo_version":"0.1.0"}"#,
+            r#"{"command":"continue","complete":true,"param":"omega_ratio","from":0.7,"to":1.0,"transient_periods":200,"doublings":0,"max_points":2000,"mechanics_only":true,"branches":[{"period":1,"parent":null,"points":445,"end":"range end at 0.7"}],"bifurcations":[{"branch":0,"kind":"fold","detail":"","param":0.800850586304854,"precision":2.7024081030575457e-10,"child_branch":null,"other_child_branch":null,"multipliers":[[1.0671300722619446,0.0],[1.000010318521307,0.0],[0.8584749550410304,-0.07662192062756869],[0.8584749550410304,0.07662192062756869],[0.1302838658389211,0.0],[0.018015857594404754,0.0]],"crossing":null,"nordmark":null,"multipliers_after":null,"state":[0.01,-0.02,0.5,-0.25]}],"cascade":{"period_doublings":[],"feigenbaum_ratios":[]},"settings":{},"vibrotribo_version":"0.1.0"}"#,
         );
     }
 

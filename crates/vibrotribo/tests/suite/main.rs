@@ -43,6 +43,7 @@ mod lyapunov;
 mod merit;
 mod motion;
 mod optimize;
+mod orbits_branch_points;
 mod orbits_continuation;
 mod orbits_curve;
 mod orbits_grazing;

@@ -1,5 +1,5 @@
-//! Following branches: the predictor–corrector loop, detection of bifurcations in each step,
-//! and the switch onto period-doubled branches.
+//! Following branches: the predictor–corrector loop, and the queue of branches born at
+//! period doublings and branch points.
 
 use std::collections::VecDeque;
 
@@ -7,16 +7,14 @@ use nalgebra::DVector;
 
 use super::corrector::{Failure, Problem};
 use super::cross::{Bridged, cross};
-use super::locate::{Located, Step, StepPoint, classify, locate_change, locate_root};
+use super::detect::{Context, Ending, KnownBranchPoint, crossing_point, detect};
+use super::locate::{Step, StepPoint, locate_root};
 use super::phase::{move_section, too_close};
-use super::types::{
-    Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions,
-    Crossing, CrossingKind, NordmarkScenario,
-};
+use super::switch::{Fork, Found, Seed, Start, collapsed, cycle_amplitude, failure, flipped, start};
+use super::types::{BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions};
 use crate::error::ParamError;
 use crate::model::{ChainParams, ChainState};
 use crate::orbits::error::OrbitError;
-use crate::orbits::floquet::real_eigenvector;
 use crate::orbits::gaps::smallest_gap_minimum;
 use crate::orbits::map::Scale;
 use crate::orbits::shooting::find_periodic_orbit;
@@ -25,40 +23,6 @@ use crate::sensitivity::state_vector;
 /// A branch that cannot go on ends at a grazing if a gap minimum is below this fraction of
 /// the length unit L.
 const GRAZING_GAP: f64 = 1e-4;
-
-/// Where a branch starts.
-enum Start {
-    /// A converged orbit: state and parameter.
-    Orbit(DVector<f64>, f64),
-    /// A period doubling of the parent at the scaled point `u`, with the critical
-    /// eigenvector `direction` (scaled, zero in the parameter).
-    Doubling {
-        u: DVector<f64>,
-        direction: DVector<f64>,
-        /// The parent branch's unit tangent there (scaled).
-        parent: DVector<f64>,
-    },
-}
-
-struct Seed {
-    period: u32,
-    /// Section phase of `start`, s.
-    phase: f64,
-    depth: u32,
-    parent: Option<(usize, usize)>,
-    start: Start,
-}
-
-/// A period doubling found on a branch, to be followed.
-struct Doubling {
-    bifurcation: usize,
-    /// Section phase of `u`, s.
-    phase: f64,
-    u: DVector<f64>,
-    direction: DVector<f64>,
-    /// The branch's unit tangent at the point (scaled).
-    tangent: DVector<f64>,
-}
 
 /// Pseudo-arclength continuation of the periodic orbit of period `period` near `guess` at
 /// parameter `from`, for the family `family` (any scalar that changes [`ChainParams`],
@@ -117,6 +81,7 @@ where
         period,
         phase: 0.0,
         depth: 0,
+        branch_depth: 0,
         parent: None,
         start: Start::Orbit(state_vector(&orbit.state), from),
     }]);
@@ -136,15 +101,28 @@ where
             options,
         };
         let direction = if to > from { 1.0 } else { -1.0 };
-        let (mut branch, doublings) = follow(&problem, &seed, (lo, hi), direction);
-        complete &= !matches!(branch.end, BranchEnd::Stopped { .. });
+        let known = known_branch_points(&branches, seed.parent);
+        let context = Context {
+            seed: &seed,
+            known: &known,
+        };
         let index = branches.len();
+        let (branch, forks) = match follow(&problem, &context, (lo, hi), direction, &branches) {
+            Followed::New(branch, forks) => (*branch, forks),
+            // The branch leaving a branch point was followed already, from its other end.
+            Followed::Known(other) => {
+                link(&mut branches, seed.parent, other);
+                continue;
+            }
+        };
+        link(&mut branches, seed.parent, index);
+        complete &= !matches!(branch.end, BranchEnd::Stopped { .. });
         // A doubled branch that came back to its parent at another period doubling was
         // followed from both ends: drop the seed at the other end.
         if let BranchEnd::Collapsed { parameter } = branch.end {
             let near = 1e-3 * (hi - lo);
             queue.retain(|s| {
-                let Some((b, k)) = s.parent else { return true };
+                let Some((b, k, _)) = s.parent else { return true };
                 let other = &mut branches[b].bifurcations[k];
                 let same = s.period == branch.period && (other.parameter - parameter).abs() <= near;
                 if same {
@@ -153,38 +131,113 @@ where
                 !same
             });
         }
-        for d in doublings {
-            if index + 1 + queue.len() >= options.max_branches {
-                break;
+        for f in forks {
+            let signs: &[f64] = match f.fork {
+                Fork::Doubling => &[1.0],
+                Fork::BranchPoint => &[1.0, -1.0],
+            };
+            for (j, sign) in signs.iter().enumerate() {
+                if index + 1 + queue.len() >= options.max_branches {
+                    break;
+                }
+                queue.push_back(fork_seed(&seed, index, &f, *sign, j == 1));
             }
-            branch.bifurcations[d.bifurcation].child = Some(index + 1 + queue.len());
-            queue.push_back(Seed {
-                period: 2 * seed.period,
-                phase: d.phase,
-                depth: seed.depth + 1,
-                parent: Some((index, d.bifurcation)),
-                start: Start::Doubling {
-                    u: d.u,
-                    direction: d.direction,
-                    parent: d.tangent,
-                },
-            });
         }
         branches.push(branch);
-    }
-    if !complete {
-        // Period doublings whose branches were not followed have no child.
-        let followed = branches.len();
-        for b in &mut branches {
-            for bif in &mut b.bifurcations {
-                bif.child = bif.child.filter(|c| *c < followed);
-            }
-        }
     }
     Ok(Continuation {
         parameter: name.to_string(),
         branches,
         complete,
+    })
+}
+
+/// The seed of the branch leaving the fork `f` of branch `index` (followed from `seed`)
+/// along `sign` times its direction; `second`: the other half at a branch point.
+fn fork_seed(seed: &Seed, index: usize, f: &Found, sign: f64, second: bool) -> Seed {
+    let (period, depth, branch_depth) = match f.fork {
+        Fork::Doubling => (2 * seed.period, seed.depth + 1, seed.branch_depth),
+        Fork::BranchPoint => (seed.period, seed.depth, seed.branch_depth + 1),
+    };
+    Seed {
+        period,
+        phase: f.phase,
+        depth,
+        branch_depth,
+        parent: Some((index, f.bifurcation, second)),
+        start: Start::Switch {
+            fork: f.fork,
+            u: f.u.clone(),
+            direction: &f.direction * sign,
+            parent: f.tangent.clone(),
+        },
+    }
+}
+
+/// Records `child` as the branch born at the parent's fork.
+fn link(branches: &mut [Branch], parent: Option<(usize, usize, bool)>, child: usize) {
+    let Some((b, k, second)) = parent else { return };
+    let Some(f) = branches.get_mut(b).and_then(|b| b.bifurcations.get_mut(k)) else {
+        return;
+    };
+    if second {
+        f.other_child = Some(child);
+    } else {
+        f.child = Some(child);
+    }
+}
+
+/// The branch points on the branches followed so far, but the one `parent` names (where the
+/// next branch is born).
+fn known_branch_points(branches: &[Branch], parent: Option<(usize, usize, bool)>) -> Vec<KnownBranchPoint> {
+    let mut out = Vec::new();
+    for (i, b) in branches.iter().enumerate() {
+        for (k, f) in b.bifurcations.iter().enumerate() {
+            if f.kind == BifurcationKind::BranchPoint && parent.is_none_or(|(pb, pk, _)| (pb, pk) != (i, k)) {
+                out.push(KnownBranchPoint {
+                    branch: i,
+                    parameter: f.parameter,
+                    state: state_vector(&f.point.state),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// What following a seed gave.
+enum Followed {
+    /// A branch, and the forks on it to follow.
+    New(Box<Branch>, Vec<Found>),
+    /// The branch leaving a branch point is this branch already followed.
+    Known(usize),
+}
+
+/// The branch followed before (of `branches`, but the parent) that the first point `first`
+/// of a branch leaving the branch point `fork` lies on: nearer a chord between two of its
+/// consecutive points than a quarter of its distance from the branch point, in the units of
+/// the state and the parameter's range.
+fn followed_before<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    branches: &[Branch],
+    parent: usize,
+    fork: &BranchPoint,
+    first: &BranchPoint,
+) -> Option<usize> {
+    let point = |q: &BranchPoint| problem.point(&state_vector(&q.state), q.parameter);
+    let x = point(first);
+    let reach = (&x - point(fork)).norm();
+    let chord = |a: &DVector<f64>, b: &DVector<f64>| {
+        let d = b - a;
+        let s = (d.dot(&(&x - a)) / d.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+        (a + d * s - &x).norm()
+    };
+    branches.iter().enumerate().position(|(i, b)| {
+        i != parent
+            && b.period == problem.period
+            && b.points
+                .windows(2)
+                .any(|w| chord(&point(&w[0]), &point(&w[1])) < 0.25 * reach)
     })
 }
 
@@ -195,140 +248,19 @@ fn stopped(current: &StepPoint) -> BranchEnd {
     }
 }
 
-/// The first point of a branch and its tangent.
-fn start<F: Fn(f64) -> ChainParams>(
-    problem: &Problem<'_, F>,
-    seed: &Seed,
-    direction: f64,
-) -> Result<(StepPoint, DVector<f64>), Failure> {
-    let dim = problem.dim();
-    match &seed.start {
-        Start::Orbit(z, p) => {
-            let u = problem.point(z, *p);
-            let ev = problem.evaluate(&u)?;
-            let mut along = DVector::zeros(dim + 1);
-            along[dim] = direction;
-            let t = problem.tangent(&ev, &along).ok_or_else(|| failure(&ev))?;
-            let described = problem.describe(&ev, 0.0).ok_or_else(|| failure(&ev))?;
-            Ok((
-                StepPoint {
-                    theta: 0.0,
-                    ev,
-                    described,
-                },
-                t,
-            ))
-        }
-        Start::Doubling { u, direction, parent } => {
-            // The pitchfork of the doubled map: its new branch leaves along the critical
-            // eigenvector with the parameter stationary. The step and the corrector's plane
-            // are taken orthogonal to the parent branch's tangent, so that the corrector
-            // cannot slide along the parent branch (which crosses a plane normal to the
-            // eigenvector alone a short way off when the doubled branch is flat). A step too
-            // short may still fall back onto the orbit of the parent's period, one too long
-            // leave the corrector's reach: from 1/16 of the first step up to 64 times it, then
-            // down to 1/1024 of it (deep in a cascade the doubled branches are small).
-            let across = direction - parent * parent.dot(direction);
-            let direction = if across.norm() > 1e-3 {
-                across.normalize()
-            } else {
-                direction.clone()
-            };
-            let direction = &direction;
-            let mut last = None;
-            for k in [-2, -1, 0, 1, 2, 3, -3, -4, -5] {
-                let ds = problem.options.initial_step * 4f64.powi(k);
-                let step = Step {
-                    base: u,
-                    tangent: direction,
-                    ds,
-                    s0: 0.0,
-                };
-                match step.at(problem, 1.0) {
-                    Ok(p) if !collapsed(problem, &p) => {
-                        let away = &p.ev.u - u;
-                        let t = problem.tangent(&p.ev, &away).ok_or_else(|| failure(&p.ev))?;
-                        return Ok((StepPoint { theta: 0.0, ..p }, t));
-                    }
-                    Ok(p) => last = Some(failure(&p.ev)),
-                    Err(f) => last = Some(f),
-                }
-            }
-            Err(last.unwrap_or_else(|| failure_of(super::super::error::NewtonFailure::Iterations)))
-        }
-    }
-}
-
-fn failure_of(reason: super::super::error::NewtonFailure) -> Failure {
-    Failure {
-        reason,
-        non_smooth: None,
-        residuals: Vec::new(),
-    }
-}
-
-fn failure(ev: &super::corrector::Evaluated) -> Failure {
-    Failure {
-        reason: super::super::error::NewtonFailure::Singular,
-        non_smooth: None,
-        residuals: vec![ev.residual.amax()],
-    }
-}
-
-/// For an orbit of even period 2P: how far its state after P periods is from its section
-/// state, in the units (0 when it is in fact of period P).
-fn cycle_amplitude<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, p: &StepPoint) -> f64 {
-    let half = (problem.period / 2) as usize;
-    let sections = &p.ev.eval.sections;
-    match (sections.first(), sections.get(half)) {
-        (Some(a), Some(b)) if problem.period.is_multiple_of(2) => problem.scale.norm(&(b - a)),
-        _ => f64::INFINITY,
-    }
-}
-
-/// Whether an orbit of a doubled branch (period 2P) is in fact of period P: its state after
-/// P periods equals its section state to 1e-7 of the units.
-fn collapsed<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, p: &StepPoint) -> bool {
-    cycle_amplitude(problem, p) < 1e-7
-}
-
-/// Whether a step of a doubled branch (period 2P) went through the branch of period P onto
-/// the other half of its pitchfork: the new point is nearer the old point's state after P
-/// periods (the same orbit, shifted by P periods) than the old point itself.
-fn flipped<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, a: &StepPoint, b: &StepPoint) -> bool {
-    let half = (problem.period / 2) as usize;
-    let (Some(za), Some(shifted), Some(zb)) = (
-        a.ev.eval.sections.first(),
-        a.ev.eval.sections.get(half),
-        b.ev.eval.sections.first(),
-    ) else {
-        return false;
-    };
-    problem.period.is_multiple_of(2)
-        && problem.scale.norm(&(zb - shifted)) < 0.5 * problem.scale.norm(&(zb - za))
-}
-
-/// What [`detect`] found that ends a branch.
-#[derive(Default)]
-struct Ending {
-    /// A period doubling at the deepest level.
-    cascade: Option<f64>,
-    /// A doubled branch back on the branch of half its period (at the other end of a
-    /// period-doubling bubble).
-    rejoin: Option<f64>,
-}
-
-/// Follows one branch from its seed.
+/// Follows one branch from its seed (`branches`: those followed before).
 fn follow<F: Fn(f64) -> ChainParams>(
     base: &Problem<'_, F>,
-    seed: &Seed,
+    context: &Context<'_>,
     (lo, hi): (f64, f64),
     direction: f64,
-) -> (Branch, Vec<Doubling>) {
+    branches: &[Branch],
+) -> Followed {
+    let seed = context.seed;
     let opts = base.options;
     let mut branch = Branch {
         period: seed.period,
-        parent: seed.parent,
+        parent: seed.parent.map(|(b, k, _)| (b, k)),
         points: Vec::new(),
         bifurcations: Vec::new(),
         end: BranchEnd::MaxPoints,
@@ -338,20 +270,32 @@ fn follow<F: Fn(f64) -> ChainParams>(
     let mut problem = base.with_phase(seed.phase);
     let seed_parameter = match &seed.start {
         Start::Orbit(_, p) => *p,
-        Start::Doubling { u, .. } => problem.parameter(u),
+        Start::Switch { u, .. } => problem.parameter(u),
     };
     let (mut current, mut t) = match start(&problem, seed, direction) {
         Ok(s) => s,
         Err(f) => {
             branch.end = match seed.start {
                 Start::Orbit(..) => step_floor(seed_parameter, f),
-                Start::Doubling { .. } => BranchEnd::SwitchFailed {
+                Start::Switch { .. } => BranchEnd::SwitchFailed {
                     parameter: seed_parameter,
                 },
             };
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
         }
     };
+    if let (
+        Start::Switch {
+            fork: Fork::BranchPoint,
+            ..
+        },
+        Some((b, k, _)),
+    ) = (&seed.start, seed.parent)
+        && let Some(fork) = branches.get(b).and_then(|p| p.bifurcations.get(k))
+        && let Some(other) = followed_before(&problem, branches, b, &fork.point, &current.described.point)
+    {
+        return Followed::Known(other);
+    }
     branch.points.push(current.described.point.clone());
     let mut ds = opts.initial_step;
     // The sequence before the last change crossed by `cross` (not to be crossed back onto).
@@ -362,7 +306,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
     for _ in 0..passes {
         if opts.shooting.cancel.requested() {
             branch.end = stopped(&current);
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
         }
         if too_close(&problem, &current)
             && let Some((phase, point, tangent)) = move_section(&problem, &current, &t)
@@ -372,7 +316,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
         }
         if branch.points.len() >= opts.max_points {
             branch.end = BranchEnd::MaxPoints;
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
         }
         let step = Step {
             base: &current.ev.u,
@@ -400,7 +344,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                 // A search stopped by the caller is not a corner of the branch.
                 if opts.shooting.cancel.requested() {
                     branch.end = stopped(&current);
-                    return (branch, doublings);
+                    return Followed::New(Box::new(branch), doublings);
                 }
                 // A corner the arclength corrector cannot turn (grazing): step across in
                 // the parameter, the way the branch was going.
@@ -422,7 +366,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                         let p = target.described.point.parameter;
                         if p <= lo || p >= hi {
                             branch.end = BranchEnd::RangeEnd { parameter: p };
-                            return (branch, doublings);
+                            return Followed::New(Box::new(branch), doublings);
                         }
                         current = target;
                         t = t_new;
@@ -446,7 +390,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                         let p = last.described.point.parameter;
                         if p <= lo || p >= hi {
                             branch.end = BranchEnd::RangeEnd { parameter: p };
-                            return (branch, doublings);
+                            return Followed::New(Box::new(branch), doublings);
                         }
                         current = last;
                         t = c.tangent;
@@ -455,7 +399,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                     }
                     None if opts.shooting.cancel.requested() => {
                         branch.end = stopped(&current);
-                        return (branch, doublings);
+                        return Followed::New(Box::new(branch), doublings);
                     }
                     None => {}
                 }
@@ -477,7 +421,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                         },
                     ),
                 };
-                return (branch, doublings);
+                return Followed::New(Box::new(branch), doublings);
             }
         };
         let base_point = StepPoint {
@@ -494,14 +438,16 @@ fn follow<F: Fn(f64) -> ChainParams>(
             None
         };
         let target = match bound {
-            Some(b) => match locate_root(&problem, &step, &base_point, &new, |d| d.point.parameter - b) {
+            Some(b) => match locate_root(&problem, &step, &base_point, &new, |d| {
+                d.described.point.parameter - b
+            }) {
                 Some(l) => l.point,
                 None => new,
             },
             None => new,
         };
         let mut ending = Ending::default();
-        if seed.depth > 0 && flipped(&problem, &base_point, &target) {
+        if seed.doubled() && flipped(&problem, &base_point, &target) {
             let closer = if cycle_amplitude(&problem, &base_point) < cycle_amplitude(&problem, &target) {
                 &base_point
             } else {
@@ -515,7 +461,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
             &base_point,
             &target,
             (&t, &t_new),
-            seed,
+            context,
             &mut branch,
             &mut doublings,
             &mut ending,
@@ -525,22 +471,29 @@ fn follow<F: Fn(f64) -> ChainParams>(
             branch.end = BranchEnd::Closed {
                 parameter: branch.points[k].parameter,
             };
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
         }
-        if seed.depth > 0 && collapsed(&problem, &target) {
+        if seed.doubled() && collapsed(&problem, &target) {
             ending.rejoin.get_or_insert(target.described.point.parameter);
         }
         if let Some(parameter) = ending.rejoin {
             branch.end = BranchEnd::Collapsed { parameter };
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
+        }
+        if let Some((parameter, branch_index)) = ending.meets {
+            branch.end = BranchEnd::Rejoined {
+                parameter,
+                branch: branch_index,
+            };
+            return Followed::New(Box::new(branch), doublings);
         }
         if let Some(b) = bound {
             branch.end = BranchEnd::RangeEnd { parameter: b };
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
         }
         if let Some(parameter) = ending.cascade {
             branch.end = BranchEnd::CascadeDepth { parameter };
-            return (branch, doublings);
+            return Followed::New(Box::new(branch), doublings);
         }
         ds = match target.ev.iterations {
             0..=2 => (ds * 1.5).min(opts.max_step),
@@ -551,7 +504,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
         t = t_new;
     }
     branch.end = BranchEnd::MaxPoints;
-    (branch, doublings)
+    Followed::New(Box::new(branch), doublings)
 }
 
 /// Whether a step from `current` to `new` goes back onto the sequence the branch left at its
@@ -610,173 +563,5 @@ fn step_floor(parameter: f64, f: Failure) -> BranchEnd {
         reason: f.reason,
         non_smooth: f.non_smooth,
         residuals: f.residuals,
-    }
-}
-
-/// Finds and locates what happens between `base` and `target` (a step from `base`), and
-/// appends it to `branch` in order along it.
-#[allow(clippy::too_many_arguments)]
-fn detect<F: Fn(f64) -> ChainParams>(
-    problem: &Problem<'_, F>,
-    step: &Step<'_>,
-    base: &StepPoint,
-    target: &StepPoint,
-    (t_base, t_target): (&DVector<f64>, &DVector<f64>),
-    seed: &Seed,
-    branch: &mut Branch,
-    doublings: &mut Vec<Doubling>,
-    ending: &mut Ending,
-) {
-    let mut found: Vec<(f64, Bifurcation, Option<Doubling>)> = Vec::new();
-    let mut intervals = vec![(base.clone(), target.clone())];
-    if base.described.signature != target.described.signature {
-        let (left, right, precision) = locate_change(problem, step, base, target);
-        // The step went through the change: the parameter went on the way the branch was
-        // going (persistence) or turned back at it (non-smooth fold).
-        let dim = problem.dim();
-        let onward = (right.described.point.parameter - left.described.point.parameter) * t_base[dim];
-        let kind = if onward >= 0.0 {
-            CrossingKind::Persistence
-        } else {
-            CrossingKind::NonSmoothFold
-        };
-        found.push((
-            left.theta,
-            crossing_point(problem, &left, &right, precision, kind),
-            None,
-        ));
-        // The multipliers may jump across the change; look for smooth crossings on either
-        // side of it only.
-        intervals = vec![(base.clone(), left), (right, target.clone())];
-    }
-    let dim = problem.dim();
-    for (a, b) in &intervals {
-        let (ta, tb) = (&a.described.tests, &b.described.tests);
-        if ta.fold * tb.fold < 0.0
-            && let Some(l) = locate_root(problem, step, a, b, |d| d.tests.fold)
-        {
-            let turned = t_base[dim] * t_target[dim] < 0.0;
-            let kind = if turned {
-                BifurcationKind::Fold
-            } else {
-                BifurcationKind::BranchPoint
-            };
-            found.push((l.point.theta, bifurcation(kind, &l), None));
-        }
-        if ta.flip * tb.flip < 0.0
-            && let Some(l) = locate_root(problem, step, a, b, |d| d.tests.flip)
-        {
-            let b = bifurcation(BifurcationKind::PeriodDoubling, &l);
-            let doubling = if seed.depth < problem.options.doubling_depth {
-                l.point
-                    .ev
-                    .eval
-                    .stm
-                    .as_ref()
-                    .ok()
-                    .and_then(|phi| real_eigenvector(phi, -1.0))
-                    .map(|e| {
-                        let n = dim / 2;
-                        let mut direction = DVector::from_fn(dim + 1, |i, _| {
-                            if i < dim {
-                                e[i] / problem.scale.of_component(i, n)
-                            } else {
-                                0.0
-                            }
-                        });
-                        direction.normalize_mut();
-                        Doubling {
-                            bifurcation: 0,
-                            phase: problem.phase,
-                            u: l.point.ev.u.clone(),
-                            direction,
-                            tangent: t_base.clone(),
-                        }
-                    })
-            } else {
-                ending.cascade.get_or_insert(l.point.described.point.parameter);
-                None
-            };
-            found.push((l.point.theta, b, doubling));
-        }
-        if ta.neimark_sacker * tb.neimark_sacker < 0.0
-            && let Some(l) = locate_root(problem, step, a, b, |d| d.tests.neimark_sacker)
-        {
-            // The pair whose product is closest to 1 must be complex (a conjugate pair on the
-            // unit circle); two real multipliers with product 1 are a neutral saddle, not a
-            // bifurcation.
-            let m = &l.point.described.point.multipliers;
-            let mut closest: Option<(f64, usize, usize)> = None;
-            for i in 0..m.len() {
-                for j in i + 1..m.len() {
-                    let d = (m[i] * m[j] - nalgebra::Complex::new(1.0, 0.0)).norm();
-                    if closest.is_none_or(|c| d < c.0) {
-                        closest = Some((d, i, j));
-                    }
-                }
-            }
-            if let Some((_, i, j)) = closest
-                && m[i].im.abs() > 1e-9 * m[i].norm()
-                && (m[i] - m[j].conj()).norm() <= 1e-6 * m[i].norm()
-            {
-                let kind = BifurcationKind::NeimarkSacker {
-                    angle: m[i].arg().abs(),
-                };
-                found.push((l.point.theta, bifurcation(kind, &l), None));
-            }
-        }
-    }
-    found.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, bif, doubling) in found {
-        let index = branch.bifurcations.len();
-        branch.bifurcations.push(bif);
-        if let Some(mut d) = doubling {
-            d.bifurcation = index;
-            doublings.push(d);
-        }
-    }
-}
-
-fn bifurcation(kind: BifurcationKind, l: &Located) -> Bifurcation {
-    Bifurcation {
-        kind,
-        parameter: l.point.described.point.parameter,
-        precision: l.precision,
-        point: l.point.described.point.clone(),
-        after: None,
-        child: None,
-        crossing: None,
-    }
-}
-
-/// A change of the event sequence crossed between `before` and `after`: its kind, and for a
-/// grazing what the square-root map predicts from the multipliers of the orbit without the
-/// impact.
-fn crossing_point<F: Fn(f64) -> ChainParams>(
-    problem: &Problem<'_, F>,
-    before: &StepPoint,
-    after: &StepPoint,
-    precision: f64,
-    crossing: CrossingKind,
-) -> Bifurcation {
-    let kind = classify(&before.described, &after.described, problem.scale.speed);
-    let nordmark = match kind {
-        BifurcationKind::Grazing { appears, .. } => {
-            let free = if appears { before } else { after };
-            Some(NordmarkScenario::of(&free.described.point.multipliers))
-        }
-        _ => None,
-    };
-    Bifurcation {
-        kind,
-        parameter: before.described.point.parameter,
-        precision,
-        point: before.described.point.clone(),
-        after: Some(after.described.point.clone()),
-        child: None,
-        crossing: Some(Crossing {
-            kind: crossing,
-            nordmark,
-        }),
     }
 }

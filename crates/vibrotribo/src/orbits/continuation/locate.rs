@@ -54,6 +54,35 @@ impl Step<'_> {
         Ok(StepPoint { theta, ev, described })
     }
 
+    /// The corrected point at θ between two corrected points `a` and `b` of this step,
+    /// predicted on the chord between them (which lies in the plane of θ, as both lie in
+    /// theirs). Next to a branch point the corrector's Jacobian is nearly singular and
+    /// Newton's method converges only from close by: the chord's error shrinks with the
+    /// square of the bracket, the tangent line's does not.
+    pub fn between<F: Fn(f64) -> ChainParams>(
+        &self,
+        problem: &Problem<'_, F>,
+        theta: f64,
+        a: &StepPoint,
+        b: &StepPoint,
+    ) -> Result<StepPoint, Failure> {
+        let width = b.theta - a.theta;
+        if width == 0.0 {
+            return self.at(problem, theta);
+        }
+        let s = (theta - a.theta) / width;
+        let u_pred = &a.ev.u + (&b.ev.u - &a.ev.u) * s;
+        let ev = problem.correct(&u_pred, self.tangent)?;
+        let described = problem
+            .describe(&ev, self.s0 + theta * self.ds)
+            .ok_or_else(|| Failure {
+                reason: super::super::error::NewtonFailure::Singular,
+                non_smooth: None,
+                residuals: Vec::new(),
+            })?;
+        Ok(StepPoint { theta, ev, described })
+    }
+
     fn precision(&self, p_scale: f64, a: &StepPoint, b: &StepPoint) -> f64 {
         let dtheta = self.ds * (b.theta - a.theta).abs();
         (b.described.point.parameter - a.described.point.parameter).abs() + p_scale * dtheta * dtheta
@@ -67,7 +96,11 @@ pub(crate) struct Located {
     pub precision: f64,
 }
 
-/// The zero of `f` between `a` and `b` (where it changes sign) by the Illinois method.
+/// The zero of `f` between `a` and `b` (where it changes sign) by the Illinois method. Where
+/// the corrector fails from the step's tangent line inside the bracket (next to a branch
+/// point the corrector's Jacobian is nearly singular), it starts from the chord between the
+/// bracket's ends ([`Step::between`]); where that fails too, the bracket reached so far is
+/// the answer, with its precision.
 pub(crate) fn locate_root<F, G>(
     problem: &Problem<'_, F>,
     step: &Step<'_>,
@@ -77,11 +110,11 @@ pub(crate) fn locate_root<F, G>(
 ) -> Option<Located>
 where
     F: Fn(f64) -> ChainParams,
-    G: Fn(&Described) -> f64,
+    G: Fn(&StepPoint) -> f64,
 {
     let tol = problem.options.location_tolerance;
     let (mut a, mut b) = (a.clone(), b.clone());
-    let (mut fa, mut fb) = (f(&a.described), f(&b.described));
+    let (mut fa, mut fb) = (f(&a), f(&b));
     if fa * fb > 0.0 {
         return None;
     }
@@ -94,8 +127,13 @@ where
         if !(theta > lo && theta < hi) {
             theta = 0.5 * (lo + hi);
         }
-        let c = step.at(problem, theta).ok()?;
-        let fc = f(&c.described);
+        let Ok(c) = step
+            .at(problem, theta)
+            .or_else(|_| step.between(problem, theta, &a, &b))
+        else {
+            break;
+        };
+        let fc = f(&c);
         if fc * fb < 0.0 {
             a = b;
             fa = fb;

@@ -49,9 +49,11 @@ mod branch;
 mod cascade;
 mod corrector;
 mod cross;
+mod detect;
 mod locate;
 mod nordmark;
 mod phase;
+mod switch;
 mod types;
 pub(in crate::orbits) use types::check_path;
 

@@ -21,12 +21,17 @@ pub struct ContinuationOptions {
     pub max_step: f64,
     /// Most points per branch ([`BranchEnd::MaxPoints`] beyond). Default 2000.
     pub max_points: usize,
-    /// Most branches in all (the first plus the period-doubled ones). Default 16.
+    /// Most branches in all (the first plus those born at period doublings and branch
+    /// points). Default 16.
     pub max_branches: usize,
     /// Period doublings to follow: at a period doubling of a branch of period 2^k·P with
     /// k < `doubling_depth` the doubled branch is followed too, so a cascade P → 2P → 4P …
     /// is followed `doubling_depth` levels deep. Default 3.
     pub doubling_depth: u32,
+    /// Branch points to switch at: at a branch point of a branch born at fewer than
+    /// `branch_point_depth` branch points, both branches leaving it are followed (the two
+    /// halves of a symmetry-breaking pitchfork). Default 1.
+    pub branch_point_depth: u32,
     /// Bifurcations and sequence changes are located to this accuracy in the parameter, in
     /// its unit. Default 1e-8.
     pub location_tolerance: f64,
@@ -51,6 +56,7 @@ impl Default for ContinuationOptions {
             max_points: 2000,
             max_branches: 16,
             doubling_depth: 3,
+            branch_point_depth: 1,
             location_tolerance: 1e-8,
             corrector_tolerance: 1e-11,
             corrector_iterations: 8,
@@ -144,7 +150,10 @@ pub enum BifurcationKind {
     /// A real multiplier crosses +1 and the branch turns back in the parameter
     /// (saddle-node).
     Fold,
-    /// A real multiplier crosses +1 without a turn in the parameter (a branch point).
+    /// A real multiplier crosses +1 without a turn in the parameter: a branch point, where
+    /// a second branch crosses this one (a symmetry-breaking pitchfork, or a transcritical
+    /// crossing). Found where `det([J; tᵀ])` changes sign, J the Jacobian
+    /// `[Φ − I | ∂φ/∂p]` and t the step's tangent.
     BranchPoint,
     /// A real multiplier crosses −1: a branch of twice the period is born.
     PeriodDoubling,
@@ -204,8 +213,12 @@ pub struct Bifurcation {
     /// For a sequence change: the first orbit after it.
     pub after: Option<BranchPoint>,
     /// For a period doubling: the index of the doubled branch in
-    /// [`Continuation::branches`], if it was followed.
+    /// [`Continuation::branches`], if it was followed. For a branch point: the branch that
+    /// leaves it one way.
     pub child: Option<usize>,
+    /// For a branch point: the branch that leaves it the other way (at a symmetry-breaking
+    /// pitchfork, the mirror image of `child`), if it was followed.
+    pub other_child: Option<usize>,
     /// For a change of the event sequence the branch was continued through (a
     /// discontinuity-induced bifurcation): how it was crossed and what the square-root map
     /// predicts there.
@@ -360,11 +373,21 @@ pub enum BranchEnd {
         /// Parameter of the point where it happened.
         parameter: f64,
     },
-    /// The branch came back to its first point: it is a closed curve (an isola), followed
-    /// once round.
+    /// The branch came back to one of its earlier points (its first one for a smooth closed
+    /// curve, an isola; any one after a corner crossed at a change of the event sequence):
+    /// from there on it repeats itself, and it is followed once round.
     Closed {
-        /// Parameter of the first point.
+        /// Parameter of the point it came back to.
         parameter: f64,
+    },
+    /// The branch reached a branch point found earlier on another branch (`branch`), where
+    /// it crosses that one: the branches beyond leave that branch point and are followed
+    /// from there.
+    Rejoined {
+        /// Parameter of the branch point.
+        parameter: f64,
+        /// The branch it lies on.
+        branch: usize,
     },
     /// The caller asked the continuation to stop
     /// ([`ShootingOptions::cancel`](crate::orbits::ShootingOptions::cancel), polled at every
@@ -414,8 +437,8 @@ impl BranchEnd {
 pub struct Branch {
     /// Period of its orbits, in excitation periods.
     pub period: u32,
-    /// Where it was born: (index of the parent branch, index of the period doubling in its
-    /// `bifurcations`); `None` for the first branch.
+    /// Where it was born: (index of the parent branch, index of the period doubling or
+    /// branch point in its `bifurcations`); `None` for the first branch.
     pub parent: Option<(usize, usize)>,
     /// The orbits in order along the branch.
     pub points: Vec<BranchPoint>,
@@ -430,7 +453,8 @@ pub struct Branch {
 pub struct Continuation {
     /// Name of the parameter.
     pub parameter: String,
-    /// The branches: the first, then the period-doubled ones in the order they were found.
+    /// The branches: the first, then those born at period doublings and branch points in the
+    /// order they were found.
     pub branches: Vec<Branch>,
     /// Whether every branch found was followed to its end: `false` when the caller stopped
     /// the continuation ([`BranchEnd::Stopped`], or period doublings left unfollowed).
