@@ -400,7 +400,7 @@ pub enum BranchEnd {
 
 impl BranchEnd {
     /// Its name in files: `range_end`, `max_points`, `step_floor`, `grazing`,
-    /// `cascade_depth`, `switch_failed`, `collapsed`, `closed`, `stopped`.
+    /// `cascade_depth`, `switch_failed`, `collapsed`, `closed`, `rejoined`, `stopped`.
     pub fn name(&self) -> &'static str {
         match self {
             BranchEnd::RangeEnd { .. } => "range_end",
@@ -411,6 +411,7 @@ impl BranchEnd {
             BranchEnd::SwitchFailed { .. } => "switch_failed",
             BranchEnd::Collapsed { .. } => "collapsed",
             BranchEnd::Closed { .. } => "closed",
+            BranchEnd::Rejoined { .. } => "rejoined",
             BranchEnd::Stopped { .. } => "stopped",
         }
     }
@@ -426,6 +427,7 @@ impl BranchEnd {
             | BranchEnd::SwitchFailed { parameter }
             | BranchEnd::Collapsed { parameter }
             | BranchEnd::Closed { parameter }
+            | BranchEnd::Rejoined { parameter, .. }
             | BranchEnd::Stopped { parameter } => Some(*parameter),
             BranchEnd::MaxPoints => None,
         }
