@@ -23,8 +23,9 @@ mod kind;
 
 pub use commands::*;
 pub use curve::{Codim2Record, CurveManifest};
-pub use grid::{Axis, MapManifest, SettleRecord, ShardRecord, SweepManifest, base_motion_of};
+pub use grid::{Axis, MapManifest, ShardRecord, SweepManifest, base_motion_of};
 pub use kind::{Kind, kind_of, shard_kind};
+pub use vibrotribo::report::SettleRecord;
 
 /// Reads the manifest `path` as `T`; the error names the file and the key at fault.
 pub fn read<T: DeserializeOwned>(path: &Path) -> Result<T> {
