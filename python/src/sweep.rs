@@ -16,10 +16,11 @@ use vibrotribo::sweep::{
 
 use vibrotribo::attractors::initial_condition_index;
 use vibrotribo::lyapunov::LyapunovOptions;
+use vibrotribo::report::SettleRecord;
 use vibrotribo::study::limits;
 
 use crate::config::{config_error, config_of, table_to_dict};
-use crate::convert::table_to_py;
+use crate::convert::{serde_to_py, table_to_py};
 use crate::interrupt::Signals;
 use crate::limits::{check_grid, check_memory};
 
@@ -127,11 +128,10 @@ pub fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'p
     d.set_item("grazing_ratio", o.grazing_ratio)?;
     d.set_item("electrical_warmup_periods", o.electrical_warmup_periods)?;
     d.set_item("mechanics_only", runner.mechanics_only())?;
-    d.set_item("settle", o.settle.as_str())?;
-    if let SettleMode::Auto(a) = &o.settle {
-        d.set_item("settle_cap_periods", a.cap_periods)?;
-        d.set_item("settle_block_periods", a.block)?;
-        d.set_item("settle_newton", a.shoot)?;
+    // How the points settle, the keys of the command line's manifests.
+    let settle = serde_to_py(py, &SettleRecord::of(o))?;
+    for (k, v) in settle.cast::<PyDict>()?.iter() {
+        d.set_item(k, v)?;
     }
     d.set_item("settings", table_to_dict(py, runner.base().table())?)?;
     Ok(d)

@@ -138,6 +138,9 @@ def test_sweep_equals_the_files(cli, tmp_path, name, args, setup):
     for key in ("param", "values", "continuation", "transient_periods", "recorded_periods",
                 "period_tolerance", "max_period_detected", "mechanics_only", "settings"):
         assert r.settings[key] == settings[key], key
+    # How the points settled: the same keys, present or absent alike.
+    for key in ("settle", "settle_cap_periods", "settle_block_periods", "settle_newton"):
+        assert r.settings.get(key) == settings.get(key), key
     assert r.summary.rows == len(values)
     assert r.summary["period"].dtype == np.int64 and r.summary["chatter"].dtype == np.bool_
     if name == "failing-points":

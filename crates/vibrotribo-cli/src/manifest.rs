@@ -26,9 +26,10 @@ mod response;
 pub use bifmap::*;
 pub use commands::*;
 pub use curve::{Codim2Record, CurveManifest};
-pub use grid::{Axis, MapManifest, SettleRecord, ShardRecord, SweepManifest, base_motion_of};
+pub use grid::{Axis, MapManifest, ShardRecord, SweepManifest, base_motion_of};
 pub use kind::{Kind, kind_of, shard_kind};
 pub use response::*;
+pub use vibrotribo::report::SettleRecord;
 
 /// Reads the manifest `path` as `T`; the error names the file and the key at fault.
 pub fn read<T: DeserializeOwned>(path: &Path) -> Result<T> {

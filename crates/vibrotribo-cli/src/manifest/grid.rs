@@ -4,8 +4,7 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use vibrotribo::config::Config;
-use vibrotribo::report::BaseMotionSummary;
-use vibrotribo::study::{PointOptions, SettleMode};
+use vibrotribo::report::{BaseMotionSummary, SettleRecord};
 use vibrotribo::sweep::Continuation;
 
 use super::Kind;
@@ -21,39 +20,6 @@ pub struct ShardRecord {
     pub index: usize,
     /// Number of slices.
     pub count: usize,
-}
-
-/// How each point settled before its recorded window.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-pub struct SettleRecord {
-    /// `auto` or `fixed`.
-    #[serde(default)]
-    pub settle: String,
-    /// `auto`: most periods run before the recorded window.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settle_cap_periods: Option<u64>,
-    /// `auto`: periods between two checks of the motion.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settle_block_periods: Option<u64>,
-    /// `auto`: whether a geometric approach is finished by Newton shooting.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub settle_newton: Option<bool>,
-}
-
-impl SettleRecord {
-    /// The settling of `options`.
-    pub fn of(options: &PointOptions) -> Self {
-        let auto = match &options.settle {
-            SettleMode::Auto(a) => Some(a),
-            SettleMode::Fixed => None,
-        };
-        SettleRecord {
-            settle: options.settle.as_str().to_string(),
-            settle_cap_periods: auto.map(|a| a.cap_periods),
-            settle_block_periods: auto.map(|a| a.block),
-            settle_newton: auto.map(|a| a.shoot),
-        }
-    }
 }
 
 /// The base motion of `config` when it is not the chain's own harmonic (kind, how it was run,

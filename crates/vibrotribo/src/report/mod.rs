@@ -6,10 +6,12 @@
 
 mod base_motion;
 mod motion;
+mod settle;
 mod summary;
 
 pub use base_motion::{BaseMotionSummary, base_motion_lines};
 pub use motion::{CoexistingRecord, MotionRecord, NewtonRecord};
+pub use settle::SettleRecord;
 pub use summary::{
     ElectricalSummary, MeritSummary, RectifierSummary, RunSummary, SummaryCommand, failure_text,
 };
