@@ -59,7 +59,8 @@ run=(simulate -q --set run.periods=30000 --set run.samples_per_period=1 --force)
 if [ "$only" != coupling ]; then
     echo "1. default case, 100 kΩ, 30 000 periods, one sample a period, files written"
     if [ -n "$base" ]; then
-        pair "A = $bin, B = $base" "$bin ${run[*]} --out $out/a" "$base ${run[*]} --out $out/b"
+        # An older binary may have no --force (it wrote over its own files without it).
+        pair "A = $bin, B = $base" "$bin ${run[*]} --out $out/a" "$base ${run[*]/--force/} --out $out/b"
     fi
     pair "A = with the harvester, B = --mechanics-only" \
         "$bin ${run[*]} --out $out/a" "$bin ${run[*]} --mechanics-only --out $out/m"
