@@ -306,6 +306,10 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
             d.set_item("parameter", parameter)?;
             "stopped"
         }
+        BranchEnd::Closed { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "closed"
+        }
         BranchEnd::Rejoined { parameter, branch } => {
             d.set_item("parameter", parameter)?;
             d.set_item("branch", branch)?;

@@ -536,10 +536,13 @@ class Branch(Display):
             ``kind`` (``fold``, ``branch_point``, ``period_doubling``, ``neimark_sacker``
             with ``angle``, ``grazing`` with ``contact``/``appears``, ``sticking`` with
             ``contact``/``onset``, ``sequence_change``), ``parameter``, ``precision``, the
-            orbit's ``x``, ``v``, ``multipliers`` and ``child`` (the doubled branch's index).
+            orbit's ``x``, ``v``, ``multipliers``, ``child`` (the doubled branch's index, or
+            at a branch point the first branch switched onto) and ``other_child`` (at a
+            branch point, the second one).
         end: why the branch ended: ``reason`` (``range_end``, ``max_points``,
             ``step_floor``, ``grazing``, ``cascade_depth``, ``switch_failed``,
-            ``collapsed``) and its details.
+            ``collapsed``, ``closed``, ``rejoined`` with the ``branch`` it reached,
+            ``stopped``) and its details.
     """
 
     period: int
