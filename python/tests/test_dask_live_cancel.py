@@ -25,7 +25,14 @@ CHILD = textwrap.dedent(
         # Count the tasks the worker starts, to see that none starts after the cancel.
         def plugin_count(dask_worker):
             return dask_worker.state.executed_count
-        threading.Timer(1.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+        # Ctrl-C once the first task has finished, whatever the machine's speed: the sweep
+        # is then under way with nearly all of its tasks still to run.
+        worker = next(iter(cluster.workers.values()))
+        def interrupt_after_the_first_task():
+            while worker.state.executed_count < 1:
+                time.sleep(0.005)
+            os.kill(os.getpid(), signal.SIGINT)
+        threading.Thread(target=interrupt_after_the_first_task, daemon=True).start()
         try:
             vibrotribo.dask.sweep(client, vt.Config(), "omega_ratio", values,
                                   transient=100, recorded=20, mechanics_only=True,
