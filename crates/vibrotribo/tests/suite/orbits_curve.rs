@@ -1,9 +1,10 @@
 //! Bifurcation curves in two parameters against the closed form of the impact oscillator
 //! (Shaw & Holmes 1983): one mass of 50 g on 120 N/m, c = 0.02 N·s/m, base amplitude 10 mm,
 //! a stop fixed above at the gap, r = 0.8. The period-doubling curve of the (1,1) orbit in
-//! (Ω, gap) where the closed-form map `S Φ(T)` has a multiplier −1; the grazing curve of the
-//! impact-free orbit where its steady amplitude equals the gap; every point of a curve a true
-//! orbit of the engine.
+//! (Ω, gap) where the closed-form map `S Φ(T)` has a multiplier −1; the fold curve where two
+//! (1,1) orbits meet (a double root of the closed-form (1,1) conditions); the grazing curve of
+//! the impact-free orbit where its steady amplitude equals the gap; every point of a curve a
+//! true orbit of the engine.
 
 use crate::common::impact_oscillator;
 
@@ -272,4 +273,126 @@ fn grazing_curve_is_where_the_steady_amplitude_equals_the_gap() {
         "the curve ends at gap {} short of the range",
         last.parameter2
     );
+}
+
+/// The state at t = 0 of the closed-form (1,1) orbit at Ω nearest the impact speed `speed`:
+/// the motion after its impact, run on to the end of the period.
+fn one_one_start(omega_ratio: f64, gap: f64, speed: f64) -> (f64, f64) {
+    let io = textbook(omega_ratio, gap);
+    let o = nearest(omega_ratio, gap, speed).expect("a closed-form (1,1) orbit");
+    let (p, pd) = io.xp(o.t0);
+    let (h0, h1) = (gap - p, -R * o.speed - pd);
+    let f = io.propagator(io.period() - o.t0);
+    let (x, v) = io.xp(0.0);
+    (x + f[0][0] * h0 + f[0][1] * h1, v + f[1][0] * h0 + f[1][1] * h1)
+}
+
+/// The impact time of the engine's orbit through `p` in its period, s.
+fn impact_time(c: &Config, p: &CurvePoint) -> f64 {
+    let chain = c.chain();
+    let mut sim = Simulator::new(chain, &p.state, SimOptions::default()).expect("valid start");
+    let mut log = vibrotribo::EventLog::default();
+    sim.run_until(chain.period(), &mut log).expect("the orbit runs");
+    log.events.first().expect("an impact").event.time
+}
+
+/// Where the closed-form (1,1) orbits of impact times near `t_fold` meet at `gap`: the (1,1)
+/// conditions reduced to the impact time have a double root there, so the extremum of the
+/// reduced residual over impact times within a twentieth of a period of `t_fold` changes sign;
+/// by bisection in Ω over `bracket`.
+fn closed_form_fold(gap: f64, t_fold: f64, bracket: (f64, f64)) -> f64 {
+    let extremum = |w: f64| {
+        let io = textbook(w, gap);
+        let g = |t: f64| io.reduced(t).0;
+        let (mut a, mut b) = (t_fold - 0.05 * io.period(), t_fold + 0.05 * io.period());
+        let outside = g(a).signum();
+        assert_eq!(
+            outside,
+            g(b).signum(),
+            "the window's ends on two sides at Ω = {w}"
+        );
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..200 {
+            let (c, d) = (b - golden * (b - a), a + golden * (b - a));
+            if outside * g(c) < outside * g(d) {
+                b = d
+            } else {
+                a = c
+            }
+        }
+        outside * g(0.5 * (a + b))
+    };
+    let (mut lo, mut hi) = bracket;
+    let f_lo = extremum(lo);
+    assert!(
+        f_lo * extremum(hi) < 0.0,
+        "no closed-form fold in {bracket:?} at gap {gap}"
+    );
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if extremum(mid) * f_lo > 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The fold curve of the (1,1) orbits in (Ω, gap), where the slow orbit born at the grazing of
+/// the impact-free motion meets the fast one, lies where the closed-form (1,1) conditions have
+/// a double root, and each of its points is an orbit of the engine with a multiplier at +1.
+#[test]
+fn fold_curve_matches_the_closed_form() {
+    let gap = 0.015;
+    // Started on the fast (1,1) orbit at Ω = 1.77 (the motion from rest there is impact-free).
+    let start = one_one_start(1.77, gap, 3.7);
+    let request = CurveRequest {
+        kind: CurveKind::Fold,
+        key: "omega_ratio".into(),
+        near: 1.77,
+        key2: GAP_KEY.into(),
+        from2: gap,
+        to2: 0.02,
+        period: Some(1),
+    };
+    let base = config_from(1.77, gap, start);
+    let result = curve_config(&base, &request, &options(40)).expect("the curve is computed");
+    let curve = &result.curve;
+    println!(
+        "located at Ω = {}, {} points, end {:?}",
+        result.located.parameter,
+        curve.points.len(),
+        curve.end
+    );
+    assert!(curve.points.len() >= 5, "only {} points", curve.points.len());
+    let last = curve.points.last().expect("points");
+    assert!(
+        last.parameter2 > 0.018,
+        "the curve stops at gap {}",
+        last.parameter2
+    );
+    let stride = (curve.points.len() / 4).max(1);
+    for p in curve.points.iter().step_by(stride).chain([last]) {
+        let c = config(p.parameter, p.parameter2);
+        assert_true_orbit(&c, p, curve.period);
+        let lambda = p
+            .multipliers
+            .iter()
+            .map(|l| (l.re - 1.0).hypot(l.im))
+            .fold(f64::INFINITY, f64::min);
+        assert!(lambda < 1e-8, "no multiplier at +1 at {p:?}");
+        let t = impact_time(&c, p);
+        let want = closed_form_fold(p.parameter2, t, (p.parameter - 5e-4, p.parameter + 5e-4));
+        println!(
+            "gap {:.6}: Ω = {:.12}, closed form {want:.12}",
+            p.parameter2, p.parameter
+        );
+        assert!(
+            (p.parameter - want).abs() < 1e-8,
+            "fold at gap {}: Ω = {} vs closed form {want}",
+            p.parameter2,
+            p.parameter
+        );
+    }
 }

@@ -19,7 +19,10 @@
 //!    where the linearised square-root map (`SquareRootModel`) puts them, then from the edge
 //!    orbit moved along the gradient `c = ∂h/∂z` of the grazing gap (by `−η c/|c|²`, so that
 //!    the flow from it strikes the contact with a penetration η of 1e-12 … 1e-6 of the length
-//!    unit, or `+η c/|c|²` to lift a slow impact off). Newton's method is held to the event
+//!    unit, or `+η c/|c|²` to lift a slow impact off), with the gap and its gradient taken
+//!    from the edge's flow and again from the flow at the new parameter (on a non-smooth
+//!    fold's side the clearance grows linearly in the distance, beyond those penetrations).
+//!    Newton's method is held to the event
 //!    sequence of its starting point, so that it cannot fall onto the old orbit; on the
 //!    square-root branch it converges from the side of small penetration (the map is convex
 //!    there), which is why the guesses start shallow. The branch then goes on along the new
@@ -145,7 +148,6 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
     let precision = (p_bad - parameter(&ok)).abs();
     // 3. The new sequence on either side of the edge: first where the square-root map puts
     // it, then from the generic guesses.
-    let generic = guesses(problem, &ok);
     let back =
         parameter(&ok) - direction * (1e-6 * problem.p_scale).max(10.0 * problem.options.location_tolerance);
     let model = orbit_keeping(
@@ -156,6 +158,7 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
         signature,
     )
     .and_then(|behind| SquareRootModel::new(problem, &ok, &behind));
+    let edge_guesses = guesses(problem, &ok, parameter(&ok));
     // The persistence side first, at every distance: a symmetric orbit that grazes two
     // contacts at once may also meet orbits striking only one of them at a fold.
     for (sigma, kind) in [
@@ -169,6 +172,10 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                 continue;
             }
             let predicted = model.as_ref().map_or_else(Vec::new, |m| m.guesses(sigma * eps));
+            // From the edge's flow first, then from the flow at p (the clearance a fold's side
+            // opens taken into account).
+            let mut generic = edge_guesses.clone();
+            generic.extend(guesses(problem, &ok, p).into_iter().skip(1));
             for z in predicted.iter().chain(&generic) {
                 if let Some(o) = orbit_beyond(problem, z, p, arclength(p), signature)
                     && o.described.signature != *signature
@@ -321,13 +328,19 @@ fn crossed<F: Fn(f64) -> ChainParams>(
     })))
 }
 
-/// Initial states for the orbit with the new sequence near the edge orbit `edge`: the orbit
-/// itself, and the orbit moved along the gradient of the gap that grazes (a gap minimum near
-/// zero: moved into contact) or of the slowest impact (moved out of contact).
-fn guesses<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, edge: &StepPoint) -> Vec<DVector<f64>> {
+/// Initial states at the parameter `p` for the orbit with the new sequence near the edge orbit
+/// `edge`: the orbit itself, and the orbit moved along the gradient of the gap that grazes (a
+/// gap minimum near zero: moved into contact) or of the slowest impact (moved out of contact).
+/// The gap and its gradient are those of the flow at `p`, so that the move makes up for the
+/// clearance the parameter step opened (on a non-smooth fold's side it grows linearly in the
+/// step, faster than the penetrations tried).
+fn guesses<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    edge: &StepPoint,
+    p: f64,
+) -> Vec<DVector<f64>> {
     let z = problem.state(&edge.ev.u);
     let mut out = vec![z.clone()];
-    let p = edge.described.point.parameter;
     let params = (problem.family)(p);
     let opts = &problem.options.shooting;
     let length = problem.scale.length;

@@ -87,6 +87,19 @@ impl ImpactOscillator {
         [p + h - self.gap, pd + hd - v]
     }
 
+    /// The (1,1) conditions reduced to the impact time: the impact speed `v(t₀)` that closes
+    /// the velocity condition (linear in v) and the position condition's residual at it, m.
+    /// The (1,1) orbits are the roots with v > 0; at a fold two of them meet in a double root.
+    pub fn reduced(&self, t0: f64) -> (f64, f64) {
+        let (p, pd) = self.xp(t0);
+        let h0 = self.gap - p;
+        let f = self.propagator(self.period());
+        // pd + f10 h0 + f11 (−r v − pd) − v = 0
+        let v = (pd + f[1][0] * h0 - f[1][1] * pd) / (1.0 + f[1][1] * self.r);
+        let h1 = -self.r * v - pd;
+        (p + f[0][0] * h0 + f[0][1] * h1 - self.gap, v)
+    }
+
     /// The (1,1) orbit near the guess (t₀, v) by Newton's method with a central-difference
     /// Jacobian, or `None` if it does not converge to an impact with v > 0.
     pub fn one_one(&self, guess: (f64, f64)) -> Option<OneOne> {
