@@ -303,24 +303,7 @@ fn impact_time(c: &Config, p: &CurvePoint) -> f64 {
 fn closed_form_fold(gap: f64, t_fold: f64, bracket: (f64, f64)) -> f64 {
     let extremum = |w: f64| {
         let io = textbook(w, gap);
-        let g = |t: f64| io.reduced(t).0;
-        let (mut a, mut b) = (t_fold - 0.05 * io.period(), t_fold + 0.05 * io.period());
-        let outside = g(a).signum();
-        assert_eq!(
-            outside,
-            g(b).signum(),
-            "the window's ends on two sides at Ω = {w}"
-        );
-        let golden = 0.5 * (5f64.sqrt() - 1.0);
-        for _ in 0..200 {
-            let (c, d) = (b - golden * (b - a), a + golden * (b - a));
-            if outside * g(c) < outside * g(d) {
-                b = d
-            } else {
-                a = c
-            }
-        }
-        outside * g(0.5 * (a + b))
+        io.fold_function((t_fold - 0.05 * io.period(), t_fold + 0.05 * io.period()))
     };
     let (mut lo, mut hi) = bracket;
     let f_lo = extremum(lo);

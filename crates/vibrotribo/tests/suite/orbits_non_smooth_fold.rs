@@ -79,26 +79,6 @@ fn closed_form_grazing() -> f64 {
     bisect(|w| steady(w) - GAP, (1.1, 2.0))
 }
 
-/// The extremum of the reduced (1,1) condition over impact times in `window`, signed so that
-/// it is negative while two (1,1) orbits lie in the window and positive once they have met:
-/// zero at their fold.
-fn fold_function(omega_ratio: f64, (mut a, mut b): (f64, f64)) -> f64 {
-    let io = textbook(omega_ratio);
-    let g = |t: f64| io.reduced(t).0;
-    let outside = g(a).signum();
-    assert_eq!(outside, g(b).signum(), "the window's ends on two sides");
-    let golden = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..200 {
-        let (c, d) = (b - golden * (b - a), a + golden * (b - a));
-        if outside * g(c) < outside * g(d) {
-            b = d
-        } else {
-            a = c
-        }
-    }
-    outside * g(0.5 * (a + b))
-}
-
 /// Impact speeds of every (1,1) orbit at Ω: the roots of the reduced condition over a period
 /// with v > 0, m/s.
 fn one_one_speeds(omega_ratio: f64) -> Vec<f64> {
@@ -180,7 +160,7 @@ fn a_grazing_crossed_as_a_non_smooth_fold_and_the_smooth_fold_beyond_match_the_c
         .find(|b| b.kind == BifurcationKind::Fold)
         .expect("the fold of the (1,1) orbits");
     let window = (0.035, 0.045);
-    let want = bisect(|w| fold_function(w, window), (1.768, 1.775));
+    let want = bisect(|w| textbook(w).fold_function(window), (1.768, 1.775));
     println!("fold at Ω = {:.12}, closed form {want:.12}", fold.parameter);
     assert!(
         (fold.parameter - want).abs() < 1e-8,

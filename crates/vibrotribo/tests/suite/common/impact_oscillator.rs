@@ -100,6 +100,26 @@ impl ImpactOscillator {
         (p + f[0][0] * h0 + f[0][1] * h1 - self.gap, v)
     }
 
+    /// The extremum of the reduced position residual over impact times in `[a, b]` (golden
+    /// section), signed so that it is negative while two (1,1) orbits lie in the window and
+    /// positive once they have met: zero at their fold. The window's ends must lie on one
+    /// side of zero.
+    pub fn fold_function(&self, (mut a, mut b): (f64, f64)) -> f64 {
+        let g = |t: f64| self.reduced(t).0;
+        let outside = g(a).signum();
+        assert_eq!(outside, g(b).signum(), "the window's ends on two sides");
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..200 {
+            let (c, d) = (b - golden * (b - a), a + golden * (b - a));
+            if outside * g(c) < outside * g(d) {
+                b = d
+            } else {
+                a = c
+            }
+        }
+        outside * g(0.5 * (a + b))
+    }
+
     /// The (1,1) orbit near the guess (t₀, v) by Newton's method with a central-difference
     /// Jacobian, or `None` if it does not converge to an impact with v > 0.
     pub fn one_one(&self, guess: (f64, f64)) -> Option<OneOne> {
