@@ -22,14 +22,13 @@
 //!    unit, or `+η c/|c|²` to lift a slow impact off), with the gap and its gradient taken
 //!    from the edge's flow and again from the flow at the new parameter (on a non-smooth
 //!    fold's side the clearance grows linearly in the distance, beyond those penetrations).
-//!    Newton's method is held to the event
-//!    sequence of its starting point, so that it cannot fall onto the old orbit; on the
-//!    square-root branch it converges from the side of small penetration (the map is convex
-//!    there), which is why the guesses start shallow. The branch then goes on along the new
-//!    sequence by natural steps away from the point before the arclength takes over; past a
-//!    grazing of one gap minimum they are solved by Newton's method with the square root of
-//!    the normal form built in ([`SquareRootModel::solve`]), since there the orbit's largest
-//!    multiplier grows like the inverse of its impact speed.
+//!    Newton's method is held to the event sequence of its starting point, so that it cannot
+//!    fall onto the old orbit; on the square-root branch it converges from the side of small
+//!    penetration (the map is convex there), which is why the guesses start shallow. The
+//!    branch then goes on along the new sequence by natural steps away from the point before
+//!    the arclength takes over; past a grazing of one gap minimum they are solved by Newton's
+//!    method with the square root of the normal form built in ([`SquareRootModel::solve`]),
+//!    since there the orbit's largest multiplier grows like the inverse of its impact speed.
 //!
 //! Feigin's rule for the square-root map (the new orbit has a multiplier that grows like the
 //! inverse of its impact speed) says which of the two happens: `det(Φ − I)` keeps its sign
@@ -172,26 +171,31 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                 continue;
             }
             let predicted = model.as_ref().map_or_else(Vec::new, |m| m.guesses(sigma * eps));
-            // From the edge's flow first, then from the flow at p (the clearance a fold's side
-            // opens taken into account).
-            let mut generic = edge_guesses.clone();
-            generic.extend(guesses(problem, &ok, p).into_iter().skip(1));
-            for z in predicted.iter().chain(&generic) {
-                if let Some(o) = orbit_beyond(problem, z, p, arclength(p), signature)
-                    && o.described.signature != *signature
-                    && !came_from.is_some_and(|(q, s)| {
-                        o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
-                    })
-                {
-                    return crossed(
-                        problem,
-                        (ok, o),
-                        model.as_ref(),
-                        precision,
-                        (sigma, kind),
-                        (lo, hi),
-                    );
-                }
+            let beyond = |z: &DVector<f64>| {
+                orbit_beyond(problem, z, p, arclength(p), signature).filter(|o| {
+                    o.described.signature != *signature
+                        && !came_from.is_some_and(|(q, s)| {
+                            o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
+                        })
+                })
+            };
+            // From the edge's flow first; only then from the flow at p (the clearance a fold's
+            // side opens taken into account), whose gap and gradient cost evaluations of their
+            // own.
+            let found = predicted
+                .iter()
+                .chain(&edge_guesses)
+                .find_map(&beyond)
+                .or_else(|| guesses(problem, &ok, p).iter().skip(1).find_map(&beyond));
+            if let Some(o) = found {
+                return crossed(
+                    problem,
+                    (ok, o),
+                    model.as_ref(),
+                    precision,
+                    (sigma, kind),
+                    (lo, hi),
+                );
             }
         }
     }
