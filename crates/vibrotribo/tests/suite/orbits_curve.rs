@@ -130,6 +130,14 @@ fn assert_true_orbit(c: &Config, p: &CurvePoint, period: u32) {
     );
 }
 
+/// The distance of the point's nearest multiplier to the real number `at`.
+fn distance_to_multiplier(p: &CurvePoint, at: f64) -> f64 {
+    p.multipliers
+        .iter()
+        .map(|l| (l.re - at).hypot(l.im))
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn options(max_points: usize) -> CurveConfigOptions {
     CurveConfigOptions {
         curve: CurveOptions {
@@ -179,11 +187,7 @@ fn period_doubling_curve_matches_the_closed_form() {
     for p in curve.points.iter().step_by(stride).chain([last]) {
         let c = config(p.parameter, p.parameter2);
         assert_true_orbit(&c, p, curve.period);
-        let lambda = p
-            .multipliers
-            .iter()
-            .map(|l| (l.re + 1.0).hypot(l.im))
-            .fold(f64::INFINITY, f64::min);
+        let lambda = distance_to_multiplier(p, -1.0);
         assert!(lambda < 1e-8, "no multiplier at −1 at {p:?}");
         let speed = impact_speed(&c, p, curve.period);
         let want = closed_form_doubling(p.parameter2, p.parameter - 0.01, p.parameter + 0.01, speed)
@@ -359,11 +363,7 @@ fn fold_curve_matches_the_closed_form() {
     for p in curve.points.iter().step_by(stride).chain([last]) {
         let c = config(p.parameter, p.parameter2);
         assert_true_orbit(&c, p, curve.period);
-        let lambda = p
-            .multipliers
-            .iter()
-            .map(|l| (l.re - 1.0).hypot(l.im))
-            .fold(f64::INFINITY, f64::min);
+        let lambda = distance_to_multiplier(p, 1.0);
         assert!(lambda < 1e-8, "no multiplier at +1 at {p:?}");
         let t = impact_time(&c, p);
         let want = closed_form_fold(p.parameter2, t, (p.parameter - 5e-4, p.parameter + 5e-4));
