@@ -1,6 +1,6 @@
 //! `vibrotribo bifmap`: the curves it writes for the impact oscillator
-//! (`configs/impact_oscillator.toml` with c = 0.02 N·s/m and a stop 1 mm above) against the
-//! closed form (Shaw & Holmes 1983: the grazing curve where the steady amplitude of the
+//! (`configs/impact_oscillator.toml` with c = 0.02 N·s/m and an upper stop at a 1 mm gap)
+//! against the closed form (Shaw & Holmes 1983: the grazing curve where the steady amplitude of the
 //! impact-free motion equals the gap, the (1,1) orbit's doubling where `S Φ(T)` has a
 //! multiplier −1); its power map against `vibrotribo map`'s, cell for cell; a stop by a
 //! signal; bad input.

@@ -12,7 +12,8 @@ use vibrotribo::report::RunSummary;
 
 use super::util::{config_file, read_csv, stderr, tempdir, vibrotribo};
 
-/// A random base motion (2–20 Hz, seeded) with a fixed stop 30 mm above the top mass.
+/// A random base motion (2–20 Hz, seeded) with a fixed upper stop at a 30 mm gap above the top
+/// mass.
 const RANDOM: &str = "[excitation]\nkind = \"random\"\nrms_acceleration = 40\nf_low_hz = 2\nf_high_hz = 20\nseed = 14\n\
                       [oscillator.stops.upper]\ngap = 0.03\nrestitution = 0.8\nframe = \"fixed\"\n";
 
