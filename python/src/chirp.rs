@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use vibrotribo::excitation::Sweep;
 use vibrotribo::study::{
     ChirpError, ChirpOptions, ChirpRun, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE, Direction, Ending,
-    chirp_config, run_chirp,
+    chirp_inputs, run_chirp,
 };
 use vibrotribo::sweep::{Cell, Kind, Table};
 
@@ -96,16 +96,15 @@ pub fn chirp<'py>(
         samples_per_cycle,
         jump_window,
         cancel,
+        ..ChirpOptions::new(from_, to, duration)
     };
-    // Both configurations first: a bad option fails before anything runs.
-    for d in [Direction::Up, Direction::Down] {
-        chirp_config(&config, &options, d).map_err(chirp_error)?;
-    }
+    // Both chirps checked first: a bad option fails before anything runs.
+    let (spec, options) = chirp_inputs(&config, &options).map_err(chirp_error)?;
     let (runs, signals) = py.detach(|| {
         let mut signals = Signals::new();
         let mut runs = Vec::new();
         for d in [Direction::Up, Direction::Down] {
-            match run_chirp(&config, &options, d, &mut signals) {
+            match run_chirp(&spec, &options, d, &mut signals) {
                 Ok(r) => {
                     let stop = r.outcome.ending != Ending::Completed;
                     runs.push(r);

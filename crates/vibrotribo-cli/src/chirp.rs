@@ -11,7 +11,7 @@ use vibrotribo::config::Config;
 use vibrotribo::excitation::Sweep;
 use vibrotribo::study::{
     ChirpError, ChirpOptions, ChirpRun, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE, Direction, Ending,
-    run_chirp,
+    chirp_inputs, run_chirp,
 };
 
 use crate::config::ConfigArgs;
@@ -114,22 +114,11 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
         samples_per_cycle: args.samples_per_cycle,
         jump_window: args.jump_window,
         cancel: orbit_cancel(),
+        ..ChirpOptions::new(args.from, args.to, args.duration)
     };
-    // Both configurations first: a bad option fails before anything runs.
-    let mut periods = 0;
-    for d in [Direction::Up, Direction::Down] {
-        let (c, _) = match vibrotribo::study::chirp_config(&config, &options, d) {
-            Ok(c) => c,
-            Err(_) if interrupted() => {
-                return Err(Interrupted {
-                    what: "while building the chirps' base motion; nothing was written".into(),
-                }
-                .into());
-            }
-            Err(e) => return Err(option_error(e)),
-        };
-        periods += c.run().periods;
-    }
+    // Both chirps checked first: a bad option fails before anything runs.
+    let (spec, options) = chirp_inputs(&config, &options).map_err(option_error)?;
+    let periods = 2 * options.run_periods(&spec.chain);
     if let Some(dir) = &args.out {
         create_dir(dir)?;
     }
@@ -139,7 +128,7 @@ pub fn run(args: &ChirpArgs) -> Result<()> {
     };
     let mut runs = Vec::new();
     for d in [Direction::Up, Direction::Down] {
-        let r = match run_chirp(&config, &options, d, &mut watch) {
+        let r = match run_chirp(&spec, &options, d, &mut watch) {
             Ok(r) => r,
             // Stopped by a signal while building the chirp's base motion or settling at its
             // start frequency: the chirps done are kept (none for the up chirp).
@@ -303,7 +292,7 @@ fn run_record(r: &ChirpRun) -> ChirpRunRecord {
             size_m: j.size_m,
             relative: j.relative,
         }),
-        base_motion: vibrotribo::report::BaseMotionSummary::of(&r.config, &r.config.run_spec(true)),
+        base_motion: vibrotribo::report::BaseMotionSummary::of(&r.spec),
     }
 }
 

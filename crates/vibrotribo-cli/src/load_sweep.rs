@@ -173,7 +173,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
             transient_periods: spec.transient_periods,
             harvester,
             settings: serde_json::to_value(config.table())?,
-            base_motion: vibrotribo::report::BaseMotionSummary::of(&config, &spec),
+            base_motion: vibrotribo::report::BaseMotionSummary::of(&spec),
         };
         write_json(&dir.join("load_sweep.json"), &to_value(&manifest)?)?;
         if args.plot {

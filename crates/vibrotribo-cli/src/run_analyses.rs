@@ -149,12 +149,13 @@ pub fn analyze_run(dir: &Path, psd_mass: Option<usize>) -> Result<()> {
         })?;
     }
     draw_impact_section(dir, masses)?;
-    // Samples per period: the row at t = T.
-    let spp = rows
-        .iter()
-        .position(|r| r[0].parse::<f64>().is_ok_and(|x| x >= period * (1.0 - 1e-12)))
-        .unwrap_or(1)
-        .max(1);
+    // Samples per period, as the run took them (a summary written without the key: the
+    // settings' value, or its default).
+    let spp = summary
+        .samples_per_period
+        .or_else(|| summary.settings["run"]["samples_per_period"].as_u64())
+        .unwrap_or(vibrotribo::study::RunSettings::default().samples_per_period)
+        .max(1) as usize;
     // The first sample at t = nT after the transient.
     let first = (0..t.len())
         .step_by(spp)

@@ -19,7 +19,7 @@ use vibrotribo::{ChainParams, Event, StateView};
 
 use crate::config::ConfigArgs;
 use crate::limits;
-use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si, write_json};
+use crate::output::{CsvFile, check_out_dir, create_dir, numbered, si};
 use crate::progress::{Interrupted, Progress, Watch, orbit_cancel};
 use crate::run_analyses::RunSections;
 
@@ -212,7 +212,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
                     if let Some(f) = files.as_mut() {
                         f.flush()?;
                     }
-                    return stopped_while_settling(&config, &spec, args, periods, started);
+                    return stopped_while_settling(&config, &spec, args, &mode, periods, started);
                 }
                 Err(e) => anyhow::bail!("while settling: {e}"),
             };
@@ -294,7 +294,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let Some(m) = &merit_report {
         print_merit(m);
     }
-    let base = vibrotribo::report::base_motion_lines(&config, &spec);
+    let base = vibrotribo::report::base_motion_lines(&spec);
     if !base.is_empty() {
         println!("  base motion:");
         for (k, v) in &base {
@@ -348,26 +348,14 @@ fn stopped_while_settling(
     config: &Config,
     spec: &RunSpec,
     args: &SimulateArgs,
+    mode: &SettleMode,
     periods: u64,
     started: Instant,
 ) -> Result<()> {
     if let Some(dir) = &args.out {
-        let summary = json!({
-            "command": "simulate",
-            "periods": 0,
-            "periods_requested": spec.periods,
-            "transient_periods": spec.transient_periods,
-            "settle": args.settle.as_str(),
-            "settle_cap_periods": args.settle_cap,
-            "settle_periods": periods,
-            "interrupted": true,
-            "interrupted_while": "settling",
-            "motion": null,
-            "error": null,
-            "settings": config.table(),
-            "wall_time_s": started.elapsed().as_secs_f64(),
-        });
-        write_json(&dir.join("summary.json"), &summary)?;
+        let summary =
+            RunSummary::stopped_while_settling(config, spec, mode, periods, started.elapsed().as_secs_f64());
+        crate::manifest::write(&dir.join("summary.json"), &summary)?;
     }
     Err(Interrupted {
         what: format!(

@@ -25,7 +25,7 @@ pub struct ShardRecord {
 /// The base motion of `config` when it is not the chain's own harmonic (kind, how it was run,
 /// spline accuracy, record scaling).
 pub fn base_motion_of(config: &Config) -> Option<BaseMotionSummary> {
-    BaseMotionSummary::of(config, &config.run_spec(true))
+    BaseMotionSummary::of(&config.run_spec(true))
 }
 
 /// `sweep.json`: everything that determines a sweep's output.

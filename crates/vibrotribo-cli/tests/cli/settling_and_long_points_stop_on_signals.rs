@@ -114,6 +114,13 @@ fn simulate_settling_stops_on_a_signal_and_says_so() {
         }
         // The directory holds this job: the same command may write there again.
         assert_eq!(s["settings"]["run"]["transient_periods"], 50_000_000, "{s}");
+        // The summary is a run summary like any other: `plot` and Python read it.
+        let typed: vibrotribo::report::RunSummary =
+            serde_json::from_value(s.clone()).expect("summary.json reads as a RunSummary");
+        assert_eq!(typed.settle, "auto", "{s}");
+        assert_eq!(typed.settle_cap_periods, Some(100_000_000), "{s}");
+        assert!(typed.motion.is_none() && typed.electrical.is_none(), "{s}");
+        assert_eq!(typed.impacts_in_each_period, Vec::<u32>::new(), "{s}");
     }
 }
 

@@ -130,6 +130,8 @@ fn the_sections_are_the_runs_own_samples_and_impacts() {
                 .unwrap();
             (summary.transient_periods as usize, spp)
         };
+        // The summary states the run's sampling: the trajectory's row at t = T.
+        assert_eq!(summary.samples_per_period, Some(spp as u64), "{name}");
         // Stroboscopic section: the trajectory's rows j = n·spp for n ≥ the transient.
         let (th, trows) = read_csv(&dir.join("trajectory.csv"));
         let (sh, srows) = read_csv(&dir.join("poincare_strobe.csv"));

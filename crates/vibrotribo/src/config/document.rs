@@ -519,6 +519,16 @@ impl Config {
         &self.excitation
     }
 
+    /// `excitation.spline_tolerance`: the bound on a spline base motion's displacement error,
+    /// relative to the signal's size (dimensionless; default
+    /// [`DEFAULT_SPLINE_TOLERANCE`](super::DEFAULT_SPLINE_TOLERANCE)).
+    pub fn spline_tolerance(&self) -> f64 {
+        self.doc
+            .excitation
+            .spline_tolerance
+            .unwrap_or(super::DEFAULT_SPLINE_TOLERANCE)
+    }
+
     /// The base motion built ([`ExcitationSpec::build`]; chirps, random signals and records
     /// are sampled into splines when the configuration is read).
     pub fn base_motion(&self) -> Result<BaseMotion, ConfigError> {

@@ -8,7 +8,6 @@ use serde::de::{MapAccess, Visitor};
 use serde::ser::SerializeMap;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use crate::config::Config;
 use crate::study::RunSpec;
 
 /// What a run states about its base motion when it is not the chain's own `A sin ωt`: the
@@ -20,9 +19,9 @@ pub struct BaseMotionSummary {
 }
 
 impl BaseMotionSummary {
-    /// The base motion of `spec` (read from `config`); `None` under the chain's own harmonic.
-    pub fn of(config: &Config, spec: &RunSpec) -> Option<Self> {
-        let lines = base_motion_lines(config, spec);
+    /// The base motion of `spec`; `None` under the chain's own harmonic.
+    pub fn of(spec: &RunSpec) -> Option<Self> {
+        let lines = base_motion_lines(spec);
         (!lines.is_empty()).then_some(BaseMotionSummary { lines })
     }
 
@@ -65,23 +64,20 @@ impl<'de> Deserialize<'de> for BaseMotionSummary {
     }
 }
 
-/// What a run of `spec` (read from `config`) states about its base motion when it is not
+/// What a run of `spec` states about its base motion when it is not
 /// the chain's own `A sin ωt` (empty then), as (name, value) lines: `kind`, `run_as` (how
 /// the engine ran it), the lines of [`BaseMotion::summary`](crate::excitation::BaseMotion::summary)
 /// (spline knots and error bounds, record scaling and baseline correction) and, for a
 /// multisine or a random signal, what the engine ran on: `piece_degree`, `piece_intervals`,
 /// `piece_displacement_error_bound_m`, `piece_velocity_error_bound_m_s`.
-pub fn base_motion_lines(config: &Config, spec: &RunSpec) -> Vec<(String, String)> {
+pub fn base_motion_lines(spec: &RunSpec) -> Vec<(String, String)> {
     use crate::excitation::BaseMotion;
     let Some(b) = &spec.base_motion else {
         return Vec::new();
     };
-    let mut out = vec![(
-        "kind".to_string(),
-        config.excitation().kind().as_str().to_string(),
-    )];
+    let mut out = vec![("kind".to_string(), b.kind().as_str().to_string())];
     let on_pieces = "exact per-interval forces k_i y + c_i y' of degree-7 Chebyshev interpolants of the \
-                     harmonics' displacement and velocity (a closed-form multisine in the engine is a later step)";
+                     harmonics' displacement and velocity";
     let run_as = match &**b {
         BaseMotion::Harmonics(h) if crate::dynamics::as_chain_harmonic(h, &spec.chain).is_some() => {
             "the harmonic excitation A sin ωt (closed form)".to_string()

@@ -13,5 +13,5 @@ pub use base_motion::{BaseMotionSummary, base_motion_lines};
 pub use motion::{CoexistingRecord, MotionRecord, NewtonRecord};
 pub use settle::SettleRecord;
 pub use summary::{
-    ElectricalSummary, MeritSummary, RectifierSummary, RunSummary, SummaryCommand, failure_text,
+    ElectricalSummary, MeritSummary, RectifierSummary, RunSummary, StoppedPhase, SummaryCommand, failure_text,
 };

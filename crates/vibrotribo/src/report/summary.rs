@@ -9,13 +9,14 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::base_motion::BaseMotionSummary;
 use super::motion::MotionRecord;
+use crate::analysis::RunStats;
 use crate::config::Config;
 use crate::coupling::CouplingStats;
 use crate::electrical::breakdown::BreakdownMargin;
 use crate::electrical::{HarvesterParams, LoadKind};
 use crate::merit::MeritReport;
 use crate::model::{ChainParams, NondimGroups};
-use crate::study::{Ending, MotionReport, RunOutcome, RunSpec, SettleMode};
+use crate::study::{Ending, MotionReport, RunOutcome, RunSpec, Sampling, SettleMode};
 
 /// Why a run failed, as one line: `simulation stopped after N complete periods: <error>:
 /// <its source>: …` (the error and the chain of its sources, each after `: `).
@@ -37,6 +38,15 @@ pub enum SummaryCommand {
     /// `vibrotribo simulate` (`vibrotribo.simulate` in Python).
     #[default]
     Simulate,
+}
+
+/// The phase before the configured run in which a signal stopped it
+/// ([`RunSummary::stopped_while_settling`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StoppedPhase {
+    /// Settling to a periodic motion (`--settle auto`).
+    Settling,
 }
 
 /// Student's t quantile t(0.975) with 9 degrees of freedom: the 95 % interval of a mean of
@@ -84,6 +94,10 @@ pub struct RunSummary {
     pub max_closing_speed_m_s: Vec<f64>,
     /// All events, transient included.
     pub events_total: u64,
+    /// Samples per excitation period of the run's time history (`trajectory.csv`; absent for
+    /// a run that took no periodic samples).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples_per_period: Option<u64>,
     /// Excitation period T, s.
     pub excitation_period_s: f64,
     /// Excitation angular frequency ω, rad/s.
@@ -113,6 +127,14 @@ pub struct RunSummary {
     /// `auto`: most periods run before the configured run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_cap_periods: Option<u64>,
+    /// A run stopped by a signal before its first period: the settling periods run by then
+    /// (absent otherwise; a classified motion says how long it settled in `motion`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_periods: Option<u64>,
+    /// A run stopped by a signal before its first period: the phase it was stopped in
+    /// (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interrupted_while: Option<StoppedPhase>,
     /// The motion after the transient (`None`: not classified, a run that did not complete
     /// or a base motion that is not periodic).
     pub motion: Option<MotionRecord>,
@@ -235,11 +257,15 @@ impl RunSummary {
             chatter_sequences: stats.chatter_sequences,
             max_closing_speed_m_s: stats.max_closing_speed.clone(),
             events_total: stats.events,
+            samples_per_period: match spec.sampling {
+                Some(Sampling::PerPeriod(n)) => Some(n),
+                _ => None,
+            },
             excitation_period_s: params.period(),
             omega_rad_s: params.omega(),
             omega_ratio: params.omega_ratio(),
             electrical,
-            base_motion: BaseMotionSummary::of(config, spec),
+            base_motion: BaseMotionSummary::of(spec),
             nondimensional: params.nondimensional(),
             parameters: params.clone(),
             settings: serde_json::to_value(config.table()).unwrap_or_default(),
@@ -248,9 +274,38 @@ impl RunSummary {
             error: failure_text(outcome),
             settle: SettleMode::Fixed.as_str().to_string(),
             settle_cap_periods: None,
+            settle_periods: None,
+            interrupted_while: None,
             motion: None,
             merit: None,
         }
+    }
+
+    /// The summary of a run of `spec` (read from `config`) stopped by a signal while it settled
+    /// by `mode`, after `settle_periods` settling periods and `wall_time_s` seconds: no period
+    /// of the configured run computed (`periods` 0, every count zero, no electrical figures,
+    /// no motion), `interrupted` true and `interrupted_while` settling.
+    pub fn stopped_while_settling(
+        config: &Config,
+        spec: &RunSpec,
+        mode: &SettleMode,
+        settle_periods: u64,
+        wall_time_s: f64,
+    ) -> Self {
+        let chain = &spec.chain;
+        let nothing = RunOutcome {
+            periods: 0,
+            ending: Ending::Stopped,
+            stats: RunStats::new(chain.contact_count(), chain.period(), spec.transient_periods),
+            electrical: None,
+            final_state: spec.initial.clone(),
+            final_time: 0.0,
+        };
+        let mut summary = RunSummary::new(config, spec, &nothing, wall_time_s);
+        summary.set_settle(mode);
+        summary.settle_periods = Some(settle_periods);
+        summary.interrupted_while = Some(StoppedPhase::Settling);
+        summary
     }
 
     /// Records that the run settled by `mode` (its cap with [`SettleMode::Auto`]).

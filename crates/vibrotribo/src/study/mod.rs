@@ -25,8 +25,9 @@ mod simulate;
 mod spice_export;
 
 pub use chirp::{
-    ChirpError, ChirpOptions, ChirpRun, ChirpStudy, Cycle, DEFAULT_JUMP_WINDOW, DEFAULT_SAMPLES_PER_CYCLE,
-    Direction, Jump, MIN_CYCLES, check_options, chirp_config, chirp_study, largest_jump, run_chirp,
+    ChirpError, ChirpOptions, ChirpPlan, ChirpRun, ChirpStudy, Cycle, DEFAULT_JUMP_WINDOW,
+    DEFAULT_SAMPLES_PER_CYCLE, Direction, Jump, MIN_CYCLES, check_options, chirp_inputs, chirp_study,
+    largest_jump, plan_chirp, run_chirp, run_plan,
 };
 pub use floquet::FloquetError;
 pub use loads::{LoadStudy, LoadStudyOptions, VqCycle, load_study, vq_cycle};

@@ -11,9 +11,9 @@ use vibrotribo::study::{ChirpError, ChirpOptions, Direction, run_chirp};
 /// the whole periods they cover, within 1 %.
 #[test]
 fn cycles_tile_the_phase_and_the_energy_adds_up() {
-    let config = Config::default();
+    let spec = Config::default().run_spec(false);
     let options = ChirpOptions::new(0.6, 0.8, 10.0);
-    let run = run_chirp(&config, &options, Direction::Down, &mut ()).unwrap();
+    let run = run_chirp(&spec, &options, Direction::Down, &mut ()).unwrap();
     let c = &run.cycles;
     assert!(c.len() > 50, "{}", c.len());
     for (k, cy) in c.iter().enumerate() {
@@ -46,7 +46,7 @@ fn cycles_tile_the_phase_and_the_energy_adds_up() {
 
 #[test]
 fn bad_options_name_the_option() {
-    let config = Config::default();
+    let spec = Config::default().run_spec(false);
     let cases = [
         (ChirpOptions::new(0.9, 0.8, 10.0), "from"),
         (ChirpOptions::new(-1.0, 0.8, 10.0), "from"),
@@ -62,11 +62,75 @@ fn bad_options_name_the_option() {
         ),
     ];
     for (options, name) in cases {
-        match run_chirp(&config, &options, Direction::Up, &mut ()) {
+        match run_chirp(&spec, &options, Direction::Up, &mut ()) {
             Err(ChirpError::Option { option, message }) => {
                 assert_eq!(option, name, "{message}");
             }
             other => panic!("{options:?}: {:?}", other.map(|r| r.cycles.len())),
         }
+    }
+}
+
+/// The experiment takes a run, however it was made: the paper's chain as a `RunSpec` built
+/// in code gives the cycles of the same run read from the default configuration, bit for
+/// bit; a run under another base motion than the chain's harmonic is refused, naming
+/// `excitation.kind`, and so are stops that move with the base.
+#[test]
+fn a_chirp_takes_any_harmonic_run_and_refuses_another_base_motion() {
+    use std::sync::Arc;
+    use vibrotribo::ChainParams;
+    use vibrotribo::excitation::{BaseMotion, Harmonic};
+    use vibrotribo::study::RunSpec;
+
+    let options = ChirpOptions {
+        mechanics_only: true,
+        settled_start: false,
+        ..ChirpOptions::new(0.6, 0.8, 5.0)
+    };
+    let built = RunSpec::new(ChainParams::default(), 1);
+    let read = Config::default().run_spec(true);
+    let a = run_chirp(&built, &options, Direction::Up, &mut ()).unwrap();
+    let b = run_chirp(&read, &options, Direction::Up, &mut ()).unwrap();
+    assert!(a.cycles.len() > 20, "{}", a.cycles.len());
+    assert_eq!(a.cycles, b.cycles);
+
+    let chain = ChainParams::default();
+    let two = BaseMotion::Harmonics(vec![
+        Harmonic {
+            amplitude: 0.01,
+            omega: chain.omega(),
+            phase: 0.0,
+        },
+        Harmonic {
+            amplitude: 0.01,
+            omega: 2.0 * chain.omega(),
+            phase: 0.0,
+        },
+    ]);
+    let multisine = RunSpec {
+        base_motion: Some(Arc::new(two)),
+        ..RunSpec::new(chain, 1)
+    };
+    match run_chirp(&multisine, &options, Direction::Up, &mut ()) {
+        Err(e @ ChirpError::Config(_)) => {
+            let text = e.to_string();
+            assert!(
+                text.contains("excitation.kind") && text.contains("multisine"),
+                "{text}"
+            );
+        }
+        other => panic!("{:?}", other.map(|r| r.cycles.len())),
+    }
+    let moving = Config::from_toml_str(
+        "[oscillator]\nmasses = [0.05]\nstiffness = 120.0\ndamping = 0.1\n\
+         [oscillator.stops.upper]\ngap = 0.001\nrestitution = 0.8\nframe = \"base\"\n",
+    )
+    .unwrap();
+    match run_chirp(&moving.run_spec(true), &options, Direction::Up, &mut ()) {
+        Err(e @ ChirpError::Config(_)) => {
+            let text = e.to_string();
+            assert!(text.contains("chirp") && text.contains("frame"), "{text}");
+        }
+        other => panic!("{:?}", other.map(|r| r.cycles.len())),
     }
 }

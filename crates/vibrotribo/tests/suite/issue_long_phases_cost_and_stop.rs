@@ -234,8 +234,8 @@ fn a_chirps_settling_stops_when_its_cancel_hook_asks() {
         mechanics_only: true,
         ..ChirpOptions::new(0.6, 0.8, 20.0)
     };
-    let config = vibrotribo::config::Config::default();
-    match run_chirp(&config, &options, Direction::Up, &mut ()) {
+    let spec = vibrotribo::config::Config::default().run_spec(true);
+    match run_chirp(&spec, &options, Direction::Up, &mut ()) {
         Err(ChirpError::Settle { source, .. }) => {
             assert!(matches!(*source, PointError::Stopped { .. }), "{source}")
         }

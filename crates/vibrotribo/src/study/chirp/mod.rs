@@ -11,18 +11,25 @@
 
 use std::f64::consts::TAU;
 
-use thiserror::Error;
-use toml::Value;
+use std::sync::Arc;
 
-use super::observer::{RunObserver, Sample};
+use thiserror::Error;
+
+use super::observer::RunObserver;
 use super::point::PointError;
-use super::settings::Sampling;
+use super::settings::{RunSpec, Sampling};
 use super::simulate::{RunOutcome, StudyError, simulate};
-use crate::config::{Config, ConfigError};
-use crate::dynamics::{Event, EventKind, StateView};
-use crate::electrical::Load;
-use crate::excitation::{Chirp, ExcitationKind, ExcitationSpec, Sweep};
+use crate::config::{Config, ConfigError, DEFAULT_SPLINE_TOLERANCE};
+use crate::excitation::{
+    BaseMotion, BaseMotionError, Chirp, ExcitationKind, ExcitationSpec, Harmonic, Sweep, WorkBudget,
+};
+use crate::model::{ChainParams, Frequency, StopFrame};
 use crate::orbits::Cancel;
+
+mod condense;
+
+use condense::Condenser;
+pub use condense::largest_jump;
 
 /// The default [`ChirpOptions::samples_per_cycle`].
 pub const DEFAULT_SAMPLES_PER_CYCLE: u64 = 200;
@@ -66,6 +73,13 @@ pub struct ChirpOptions {
     /// [`ChirpError::Settle`] holding [`PointError::Stopped`]. (The chirp itself stops where
     /// the observer given to [`run_chirp`] says.) Default: never.
     pub cancel: Cancel,
+    /// Bound on the chirp spline's displacement error relative to the amplitude
+    /// (dimensionless; a configuration's `excitation.spline_tolerance`, see
+    /// [`chirp_inputs`]).
+    pub spline_tolerance: f64,
+    /// The budget the chirp's spline is built within: its stop flag stops the build
+    /// (a configuration's budget, see [`chirp_inputs`]). Default: unbounded, never stopped.
+    pub budget: WorkBudget,
 }
 
 impl ChirpOptions {
@@ -83,7 +97,15 @@ impl ChirpOptions {
             samples_per_cycle: DEFAULT_SAMPLES_PER_CYCLE,
             jump_window: DEFAULT_JUMP_WINDOW,
             cancel: Cancel::never(),
+            spline_tolerance: DEFAULT_SPLINE_TOLERANCE,
+            budget: WorkBudget::default(),
         }
+    }
+
+    /// Reference periods T of `chain` each chirp runs: the duration rounded up to a whole
+    /// number of them (at least one).
+    pub fn run_periods(&self, chain: &ChainParams) -> u64 {
+        (self.duration_s / chain.period()).ceil().max(1.0) as u64
     }
 }
 
@@ -100,7 +122,8 @@ pub enum ChirpError {
         /// Why.
         message: String,
     },
-    /// The chirp configuration is refused (naming the key).
+    /// The configuration is refused (naming the key), or the chirp's base motion cannot be
+    /// built or run on its chain (named as the key `excitation.kind` of a chirp).
     #[error(transparent)]
     Config(#[from] ConfigError),
     /// The run could not start.
@@ -196,8 +219,9 @@ pub struct ChirpRun {
     pub chirp: Chirp,
     /// The requested duration, s: cycles ending after it are not reported.
     pub duration_s: f64,
-    /// The configuration that ran (`excitation.kind = "chirp"`).
-    pub config: Config,
+    /// The run that ran: the chain under the chirp (its base motion), no transient, a whole
+    /// number of reference periods.
+    pub spec: RunSpec,
     /// The complete cycles, in time order.
     pub cycles: Vec<Cycle>,
     /// The largest jump (None with fewer than 2 × `jump_window` cycles).
@@ -216,13 +240,21 @@ pub struct ChirpStudy {
 }
 
 /// The chain's Ω-to-Hz factor √(k₁/m₁)/2π, Hz.
-fn hz_per_omega_ratio(config: &Config) -> f64 {
-    let chain = config.chain();
+fn hz_per_omega_ratio(chain: &ChainParams) -> f64 {
     chain.omega() / chain.omega_ratio() / TAU
 }
 
-/// Checks `options` against `config`; the error names the option.
-pub fn check_options(config: &Config, options: &ChirpOptions) -> Result<(), ChirpError> {
+/// An error naming `excitation.kind`: the chirp's base motion cannot be built or run.
+fn kind_error(message: String) -> ChirpError {
+    ChirpError::Config(ConfigError::Param(crate::error::ParamError::Conflict {
+        name: "excitation.kind".into(),
+        message,
+    }))
+}
+
+/// Checks `options` against the run `spec` a chirp replaces the base motion of (its chain
+/// under its own harmonic); the error names the option.
+pub fn check_options(spec: &RunSpec, options: &ChirpOptions) -> Result<(), ChirpError> {
     let positive = |x: f64, option: &'static str| {
         if x.is_finite() && x > 0.0 {
             Ok(())
@@ -245,6 +277,7 @@ pub fn check_options(config: &Config, options: &ChirpOptions) -> Result<(), Chir
     if let Some(a) = options.amplitude {
         positive(a, "amplitude")?;
     }
+    positive(options.spline_tolerance, "spline_tolerance")?;
     if options.jump_window == 0 {
         return Err(bad("jump_window", "0 must be at least 1".into()));
     }
@@ -254,21 +287,27 @@ pub fn check_options(config: &Config, options: &ChirpOptions) -> Result<(), Chir
             format!("{} must be at least 4", options.samples_per_cycle),
         ));
     }
-    match config.excitation().kind() {
-        ExcitationKind::Harmonic | ExcitationKind::Chirp => {}
-        other => {
-            return Err(ChirpError::Config(ConfigError::Param(
-                crate::error::ParamError::Conflict {
-                    name: "excitation.kind".into(),
-                    message: format!(
-                        "a chirp replaces the base motion of a harmonic configuration; this one is \"{}\"",
-                        other.as_str()
-                    ),
-                },
-            )));
-        }
+    if let Some(base) = spec.base_motion.as_deref()
+        && !matches!(base, BaseMotion::Harmonics(h) if crate::dynamics::as_chain_harmonic(h, &spec.chain).is_some())
+    {
+        return Err(kind_error(format!(
+            "a chirp replaces the base motion of a harmonic run; this one is \"{}\"",
+            base.kind().as_str()
+        )));
     }
-    let hz = hz_per_omega_ratio(config);
+    let chain = &spec.chain;
+    // Stops that move with the base follow the harmonic only.
+    if [chain.stops.upper, chain.stops.lower]
+        .iter()
+        .flatten()
+        .any(|s| s.frame == StopFrame::Base)
+    {
+        let e = BaseMotionError::MovingStops { kind: "chirp" };
+        return Err(ChirpError::Config(ConfigError::Unsupported(format!(
+            "excitation kind chirp: {e}"
+        ))));
+    }
+    let hz = hz_per_omega_ratio(chain);
     let chirp = Chirp {
         amplitude: 1.0,
         f_start_hz: options.from * hz,
@@ -286,21 +325,15 @@ pub fn check_options(config: &Config, options: &ChirpOptions) -> Result<(), Chir
             ),
         ));
     }
-    let relative = config
-        .table()
-        .get("excitation")
-        .and_then(|e| e.get("spline_tolerance"))
-        .and_then(Value::as_float)
-        .unwrap_or(crate::config::DEFAULT_SPLINE_TOLERANCE);
-    let amplitude = options.amplitude.unwrap_or(config.chain().excitation.amplitude);
+    let amplitude = options.amplitude.unwrap_or(chain.excitation.amplitude);
     if amplitude > 0.0 {
         let chirp = Chirp {
             amplitude,
-            duration: options.duration_s + config.chain().period(),
+            duration: options.duration_s + chain.period(),
             ..chirp
         };
         chirp
-            .intervals_needed(relative * amplitude)
+            .intervals_needed(options.spline_tolerance * amplitude)
             .map_err(|e| bad("duration", format!("{} s: {e}", options.duration_s)))?;
     }
     let cap = (options.to * hz * options.duration_s) * options.samples_per_cycle as f64;
@@ -316,31 +349,65 @@ pub fn check_options(config: &Config, options: &ChirpOptions) -> Result<(), Chir
     Ok(())
 }
 
-/// The chirp configuration of `config` for one direction: `excitation.kind = "chirp"`, the
-/// frequencies from Ω, `duration_s` extended to a whole number of reference periods
-/// (`run.periods` of them, no transient) with the same sweep law, the amplitude, and the
-/// chirp it describes.
-pub fn chirp_config(
-    config: &Config,
+/// The run of a configuration a chirp starts from, and the chirp's options with the
+/// configuration's `excitation.spline_tolerance` and work budget: `config`'s chain,
+/// initial state, numerical settings and (unless `options.mechanics_only`) harvester, under
+/// the chain's own harmonic. The configuration's base motion must be harmonic or a chirp
+/// (which the experiment's chirps replace); an error naming `excitation.kind` otherwise.
+pub fn chirp_inputs(config: &Config, options: &ChirpOptions) -> Result<(RunSpec, ChirpOptions), ChirpError> {
+    match config.excitation().kind() {
+        ExcitationKind::Harmonic | ExcitationKind::Chirp => {}
+        other => {
+            return Err(kind_error(format!(
+                "a chirp replaces the base motion of a harmonic configuration; this one is \"{}\"",
+                other.as_str()
+            )));
+        }
+    }
+    let spec = RunSpec {
+        base_motion: None,
+        ..config.run_spec(options.mechanics_only)
+    };
+    let options = ChirpOptions {
+        spline_tolerance: config.spline_tolerance(),
+        budget: config.budget().clone(),
+        ..options.clone()
+    };
+    check_options(&spec, &options)?;
+    Ok((spec, options))
+}
+
+/// One chirp of the experiment, ready to run ([`plan_chirp`]).
+#[derive(Debug, Clone)]
+pub struct ChirpPlan {
+    /// Up or down.
+    pub direction: Direction,
+    /// The chirp (over a whole number of reference periods, see [`ChirpRun::chirp`]).
+    pub chirp: Chirp,
+    /// The run under it: the chain with the chirp as its base motion, from the initial state
+    /// given, `periods` reference periods, no transient.
+    pub spec: RunSpec,
+}
+
+/// The chirp of `options` in `direction` as a run of `spec`'s chain (the run a chirp
+/// replaces the base motion of): the frequencies from Ω, `duration_s` extended to a whole
+/// number of reference periods with the same sweep law, the amplitude, the spline built
+/// within `options.budget` (stopped by its stop flag). The harvester is `spec`'s, dropped
+/// with `options.mechanics_only`.
+pub fn plan_chirp(
+    spec: &RunSpec,
     options: &ChirpOptions,
     direction: Direction,
-) -> Result<(Config, Chirp), ChirpError> {
-    check_options(config, options)?;
-    let hz = hz_per_omega_ratio(config);
+) -> Result<ChirpPlan, ChirpError> {
+    check_options(spec, options)?;
+    let hz = hz_per_omega_ratio(&spec.chain);
     let (f0, f1) = match direction {
         Direction::Up => (options.from * hz, options.to * hz),
         Direction::Down => (options.to * hz, options.from * hz),
     };
-    let requested = Chirp {
-        amplitude: options.amplitude.unwrap_or(config.chain().excitation.amplitude),
-        f_start_hz: f0,
-        f_end_hz: f1,
-        duration: options.duration_s,
-        sweep: options.sweep,
-    };
-    let period = config.chain().period();
-    let periods = (options.duration_s / period).ceil().max(1.0);
-    let duration = periods * period;
+    let period = spec.chain.period();
+    let periods = options.run_periods(&spec.chain);
+    let duration = periods as f64 * period;
     // The same law over the longer duration: f at the requested end is f1.
     let stretch = duration / options.duration_s;
     let f_end = match options.sweep {
@@ -358,47 +425,64 @@ pub fn chirp_config(
         ));
     }
     let chirp = Chirp {
+        amplitude: options.amplitude.unwrap_or(spec.chain.excitation.amplitude),
+        f_start_hz: f0,
         f_end_hz: f_end,
         duration,
-        ..requested
+        sweep: options.sweep,
     };
-    let sweep = match options.sweep {
-        Sweep::Linear => "linear",
-        Sweep::Logarithmic => "logarithmic",
+    let tolerance = options.spline_tolerance * chirp.amplitude;
+    let excitation = ExcitationSpec::Chirp {
+        chirp,
+        tolerance: if tolerance > 0.0 {
+            tolerance
+        } else {
+            f64::MIN_POSITIVE
+        },
     };
-    let mut c = config.clone();
-    c.set_all([
-        ("excitation.kind", Value::String("chirp".into())),
-        ("excitation.f_start_hz", Value::Float(f0)),
-        ("excitation.f_end_hz", Value::Float(f_end)),
-        ("excitation.sweep", Value::String(sweep.into())),
-        ("excitation.duration_s", Value::Float(duration)),
-        ("excitation.amplitude", Value::Float(chirp.amplitude)),
-        ("run.periods", Value::Integer(periods as i64)),
-        ("run.transient_periods", Value::Integer(0)),
-    ])?;
-    c.check_runnable()?;
-    // The chirp as the configuration reads it (bit for bit what drives the run).
-    let chirp = match c.excitation() {
-        ExcitationSpec::Chirp { chirp, .. } => *chirp,
-        _ => chirp,
+    let mut chain = spec.chain.clone();
+    chain.excitation.amplitude = chirp.amplitude;
+    let harmonic = Harmonic {
+        amplitude: chirp.amplitude,
+        omega: chain.omega(),
+        phase: 0.0,
     };
-    Ok((c, chirp))
+    let base = excitation
+        .build_within(harmonic, &options.budget)
+        .map_err(|e| kind_error(format!("kind = \"chirp\": {e}")))?;
+    crate::dynamics::check_base_motion(&chain, &base)
+        .map_err(|e| ChirpError::Config(ConfigError::Unsupported(format!("excitation kind chirp: {e}"))))?;
+    let harvester = spec.harvester.clone().filter(|_| !options.mechanics_only);
+    Ok(ChirpPlan {
+        direction,
+        chirp,
+        spec: RunSpec {
+            chain,
+            harvester,
+            periods,
+            transient_periods: 0,
+            sampling: None,
+            breakdown_check: false,
+            base_motion: Some(Arc::new(base)),
+            ..spec.clone()
+        },
+    })
 }
 
-/// The steady state of `config`'s harmonic motion at Ω = `omega_ratio`, at a period's end
+/// The steady state of `spec`'s harmonic motion at Ω = `omega_ratio`, at a period's end
 /// (mechanics only; [`settle`](super::settle) with the defaults of a sweep point), stopped
 /// by `cancel`.
 fn settled_state(
-    config: &Config,
+    spec: &RunSpec,
     omega_ratio: f64,
     cancel: &Cancel,
 ) -> Result<crate::model::ChainState, ChirpError> {
-    let harmonic = config.with("omega_ratio", Value::Float(omega_ratio))?;
+    let mut chain = spec.chain.clone();
+    chain.excitation.frequency = Frequency::OmegaRatio(omega_ratio);
     let s = super::settle::settle(
-        harmonic.chain(),
-        harmonic.initial_state(),
-        harmonic.sim_options(),
+        &chain,
+        &spec.initial,
+        &spec.options,
         &super::point::PointOptions {
             cancel: cancel.clone(),
             ..super::point::PointOptions::default()
@@ -412,231 +496,39 @@ fn settled_state(
     Ok(s.state)
 }
 
-/// The time (s) at which the chirp's phase reaches `phase` (rad), by bisection (the phase
-/// grows strictly).
-fn time_at_phase(chirp: &Chirp, phase: f64, end: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, end);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if chirp.phase(mid) < phase {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
-}
-
-/// Condenses a chirp run into cycles as it goes (a [`RunObserver`]).
-struct Condenser {
-    chirp: Chirp,
-    /// Cycle boundaries t_0 = 0 < t_1 < … ≤ the requested duration, s.
-    bounds: Vec<f64>,
-    lo: Vec<Vec<f64>>,
-    hi: Vec<Vec<f64>>,
-    impacts: Vec<u64>,
-    energy: Vec<f64>,
-    load: Option<Load>,
-    /// The previous sample's time, load power (resistor) or storage voltage (rectifier).
-    last: Option<(f64, f64)>,
-}
-
-impl Condenser {
-    fn new(chirp: Chirp, requested: f64, masses: usize, load: Option<Load>) -> Self {
-        let cycles = (chirp.phase(requested) / TAU).floor() as usize;
-        let mut bounds = vec![0.0];
-        bounds.extend((1..=cycles).map(|c| time_at_phase(&chirp, TAU * c as f64, chirp.duration)));
-        Condenser {
-            chirp,
-            lo: vec![vec![f64::INFINITY; masses]; cycles],
-            hi: vec![vec![f64::NEG_INFINITY; masses]; cycles],
-            impacts: vec![0; cycles],
-            energy: vec![0.0; cycles],
-            bounds,
-            load,
-            last: None,
-        }
-    }
-
-    /// The cycle holding `t`: [t_c, t_{c+1}), the last one closed at its end.
-    fn cycle_of(&self, t: f64) -> Option<usize> {
-        let cycles = self.bounds.len() - 1;
-        let k = self.bounds.partition_point(|&b| b <= t);
-        if k >= 1 && k <= cycles {
-            Some(k - 1)
-        } else if cycles > 0 && t == self.bounds[cycles] {
-            Some(cycles - 1)
-        } else {
-            None
-        }
-    }
-
-    fn extremes(&mut self, c: usize, positions: &[f64], base: f64) {
-        for (i, &x) in positions.iter().enumerate() {
-            let r = x - base;
-            self.lo[c][i] = self.lo[c][i].min(r);
-            self.hi[c][i] = self.hi[c][i].max(r);
-        }
-    }
-
-    /// The cycles that end by `final_time` (s, where the run ended).
-    fn finish(self, final_time: f64, hz: f64) -> Vec<Cycle> {
-        let mut out = Vec::new();
-        for c in 0..self.impacts.len() {
-            let (start, end) = (self.bounds[c], self.bounds[c + 1]);
-            if end > final_time || !self.lo[c].iter().all(|x| x.is_finite()) {
-                break;
-            }
-            let mid = time_at_phase(&self.chirp, TAU * (c as f64 + 0.5), self.chirp.duration);
-            let f = self.chirp.frequency_hz(mid);
-            out.push(Cycle {
-                cycle: c as u64 + 1,
-                start_s: start,
-                end_s: end,
-                time_s: mid,
-                omega_ratio: f / hz,
-                frequency_hz: f,
-                amplitudes: self.lo[c]
-                    .iter()
-                    .zip(&self.hi[c])
-                    .map(|(l, h)| 0.5 * (h - l))
-                    .collect(),
-                impacts: self.impacts[c],
-                energy_j: self.load.map(|_| self.energy[c]),
-            });
-        }
-        out
-    }
-}
-
-impl RunObserver for Condenser {
-    fn event(&mut self, event: &Event, state: &StateView<'_>) {
-        if let Some(c) = self.cycle_of(event.time) {
-            if event.kind == EventKind::Impact {
-                self.impacts[c] += 1;
-            }
-            let base = self.chirp.displacement_velocity(event.time)[0];
-            self.extremes(c, state.positions, base);
-        }
-    }
-
-    fn wants_samples(&self) -> bool {
-        true
-    }
-
-    fn sample(&mut self, s: &Sample<'_>) {
-        if let Some(c) = self.cycle_of(s.time) {
-            self.extremes(c, s.positions, s.base);
-        }
-        let (Some(load), Some(e)) = (self.load, s.electrical) else {
-            return;
-        };
-        // Energy into the load between this sample and the previous one, given to the cycle
-        // holding the interval's middle: ∫V²/R (trapezoid) for a resistor; for a rectifier
-        // the storage energy's change ½C(V_s² − V_s,prev²) plus ∫V_s²/R_s (its resistor).
-        let now = match load {
-            Load::Resistor { resistance } => e.voltage_v * e.voltage_v / resistance,
-            Load::Rectifier(_) => e.storage_voltage_v.unwrap_or(0.0),
-            Load::Open | Load::Short => 0.0,
-        };
-        if let Some((t0, before)) = self.last
-            && let Some(c) = self.cycle_of(0.5 * (t0 + s.time))
-        {
-            let dt = s.time - t0;
-            self.energy[c] += match load {
-                Load::Resistor { .. } => 0.5 * (before + now) * dt,
-                Load::Rectifier(r) => {
-                    let drain = r
-                        .storage_load_resistance
-                        .map_or(0.0, |rs| 0.5 * (before * before + now * now) / rs * dt);
-                    // ½C(V1² − V0²) as a product: no cancellation at a large storage voltage.
-                    0.5 * r.storage_capacitance * (now - before) * (now + before) + drain
-                }
-                Load::Open | Load::Short => 0.0,
-            };
-        }
-        self.last = Some((s.time, now));
-    }
-}
-
-/// The largest jump of the response (the jump criterion): the boundary between consecutive
-/// cycles where the median amplitude of the `window` cycles after it differs most from the
-/// median of the `window` cycles before it, for any mass, relative to that mass's largest
-/// amplitude in the chirp. `window` = 1 is the plain cycle-to-cycle change; a few cycles keep
-/// the cycle-to-cycle scatter of an irregular (chaotic, period-n) motion from passing for a
-/// jump, and the median keeps a step a step. `omega_at(j)` is Ω at the end of cycle `j`.
-pub fn largest_jump(cycles: &[Cycle], window: usize, omega_at: impl Fn(usize) -> f64) -> Option<Jump> {
-    let n = cycles.first()?.amplitudes.len();
-    let w = window.max(1);
-    if cycles.len() < 2 * w {
-        return None;
-    }
-    let median = |i: usize, range: std::ops::Range<usize>| {
-        let mut v: Vec<f64> = cycles[range].iter().map(|c| c.amplitudes[i]).collect();
-        v.sort_by(f64::total_cmp);
-        let m = v.len() / 2;
-        if v.len() % 2 == 1 {
-            v[m]
-        } else {
-            0.5 * (v[m - 1] + v[m])
-        }
-    };
-    let mut best: Option<Jump> = None;
-    for i in 0..n {
-        let top = cycles.iter().map(|c| c.amplitudes[i]).fold(0.0, f64::max);
-        if top <= 0.0 {
-            continue;
-        }
-        for j in (w - 1)..(cycles.len() - w) {
-            let size = median(i, j + 1..j + 1 + w) - median(i, j + 1 - w..j + 1);
-            let relative = size.abs() / top;
-            if best.as_ref().is_none_or(|b| relative > b.relative) {
-                best = Some(Jump {
-                    index: j,
-                    omega_ratio: omega_at(j),
-                    mass: i,
-                    size_m: size,
-                    relative,
-                });
-            }
-        }
-    }
-    best
-}
-
-/// Runs one chirp of the experiment through [`simulate`], `observer` shown the run (a
-/// progress bar, a checkpoint that may stop it at a period's end), and condenses it into
-/// cycles. A run that stops or fails early keeps the cycles it completed
-/// ([`RunOutcome::ending`] says why).
-pub fn run_chirp<O: RunObserver + ?Sized>(
-    config: &Config,
+/// Runs `plan` through [`simulate`], `observer` shown the run (a progress bar, a checkpoint
+/// that may stop it at a period's end), and condenses it into cycles; with
+/// `options.settled_start` it starts from the steady harmonic motion of `spec` (the run the
+/// plan was made from) at the chirp's start Ω. A run that stops or fails early keeps the
+/// cycles it completed ([`RunOutcome::ending`] says why).
+pub fn run_plan<O: RunObserver + ?Sized>(
+    spec: &RunSpec,
+    plan: ChirpPlan,
     options: &ChirpOptions,
-    direction: Direction,
     observer: &mut O,
 ) -> Result<ChirpRun, ChirpError> {
-    let (chirp_config, chirp) = chirp_config(config, options, direction)?;
-    let mut spec = chirp_config.run_spec(options.mechanics_only);
+    let ChirpPlan {
+        direction,
+        chirp,
+        spec: mut run,
+    } = plan;
     if options.settled_start {
         let start = match direction {
             Direction::Up => options.from,
             Direction::Down => options.to,
         };
-        spec.initial = settled_state(config, start, &options.cancel)?;
+        run.initial = settled_state(spec, start, &options.cancel)?;
     }
     let f_max = chirp.f_start_hz.max(chirp.f_end_hz);
-    spec.sampling = Some(Sampling::Uniform {
+    run.sampling = Some(Sampling::Uniform {
         start: 0.0,
         step: 1.0 / (f_max * options.samples_per_cycle as f64),
     });
-    let load = spec.harvester.as_ref().map(|h| h.params.load);
-    let mut condenser = Condenser::new(chirp, options.duration_s, spec.chain.len(), load);
-    let outcome = simulate(&spec, &mut (&mut condenser, observer))?;
-    let hz = hz_per_omega_ratio(config);
-    let bounds = condenser.bounds.clone();
-    let cycles = condenser.finish(outcome.final_time, hz);
+    let load = run.harvester.as_ref().map(|h| h.params.load);
+    let mut condenser = Condenser::new(chirp, options.duration_s, run.chain.len(), load);
+    let outcome = simulate(&run, &mut (&mut condenser, observer))?;
+    let hz = hz_per_omega_ratio(&spec.chain);
+    let (cycles, bounds) = condenser.finish(outcome.final_time, hz);
     let jump = largest_jump(&cycles, options.jump_window, |j| {
         chirp.frequency_hz(bounds[j + 1]) / hz
     });
@@ -644,20 +536,31 @@ pub fn run_chirp<O: RunObserver + ?Sized>(
         direction,
         chirp,
         duration_s: options.duration_s,
-        config: chirp_config,
+        spec: run,
         cycles,
         jump,
         outcome,
     })
 }
 
+/// One chirp of the experiment on `spec`'s chain: [`plan_chirp`], then [`run_plan`].
+pub fn run_chirp<O: RunObserver + ?Sized>(
+    spec: &RunSpec,
+    options: &ChirpOptions,
+    direction: Direction,
+    observer: &mut O,
+) -> Result<ChirpRun, ChirpError> {
+    let plan = plan_chirp(spec, options, direction)?;
+    run_plan(spec, plan, options, observer)
+}
+
 /// The up chirp, then the down chirp (see [`run_chirp`]).
 pub fn chirp_study<O: RunObserver + ?Sized>(
-    config: &Config,
+    spec: &RunSpec,
     options: &ChirpOptions,
     observer: &mut O,
 ) -> Result<ChirpStudy, ChirpError> {
-    let up = run_chirp(config, options, Direction::Up, observer)?;
-    let down = run_chirp(config, options, Direction::Down, observer)?;
+    let up = run_chirp(spec, options, Direction::Up, observer)?;
+    let down = run_chirp(spec, options, Direction::Down, observer)?;
     Ok(ChirpStudy { up, down })
 }
