@@ -47,6 +47,7 @@ mod orbits_branch_points;
 mod orbits_continuation;
 mod orbits_curve;
 mod orbits_grazing;
+mod orbits_neimark_sacker;
 mod orbits_non_smooth_fold;
 mod orbits_shooting;
 mod properties;
