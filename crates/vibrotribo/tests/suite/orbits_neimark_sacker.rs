@@ -91,9 +91,14 @@ fn a_neimark_sacker_point_is_where_direct_simulation_starts_to_spiral_out() {
     };
     let ((above, angle_above), orbit_above) = at(ns.parameter + delta);
     let ((below, angle_below), orbit_below) = at(ns.parameter - delta);
-    println!("finite differences: |μ| = {below} at Ω − δ, {above} at Ω + δ; angles {angle_below} {angle_above}");
+    println!(
+        "finite differences: |μ| = {below} at Ω − δ, {above} at Ω + δ; angles {angle_below} {angle_above}"
+    );
     assert!(above < 1.0 && below > 1.0, "{below} {above}");
-    assert!((0.5 * (angle_above + angle_below) - angle).abs() < 1e-3, "{angle}");
+    assert!(
+        (0.5 * (angle_above + angle_below) - angle).abs() < 1e-3,
+        "{angle}"
+    );
     // Closer in, where the modulus is linear in Ω to well below the tolerance.
     let near = delta / 10.0;
     let ((above_near, _), _) = at(ns.parameter + near);
@@ -115,7 +120,9 @@ fn a_neimark_sacker_point_is_where_direct_simulation_starts_to_spiral_out() {
         let periods = 1500;
         let mut deviations = Vec::with_capacity(periods);
         for _ in 0..periods {
-            z = fd::run(&orbit.params, &z, Horizon::Periods(1)).expect("a plain run").0;
+            z = fd::run(&orbit.params, &z, Horizon::Periods(1))
+                .expect("a plain run")
+                .0;
             deviations.push(&z - &star);
         }
         // The rate from the deviation's size over whole periods, after the faster modes have
@@ -123,9 +130,15 @@ fn a_neimark_sacker_point_is_where_direct_simulation_starts_to_spiral_out() {
         let log_size = |n: usize| deviations[n].norm().ln();
         let (n0, n1) = (300, periods - 1);
         let rate = ((log_size(n1) - log_size(n0)) / (n1 - n0) as f64).exp();
-        println!("Ω = {}: deviation rate {rate} per period, pair modulus {modulus}", orbit.params.omega_ratio());
+        println!(
+            "Ω = {}: deviation rate {rate} per period, pair modulus {modulus}",
+            orbit.params.omega_ratio()
+        );
         assert_eq!(rate > 1.0, grows, "{rate}");
-        assert!((rate - modulus).abs() < 0.2 * (modulus - 1.0).abs(), "{rate} vs {modulus}");
+        assert!(
+            (rate - modulus).abs() < 0.2 * (modulus - 1.0).abs(),
+            "{rate} vs {modulus}"
+        );
         // The turn per period from the sign changes of one coordinate of the deviation,
         // r^n cos(nθ + φ) sampled once a period: 2 per turn, θ/π per period (θ < π).
         let changes = (n0..n1)
