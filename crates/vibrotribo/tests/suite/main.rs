@@ -44,6 +44,7 @@ mod merit;
 mod motion;
 mod optimize;
 mod orbits_branch_points;
+mod orbits_cascade_certified;
 mod orbits_continuation;
 mod orbits_curve;
 mod orbits_grazing;
