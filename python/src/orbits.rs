@@ -294,6 +294,11 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
             d.set_item("parameter", parameter)?;
             "cascade_depth"
         }
+        BranchEnd::Unlocated { parameter, between } => {
+            d.set_item("parameter", parameter)?;
+            d.set_item("between", [between.0, between.1])?;
+            "unlocated"
+        }
         BranchEnd::SwitchFailed { parameter } => {
             d.set_item("parameter", parameter)?;
             "switch_failed"

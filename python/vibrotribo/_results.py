@@ -540,9 +540,10 @@ class Branch(Display):
             at a branch point the first branch switched onto) and ``other_child`` (at a
             branch point, the second one).
         end: why the branch ended: ``reason`` (``range_end``, ``max_points``,
-            ``step_floor``, ``grazing``, ``cascade_depth``, ``switch_failed``,
-            ``collapsed``, ``closed``, ``rejoined`` with the ``branch`` it reached,
-            ``stopped``) and its details.
+            ``step_floor``, ``grazing``, ``cascade_depth``, ``unlocated`` with the
+            ``between`` bracket of a multiplier near −1 that could not be located,
+            ``switch_failed``, ``collapsed``, ``closed``, ``rejoined`` with the ``branch``
+            it reached, ``stopped``) and its details.
     """
 
     period: int

@@ -193,6 +193,12 @@ pub fn end_text(end: &BranchEnd) -> String {
         BranchEnd::CascadeDepth { parameter } => {
             format!("period doubling at {parameter} beyond the depth followed (--doublings)")
         }
+        BranchEnd::Unlocated {
+            parameter,
+            between: (a, b),
+        } => format!(
+            "a multiplier near −1 could not be located between {a} and {b}: not followed past {parameter}"
+        ),
         BranchEnd::SwitchFailed { parameter } => {
             format!("could not switch onto the doubled branch at {parameter}")
         }

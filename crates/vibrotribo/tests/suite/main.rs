@@ -45,6 +45,7 @@ mod motion;
 mod optimize;
 mod orbits_branch_points;
 mod orbits_branch_stability;
+mod orbits_cascade_certified;
 mod orbits_continuation;
 mod orbits_curve;
 mod orbits_grazing;

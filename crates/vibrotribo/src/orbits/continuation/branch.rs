@@ -455,7 +455,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
             };
             ending.rejoin = Some(closer.described.point.parameter);
         }
-        detect(
+        let detected = detect(
             &problem,
             &step,
             &base_point,
@@ -466,6 +466,19 @@ fn follow<F: Fn(f64) -> ChainParams>(
             &mut doublings,
             &mut ending,
         );
+        // A multiplier crossing −1 that could not be located: a shorter step, down to the
+        // floor.
+        if let Err(u) = detected {
+            ds *= 0.5;
+            if ds >= opts.min_step {
+                continue;
+            }
+            branch.end = BranchEnd::Unlocated {
+                parameter: current.described.point.parameter,
+                between: u.bracket,
+            };
+            return Followed::New(Box::new(branch), doublings);
+        }
         branch.points.push(target.described.point.clone());
         if let Some(k) = closes(&problem, &branch, ds) {
             branch.end = BranchEnd::Closed {

@@ -46,8 +46,24 @@ pub(super) struct Context<'a> {
     pub known: &'a [KnownBranchPoint],
 }
 
+/// A sign change of `det(Φ + I)` in a step that [`detect`] could not certify as a period
+/// doubling ([`certified_doubling`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Unlocated {
+    /// The parameters of the locator's final bracket's ends.
+    pub bracket: (f64, f64),
+}
+
+/// A real multiplier within this distance of −1 at a located period doubling (located to
+/// the location tolerance in the parameter, the multiplier is far closer on a smooth
+/// branch).
+const DOUBLING_MULTIPLIER: f64 = 1e-3;
+
 /// Finds and locates what happens between `base` and `target` (a step from `base`), and
-/// appends it to `branch` in order along it, with the forks to follow in `forks`.
+/// appends it to `branch` in order along it, with the forks to follow in `forks`. A sign
+/// change of `det(Φ + I)` that cannot be certified as a period doubling leaves `branch`,
+/// `forks` and `ending` as they were and is returned as [`Unlocated`]: the step is not to be
+/// taken.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn detect<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
@@ -59,8 +75,10 @@ pub(super) fn detect<F: Fn(f64) -> ChainParams>(
     branch: &mut Branch,
     forks: &mut Vec<Found>,
     ending: &mut Ending,
-) {
+) -> Result<(), Unlocated> {
     let mut found: Vec<(f64, Bifurcation, Option<Found>)> = Vec::new();
+    // What ends the branch, written to `ending` once the whole step is certified.
+    let (mut cascade_end, mut meets) = (None, None);
     let mut intervals = vec![(base.clone(), target.clone())];
     if base.described.signature != target.described.signature {
         let (left, right, precision) = locate_change(problem, step, base, target);
@@ -97,7 +115,7 @@ pub(super) fn detect<F: Fn(f64) -> ChainParams>(
             && let Some(l) = locate_root(problem, step, a, b, |p| branch_test(p, t0))
             && has_multiplier_at_one(&l.point.described.point.multipliers)
         {
-            let fork = branch_point(problem, context, &l, t0, ending);
+            let fork = branch_point(problem, context, &l, t0, &mut meets);
             found.push((l.point.theta, bifurcation(BifurcationKind::BranchPoint, &l), fork));
             bp = Some(l.point);
         }
@@ -118,11 +136,14 @@ pub(super) fn detect<F: Fn(f64) -> ChainParams>(
         if ta.flip * tb.flip < 0.0
             && let Some(l) = locate_root(problem, step, a, b, |p| p.described.tests.flip)
         {
+            if !certified_doubling(problem, &l) {
+                return Err(Unlocated { bracket: l.bracket });
+            }
             let b = bifurcation(BifurcationKind::PeriodDoubling, &l);
             let doubling = if context.seed.depth < problem.options.doubling_depth {
                 doubling(problem, &l, t_base)
             } else {
-                ending.cascade.get_or_insert(l.point.described.point.parameter);
+                cascade_end.get_or_insert(l.point.described.point.parameter);
                 None
             };
             found.push((l.point.theta, b, doubling));
@@ -135,6 +156,12 @@ pub(super) fn detect<F: Fn(f64) -> ChainParams>(
             found.push((l.point.theta, bifurcation(kind, &l), None));
         }
     }
+    if let Some(p) = cascade_end {
+        ending.cascade.get_or_insert(p);
+    }
+    if let Some(m) = meets {
+        ending.meets.get_or_insert(m);
+    }
     found.sort_by(|a, b| a.0.total_cmp(&b.0));
     for (_, bif, fork) in found {
         let index = branch.bifurcations.len();
@@ -144,6 +171,23 @@ pub(super) fn detect<F: Fn(f64) -> ChainParams>(
             forks.push(f);
         }
     }
+    Ok(())
+}
+
+/// Whether the located sign change `l` of `det(Φ + I)` is a period doubling: its bracket
+/// is within the location tolerance in the parameter (or the test vanishes at the point),
+/// and the orbit there has a real multiplier within [`DOUBLING_MULTIPLIER`] of −1. A step
+/// that jumps onto another branch, or over a point where a multiplier passes through
+/// infinity, changes the sign of the test without either.
+fn certified_doubling<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, l: &Located) -> bool {
+    let located = l.precision <= problem.options.location_tolerance || l.point.described.tests.flip == 0.0;
+    located
+        && l.point
+            .described
+            .point
+            .multipliers
+            .iter()
+            .any(|m| m.im.abs() <= 1e-9 * m.norm() && (m.re + 1.0).abs() < DOUBLING_MULTIPLIER)
 }
 
 /// The doubled branch's start at the period doubling `l`: along the eigenvector of the
@@ -176,14 +220,15 @@ fn doubling<F: Fn(f64) -> ChainParams>(
 }
 
 /// The fork at the branch point `l` (the step's tangent `t0`), unless the branch point was
-/// already found on another branch (then the branch meets that one there, and ends), or
-/// branch points are not followed this deep.
+/// already found on another branch (then the branch meets that one there, and ends: its
+/// parameter and that branch are written to `meets`), or branch points are not followed this
+/// deep.
 fn branch_point<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
     context: &Context<'_>,
     l: &Located,
     t0: &DVector<f64>,
-    ending: &mut Ending,
+    meets: &mut Option<(f64, usize)>,
 ) -> Option<Found> {
     let point = &l.point.described.point;
     let z = state_vector(&point.state);
@@ -192,7 +237,7 @@ fn branch_point<F: Fn(f64) -> ChainParams>(
             && problem.scale.norm(&(&k.state - &z)) <= SAME_BRANCH_POINT_STATE
     });
     if let Some(k) = same {
-        ending.meets.get_or_insert((point.parameter, k.branch));
+        meets.get_or_insert((point.parameter, k.branch));
         return None;
     }
     if context.seed.branch_depth >= problem.options.branch_point_depth {

@@ -94,6 +94,8 @@ impl Step<'_> {
 pub(crate) struct Located {
     pub point: StepPoint,
     pub precision: f64,
+    /// The parameters of the final bracket's ends.
+    pub bracket: (f64, f64),
 }
 
 /// The zero of `f` between `a` and `b` (where it changes sign) by the Illinois method. Where
@@ -144,8 +146,13 @@ where
         fb = fc;
     }
     let precision = step.precision(problem.p_scale, &a, &b);
+    let bracket = (a.described.point.parameter, b.described.point.parameter);
     let point = if fa.abs() < fb.abs() { a } else { b };
-    Some(Located { point, precision })
+    Some(Located {
+        point,
+        precision,
+        bracket,
+    })
 }
 
 /// Where the event sequence changes between `a` (before) and `b` (after), by bisection:

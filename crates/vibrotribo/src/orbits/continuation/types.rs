@@ -363,6 +363,18 @@ pub enum BranchEnd {
         /// Parameter of the period doubling.
         parameter: f64,
     },
+    /// A multiplier crosses −1 (`det(Φ + I)` changes sign) between two orbits of the branch,
+    /// but the crossing could not be located down to the smallest step: the locator's bracket
+    /// stayed wider than [`ContinuationOptions::location_tolerance`], or the orbit it ended on
+    /// has no real multiplier near −1 (a step onto another branch, or over a point where a
+    /// multiplier passes through infinity). No period doubling is reported there, and the
+    /// branch is not followed past it.
+    Unlocated {
+        /// Parameter of the last point.
+        parameter: f64,
+        /// The parameters of the locator's final bracket's ends.
+        between: (f64, f64),
+    },
     /// The doubled branch could not be started from its period doubling.
     SwitchFailed {
         /// Parameter of the period doubling.
@@ -400,7 +412,8 @@ pub enum BranchEnd {
 
 impl BranchEnd {
     /// Its name in files: `range_end`, `max_points`, `step_floor`, `grazing`,
-    /// `cascade_depth`, `switch_failed`, `collapsed`, `closed`, `rejoined`, `stopped`.
+    /// `cascade_depth`, `unlocated`, `switch_failed`, `collapsed`, `closed`, `rejoined`,
+    /// `stopped`.
     pub fn name(&self) -> &'static str {
         match self {
             BranchEnd::RangeEnd { .. } => "range_end",
@@ -408,6 +421,7 @@ impl BranchEnd {
             BranchEnd::StepFloor { .. } => "step_floor",
             BranchEnd::Grazing { .. } => "grazing",
             BranchEnd::CascadeDepth { .. } => "cascade_depth",
+            BranchEnd::Unlocated { .. } => "unlocated",
             BranchEnd::SwitchFailed { .. } => "switch_failed",
             BranchEnd::Collapsed { .. } => "collapsed",
             BranchEnd::Closed { .. } => "closed",
@@ -424,6 +438,7 @@ impl BranchEnd {
             | BranchEnd::StepFloor { parameter, .. }
             | BranchEnd::Grazing { parameter, .. }
             | BranchEnd::CascadeDepth { parameter }
+            | BranchEnd::Unlocated { parameter, .. }
             | BranchEnd::SwitchFailed { parameter }
             | BranchEnd::Collapsed { parameter }
             | BranchEnd::Closed { parameter }
