@@ -10,7 +10,7 @@ use std::ops::ControlFlow;
 
 use thiserror::Error;
 
-use crate::config::{Config, ConfigError};
+use crate::config::{Config, ConfigError, Param};
 use crate::orbits::{
     Continuation, ContinuationOptions, OrbitError, PeriodicOrbit, ShootingOptions, continue_orbit,
     periodic_orbit_from_transient,
@@ -77,9 +77,16 @@ pub enum BranchError {
 /// The chain of `config` with `key` set to each value: a value that makes an invalid
 /// configuration gives a chain that fails its validation (not-a-number masses), so that a
 /// corrector evaluating it fails and the branch ends there.
+///
+/// The key is resolved once ([`Param`]), so that each value is set in the document's types
+/// directly rather than written and read back as TOML.
 pub fn config_family(config: &Config, key: &str) -> impl Fn(f64) -> ChainParams {
     let n = config.chain().len();
-    move |v: f64| match config.with(key, toml::Value::Float(v)) {
+    let param = Param::new(config, key).ok();
+    move |v: f64| match match &param {
+        Some(p) => config.with_values(&[(p, v)]),
+        None => config.with(key, toml::Value::Float(v)),
+    } {
         Ok(c) => c.chain().clone(),
         Err(_) => ChainParams {
             masses: vec![f64::NAN; n],

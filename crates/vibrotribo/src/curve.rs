@@ -9,7 +9,7 @@ use thiserror::Error;
 
 use crate::ChainParams;
 use crate::branch::{BRANCH_POWER_PERIODS, BRANCH_POWER_WARMUP, BranchError, BranchOptions, continue_config};
-use crate::config::{Config, ConfigError};
+use crate::config::{Config, ConfigError, Param};
 use crate::orbits::curve::{Curve, CurveError, CurveKind, CurveOptions, CurveStart, continue_curve};
 use crate::orbits::{
     Bifurcation, BifurcationKind, ContinuationOptions, OrbitError, ShootingOptions,
@@ -149,12 +149,18 @@ pub fn canonical_key(key: &str) -> String {
 /// The chain of `config` with `key = p1` and `key2 = p2`: values that make an invalid
 /// configuration give a chain that fails its validation (not-a-number masses), so that the
 /// corrector fails there and the curve ends.
+///
+/// The keys are resolved once ([`Param`]), so that each pair of values is set in the
+/// document's types directly rather than written and read back as TOML.
 pub fn config_family2(config: &Config, key: &str, key2: &str) -> impl Fn(f64, f64) -> ChainParams {
     let n = config.chain().len();
-    move |p1: f64, p2: f64| match config
-        .with(key, toml::Value::Float(p1))
-        .and_then(|c| c.with(key2, toml::Value::Float(p2)))
-    {
+    let params = Param::new(config, key).ok().zip(Param::new(config, key2).ok());
+    move |p1: f64, p2: f64| match match &params {
+        Some((a, b)) => config.with_values(&[(a, p1), (b, p2)]),
+        None => config
+            .with(key, toml::Value::Float(p1))
+            .and_then(|c| c.with(key2, toml::Value::Float(p2))),
+    } {
         Ok(c) => c.chain().clone(),
         Err(_) => ChainParams {
             masses: vec![f64::NAN; n],

@@ -48,6 +48,7 @@ mod orbits_branch_stability;
 mod orbits_cascade_certified;
 mod orbits_continuation;
 mod orbits_curve;
+mod orbits_doubling_switch;
 mod orbits_grazing;
 mod orbits_neimark_sacker;
 mod orbits_non_smooth_fold;

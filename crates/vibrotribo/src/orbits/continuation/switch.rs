@@ -21,8 +21,10 @@ use nalgebra::DVector;
 
 use super::super::error::NewtonFailure;
 use super::corrector::{Evaluated, Failure, Problem};
+use super::cross::{orbit_keeping, sequence};
 use super::locate::{Step, StepPoint};
 use crate::model::ChainParams;
+use crate::orbits::map::evaluate;
 
 /// How a branch leaves its parent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -157,9 +159,93 @@ pub(super) fn start<F: Fn(f64) -> ChainParams>(
                     Err(f) => last = Some(f),
                 }
             }
+            if *fork == Fork::Doubling
+                && let Some(found) = doubled_at_fixed_parameter(problem, u, direction)
+            {
+                return Ok(found);
+            }
             Err(last.unwrap_or_else(|| failure_of(NewtonFailure::Iterations)))
         }
     }
+}
+
+/// Distances from the period doubling in the parameter at which [`doubled_at_fixed_parameter`]
+/// seeks the doubled orbit, fractions of the range (the nearest first: deep in a cascade the
+/// doubled branches turn within a short distance).
+const FIXED_PARAMETER_STEPS: [f64; 6] = [1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4];
+
+/// Moves along the eigenvector of the multiplier −1 from which it is sought (scaled units,
+/// the smallest first).
+const EIGENVECTOR_MOVES: [f64; 5] = [1e-6, 1e-5, 1e-4, 1e-3, 1e-2];
+
+/// The first orbit of a doubled branch found at a fixed parameter, for a doubling where no
+/// arclength step reached it: Newton's method on the doubled map at `p* ± δ` (on the
+/// pitchfork's side, the doubled orbit lies `√(δ/|c|)` along the eigenvector from the parent,
+/// `c` unknown), from the parent's state moved along the eigenvector, held to the event
+/// sequence of the flow from the guess (next to a grazing the map is not smooth across it).
+/// An orbit that is the parent (of half the period) or lies farther from the fork than twice
+/// the move it started from is refused. The branch goes on from the orbit found, away from
+/// the fork.
+fn doubled_at_fixed_parameter<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    u: &DVector<f64>,
+    direction: &DVector<f64>,
+) -> Option<(StepPoint, DVector<f64>)> {
+    let dim = problem.dim();
+    let mut v = direction.clone();
+    v[dim] = 0.0;
+    let v = v.try_normalize(0.0)?;
+    let p0 = problem.parameter(u);
+    for delta in FIXED_PARAMETER_STEPS {
+        for sigma in [1.0, -1.0] {
+            let p = p0 + sigma * delta * problem.p_scale;
+            for eps in EIGENVECTOR_MOVES {
+                if problem.options.shooting.cancel.requested() {
+                    return None;
+                }
+                let guess = problem.state(&(u + &v * eps));
+                let Some(found) = orbit_near(problem, &guess, p) else {
+                    continue;
+                };
+                let away = &found.ev.u - u;
+                if collapsed(problem, &found) || state_distance(&away, dim) > 2.0 * eps {
+                    continue;
+                }
+                let Some(t) = problem.tangent(&found.ev, &away) else {
+                    continue;
+                };
+                return Some((found, t));
+            }
+        }
+    }
+    None
+}
+
+/// The length of the state part of the scaled vector `d`.
+fn state_distance(d: &DVector<f64>, dim: usize) -> f64 {
+    d.rows(0, dim).norm()
+}
+
+/// The orbit at `p` from `z`, Newton's method held to the event sequence of the flow from `z`.
+fn orbit_near<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    z: &DVector<f64>,
+    p: f64,
+) -> Option<StepPoint> {
+    let params = (problem.family)(p);
+    let opts = &problem.options.shooting;
+    let first = evaluate(
+        &params,
+        z,
+        problem.period,
+        problem.phase,
+        &opts.sim,
+        &opts.sensitivity,
+    )
+    .ok()?;
+    let end = problem.phase + f64::from(problem.period) * params.period();
+    let keep = sequence(&first.events, end);
+    orbit_keeping(problem, z, p, 0.0, &keep)
 }
 
 /// Whether the first point `p` of a branch leaving the fork at `u` fell back onto the
