@@ -17,7 +17,7 @@ use crate::config::{config_error, config_of};
 use crate::convert::table_to_py;
 use crate::interrupt::{Signals, cancel_hook, cancel_result};
 use crate::manifest::{ChirpSettings, json_error, manifest_dict};
-use vibrotribo::report::manifest::{ChirpSettingsRecord, Kind as ManifestKind, settings_of};
+use vibrotribo::report::manifest::{ChirpSettingsRecord, Kind as ManifestKind, settings_of, version};
 
 /// A library error in the words of the Python function (`from_`, `duration`, …).
 fn chirp_error(e: ChirpError) -> PyErr {
@@ -164,6 +164,7 @@ pub fn chirp<'py>(
         command: ManifestKind::Chirp,
         chirp: ChirpSettingsRecord::of(&config, &options, runs.first().map(|r| r.chirp.amplitude)),
         settings: settings_of(&config).map_err(json_error)?,
+        vibrotribo_version: version(),
     };
     let s = manifest_dict(py, &settings)?;
     out.set_item("settings", s)?;

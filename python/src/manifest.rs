@@ -11,6 +11,7 @@ use serde_json::Value;
 use vibrotribo::report::BaseMotionSummary;
 use vibrotribo::report::manifest::{
     Axis, ChirpSettingsRecord, Kind, PeriodsRecord, RunnerRecord, SettleRecord, base_motion_of, settings_of,
+    version,
 };
 use vibrotribo::sweep::PointRunner;
 
@@ -50,7 +51,7 @@ pub fn add_missing(d: &Bound<'_, PyDict>, record: &impl Serialize) -> PyResult<(
 
 /// The settings of a study on the point runner: its command, the swept axis if any, the
 /// runner's periods, tolerances and `mechanics_only`, how the points settled, the
-/// configuration and its base motion.
+/// configuration, its base motion and the library's version.
 #[derive(Debug, Serialize)]
 pub struct RunnerSettings {
     /// The command whose manifest these keys are.
@@ -69,6 +70,8 @@ pub struct RunnerSettings {
     /// The base motion, when it is not the chain's own harmonic.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub base_motion: Option<BaseMotionSummary>,
+    /// The library's version.
+    pub vibrotribo_version: String,
 }
 
 impl RunnerSettings {
@@ -86,6 +89,7 @@ impl RunnerSettings {
             settle: SettleRecord::of(runner.options()),
             settings: settings_of(runner.base()).map_err(json_error)?,
             base_motion: base_motion_of(runner.base()),
+            vibrotribo_version: version(),
         };
         manifest_dict(py, &s)
     }
@@ -121,4 +125,6 @@ pub struct ChirpSettings {
     pub chirp: ChirpSettingsRecord,
     /// The configuration (the library's document).
     pub settings: Value,
+    /// The library's version.
+    pub vibrotribo_version: String,
 }

@@ -2,8 +2,8 @@
 command line and Python build both from the library's manifest types.
 
 Documented differences:
-- `CLI_ONLY`: the keys only an output directory has (a grid job's shard, a job's progress,
-  the wall time), which Python leaves out.
+- `CLI_ONLY`: the keys only an output directory has (a grid job's shard, a job's progress
+  `complete`, `done` and `rows`, the wall time), which Python leaves out.
 - `AXES`: where a manifest's axis is an object (`map.json`, `basins.json`: `x` and `y` with
   `param`, `from`, `to`, `steps`, `values`), Python's `settings` name the key (`x`) and list
   its values (`x_values`).
@@ -17,7 +17,7 @@ import pytest
 import vibrotribo as vt
 from conftest import read_json, run_cli
 
-CLI_ONLY = {"shard", "complete", "done", "wall_time_s"}
+CLI_ONLY = {"shard", "complete", "done", "rows", "wall_time_s"}
 
 
 def assert_same_keys(settings, manifest, axes=(), elsewhere=None):
@@ -109,9 +109,9 @@ def test_band_response_settings_are_the_manifest(cli, tmp_path):
 
 
 def test_chirp_settings_are_the_manifest(cli, tmp_path):
-    run_cli(cli, "chirp", "--from", "0.6", "--to", "0.7", "--duration", "1", "--samples-per-cycle", "20",
+    run_cli(cli, "chirp", "--from", "0.6", "--to", "0.9", "--duration", "3", "--samples-per-cycle", "20",
             "--out", tmp_path)
-    r = vt.chirp(vt.Config(), 0.6, 0.7, 1, samples_per_cycle=20)
+    r = vt.chirp(vt.Config(), 0.6, 0.9, 3, samples_per_cycle=20)
     m = read_json(tmp_path / "chirp.json")
     # The runs and their jumps are the result's `up`, `down` and `hysteresis`.
     for key in ("up", "down", "hysteresis"):

@@ -474,8 +474,8 @@ fn manifest_of(
             done,
             points: xs.len() * ys.len(),
         },
-        settings: serde_json::to_value(base.table()).context("the configuration as JSON")?,
+        settings: crate::manifest::settings_of(base).context("the configuration as JSON")?,
         base_motion: base_motion_of(base),
-        vibrotribo_version: env!("CARGO_PKG_VERSION").into(),
+        vibrotribo_version: crate::manifest::version(),
     })
 }

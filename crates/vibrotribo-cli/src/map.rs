@@ -509,7 +509,7 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             omega_ratio: ws,
             optimal_mass_ratio: rs,
             periods: PeriodsRecord::of(runner.options()),
-            settings: serde_json::to_value(runner.base().table())?,
+            settings: crate::manifest::settings_of(runner.base())?,
         };
         write_json(&dir.join("fit.json"), &to_value(&manifest)?)?;
         if args.plot {
