@@ -22,8 +22,10 @@ use crate::config::{config_error, config_of};
 use crate::convert::table_to_py;
 use crate::interrupt::Signals;
 use crate::limits::check_grid;
-use crate::sweep::{PointSettings, StudySettings, check_points};
+use crate::manifest::{json_error, manifest_dict};
+use crate::sweep::{PointSettings, check_points};
 use vibrotribo::config::Config;
+use vibrotribo::report::manifest::{AttractorsManifest, Axis, BasinsManifest};
 
 /// The attractor options of the command line's `--cell`, `--section-tolerance`,
 /// `--match-tolerance` (and `--continuation-distance`).
@@ -126,12 +128,21 @@ pub fn basins<'py>(
         &results,
         &options,
     )?;
-    let s = StudySettings::new(py, "basins")?
-        .set("x", x)?
-        .set("x_values", xs)?
-        .set("y", y)?
-        .set("y_values", ys)?
-        .finish(starts.point_runner())?;
+    let axis = |param: &str, from: f64, to: f64, values: &[f64]| Axis {
+        param: param.to_string(),
+        from,
+        to,
+        steps: values.len(),
+        values: values.to_vec(),
+    };
+    let manifest = BasinsManifest::new(&starts, axis(&x, x_from, x_to, &xs), axis(&y, y_from, y_to, &ys))
+        .map_err(json_error)?;
+    let s = manifest_dict(py, &manifest)?;
+    // The keys by name, their values as lists (basins.json's x and y are the axes).
+    s.set_item("x", x)?;
+    s.set_item("x_values", xs)?;
+    s.set_item("y", y)?;
+    s.set_item("y_values", ys)?;
     out.set_item("settings", s)?;
     Ok(out)
 }
@@ -401,12 +412,9 @@ pub fn attractors<'py>(
     let out = PyDict::new(py);
     out.set_item("attractors", table_to_py(py, &at_table)?)?;
     out.set_item("expected_power", table_to_py(py, &expected)?)?;
-    let s = StudySettings::new(py, "attractors")?
-        .set("param", param)?
-        .set("values", values)?
-        .set("samples", samples)?
-        .set("seed", seed)?
-        .finish(starts.point_runner())?;
+    let manifest =
+        AttractorsManifest::new(&starts, Axis::of_values(&param, &values), &sampling).map_err(json_error)?;
+    let s = manifest_dict(py, &manifest)?;
     out.set_item("settings", s)?;
     Ok(out)
 }

@@ -16,7 +16,9 @@ use crate::config::{config_error, config_of};
 use crate::convert::table_to_py;
 use crate::interrupt::{cancel_hook, cancel_result};
 use crate::limits::{check_grid, check_memory};
-use crate::sweep::{PointSettings, check_points, run_grid, settings};
+use crate::manifest::RunnerSettings;
+use crate::sweep::{PointSettings, check_points, run_grid};
+use vibrotribo::report::manifest::Kind;
 
 fn error(e: BifmapError) -> PyErr {
     match e {
@@ -223,8 +225,7 @@ pub fn bifmap<'py>(
     out.set_item("seeds", seeds)?;
     out.set_item("untraced", map.untraced)?;
     out.set_item("map", table_to_py(py, &table.summary())?)?;
-    let s = settings(py, &runner)?;
-    s.set_item("command", "bifmap")?;
+    let s = RunnerSettings::dict(py, Kind::Bifmap, None, &runner)?;
     s.set_item("x_values", x_values)?;
     s.set_item("y_values", y_values)?;
     s.set_item(

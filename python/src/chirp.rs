@@ -13,9 +13,11 @@ use vibrotribo::study::{
 };
 use vibrotribo::sweep::{Cell, Kind, Table};
 
-use crate::config::{config_error, config_of, table_to_dict};
+use crate::config::{config_error, config_of};
 use crate::convert::table_to_py;
 use crate::interrupt::{Signals, cancel_hook, cancel_result};
+use crate::manifest::{ChirpSettings, json_error, manifest_dict};
+use vibrotribo::report::manifest::{ChirpSettingsRecord, Kind as ManifestKind, settings_of, version};
 
 /// A library error in the words of the Python function (`from_`, `duration`, …).
 fn chirp_error(e: ChirpError) -> PyErr {
@@ -158,23 +160,13 @@ pub fn chirp<'py>(
     for d in [Direction::Up, Direction::Down] {
         out.set_item(d.as_str(), find(d).map(|r| run_to_py(py, r)).transpose()?)?;
     }
-    let chain = config.chain();
-    let s = PyDict::new(py);
-    s.set_item("command", "chirp")?;
-    s.set_item("from", from_)?;
-    s.set_item("to", to)?;
-    s.set_item("duration_s", duration)?;
-    s.set_item("sweep", sweep)?;
-    s.set_item("amplitude_m", runs.first().map(|r| r.chirp.amplitude))?;
-    s.set_item("mechanics_only", mechanics_only)?;
-    s.set_item("start", if from_rest { "initial_state" } else { "settled" })?;
-    s.set_item("samples_per_cycle", samples_per_cycle)?;
-    s.set_item("jump_window_cycles", jump_window)?;
-    s.set_item(
-        "natural_frequency_hz",
-        chain.omega() / chain.omega_ratio() / std::f64::consts::TAU,
-    )?;
-    s.set_item("settings", table_to_dict(py, config.table())?)?;
+    let settings = ChirpSettings {
+        command: ManifestKind::Chirp,
+        chirp: ChirpSettingsRecord::of(&config, &options, runs.first().map(|r| r.chirp.amplitude)),
+        settings: settings_of(&config).map_err(json_error)?,
+        vibrotribo_version: version(),
+    };
+    let s = manifest_dict(py, &settings)?;
     out.set_item("settings", s)?;
     out.set_item(
         "complete",

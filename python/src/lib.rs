@@ -16,6 +16,7 @@ mod interrupt;
 mod limits;
 mod loads;
 mod lyapunov;
+mod manifest;
 mod mass_ratio;
 mod optimize;
 mod orbits;

@@ -15,7 +15,9 @@ use vibrotribo::sweep::{Cell, Kind, PointColumns, Table, grid};
 use crate::config::config_of;
 use crate::convert::table_to_py;
 use crate::limits::check_grid;
-use crate::sweep::{PointSettings, StudySettings, check_points, run_grid};
+use crate::manifest::{MassRatioSettings, json_error, manifest_dict};
+use crate::sweep::{PointSettings, check_points, run_grid};
+use vibrotribo::report::manifest::{self, Kind as ManifestKind, PeriodsRecord};
 
 /// Refuses an axis the command line refuses (`--{name}-from/-to/-steps`).
 fn check_axis(name: &str, from: f64, to: f64, steps: usize) -> PyResult<()> {
@@ -172,10 +174,15 @@ pub fn optimize_mass_ratio<'py>(
     paper.set_item("b", b)?;
     paper.set_item("c", c)?;
     out.set_item("paper_fit", paper)?;
-    let s = StudySettings::new(py, "optimize-mass-ratio")?
-        .set("omega_values", omegas)?
-        .set("mass_ratio_values", ratios)?
-        .finish(&runner)?;
+    let settings = MassRatioSettings {
+        command: ManifestKind::OptimizeMassRatio,
+        omega_values: omegas,
+        mass_ratio_values: ratios,
+        periods: PeriodsRecord::of(runner.options()),
+        mechanics_only: runner.mechanics_only(),
+        settings: manifest::settings_of(runner.base()).map_err(json_error)?,
+    };
+    let s = manifest_dict(py, &settings)?;
     out.set_item("settings", s)?;
     Ok(out)
 }

@@ -19,7 +19,9 @@ use crate::config::{config_error, config_of};
 use crate::convert::{json_to_py, table_to_py};
 use crate::interrupt::{Signals, cancel_hook, cancel_result};
 use crate::limits::check_grid;
-use crate::sweep::{PointSettings, settings};
+use crate::manifest::RunnerSettings;
+use crate::sweep::PointSettings;
+use vibrotribo::report::manifest::{Axis, Kind};
 
 /// A library error as a Python exception (a bad key or value: the configuration's error).
 fn response_error(e: ResponseError) -> PyErr {
@@ -125,10 +127,12 @@ pub fn response<'py>(
         "summary",
         summary_to_py(py, &r.summary(options.branches.as_ref()))?,
     )?;
-    let st = settings(py, &runner)?;
-    st.set_item("command", "response")?;
-    st.set_item("param", param)?;
-    st.set_item("values", values)?;
+    let st = RunnerSettings::dict(
+        py,
+        Kind::Response,
+        Some(Axis::of_values(&param, &values)),
+        &runner,
+    )?;
     out.set_item("settings", st)?;
     Ok(out)
 }
@@ -199,8 +203,7 @@ pub fn band_response<'py>(
     out.set_item("response", table_to_py(py, &band_table(&r).table())?)?;
     out.set_item("seeds", table_to_py(py, &band_seed_table(&r).table())?)?;
     out.set_item("summary", summary_to_py(py, &r.summary())?)?;
-    let st = settings(py, &runner)?;
-    st.set_item("command", "band-response")?;
+    let st = RunnerSettings::dict(py, Kind::BandResponse, None, &runner)?;
     out.set_item("settings", st)?;
     Ok(out)
 }

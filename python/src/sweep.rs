@@ -16,13 +16,14 @@ use vibrotribo::sweep::{
 
 use vibrotribo::attractors::initial_condition_index;
 use vibrotribo::lyapunov::LyapunovOptions;
-use vibrotribo::report::SettleRecord;
+use vibrotribo::report::manifest::{Axis, MapManifest, RunnerRecord, SweepManifest};
 use vibrotribo::study::limits;
 
-use crate::config::{config_error, config_of, table_to_dict};
-use crate::convert::{serde_to_py, table_to_py};
+use crate::config::{config_error, config_of};
+use crate::convert::table_to_py;
 use crate::interrupt::Signals;
 use crate::limits::{check_grid, check_memory};
+use crate::manifest::{add_missing, json_error, manifest_dict};
 
 /// Settings shared by sweeps and maps.
 pub struct PointSettings {
@@ -115,57 +116,6 @@ pub fn check_points(runner: &PointRunner, points: &[Vec<(&str, f64)>]) -> PyResu
         runner.configure(keys).map_err(config_error)?;
     }
     Ok(())
-}
-
-/// The settings of a sweep or a map as a dict (what `sweep.json`/`map.json` record).
-pub fn settings<'py>(py: Python<'py>, runner: &PointRunner) -> PyResult<Bound<'py, PyDict>> {
-    let o = runner.options();
-    let d = PyDict::new(py);
-    d.set_item("transient_periods", o.transient_periods)?;
-    d.set_item("recorded_periods", o.recorded_periods)?;
-    d.set_item("period_tolerance", o.period_tolerance)?;
-    d.set_item("max_period_detected", o.period_options().max_period)?;
-    d.set_item("grazing_ratio", o.grazing_ratio)?;
-    d.set_item("electrical_warmup_periods", o.electrical_warmup_periods)?;
-    d.set_item("mechanics_only", runner.mechanics_only())?;
-    // How the points settle, the keys of the command line's manifests.
-    let settle = serde_to_py(py, &SettleRecord::of(o))?;
-    for (k, v) in settle.cast::<PyDict>()?.iter() {
-        d.set_item(k, v)?;
-    }
-    d.set_item("settings", table_to_dict(py, runner.base().table())?)?;
-    Ok(d)
-}
-
-/// The settings of a study's result as a dict, as its command's manifest records them:
-/// `command` first, the study's own keys ([`StudySettings::set`]), then the point runner's
-/// periods, `mechanics_only` and the configuration ([`StudySettings::finish`]).
-pub struct StudySettings<'py>(Bound<'py, PyDict>);
-
-impl<'py> StudySettings<'py> {
-    /// The settings of a result of `command` (`"basins"`, `"attractors"`, …).
-    pub fn new(py: Python<'py>, command: &str) -> PyResult<Self> {
-        let d = PyDict::new(py);
-        d.set_item("command", command)?;
-        Ok(StudySettings(d))
-    }
-
-    /// Adds the key `key`.
-    pub fn set(self, key: &str, value: impl IntoPyObject<'py>) -> PyResult<Self> {
-        self.0.set_item(key, value)?;
-        Ok(self)
-    }
-
-    /// Adds `transient_periods`, `recorded_periods`, `mechanics_only` and `settings` of the
-    /// points `runner` ran.
-    pub fn finish(self, runner: &PointRunner) -> PyResult<Bound<'py, PyDict>> {
-        let (d, o) = (self.0, runner.options());
-        d.set_item("transient_periods", o.transient_periods)?;
-        d.set_item("recorded_periods", o.recorded_periods)?;
-        d.set_item("mechanics_only", runner.mechanics_only())?;
-        d.set_item("settings", table_to_dict(d.py(), runner.base().table())?)?;
-        Ok(d)
-    }
 }
 
 /// Runs `points` on the pool, handing each point's keys and result to `each` in grid order;
@@ -289,11 +239,10 @@ pub fn sweep<'py>(
     out.set_item("summary", table_to_py(py, &table.summary())?)?;
     out.set_item("orbit", table_to_py(py, &table.orbit())?)?;
     out.set_item("impacts", table_to_py(py, &table.impacts())?)?;
-    let s = settings(py, &runner)?;
-    s.set_item("command", "sweep")?;
-    s.set_item("param", param)?;
-    s.set_item("values", values)?;
-    s.set_item("continuation", continuation.as_str())?;
+    let manifest = SweepManifest::new(Axis::of_values(&param, &values), continuation, &runner, lyapunov)
+        .map_err(json_error)?;
+    let s = manifest_dict(py, &manifest)?;
+    // Present whether or not they are set (sweep.json has them only when they are).
     s.set_item("floquet", floquet)?;
     s.set_item("lyapunov", lyapunov)?;
     out.set_item("settings", s)?;
@@ -361,8 +310,15 @@ pub fn map<'py>(
     py.detach(|| run_points(&pool, &runner, &points, &mut table))?;
     let out = PyDict::new(py);
     out.set_item("summary", table_to_py(py, &table.summary())?)?;
-    let s = settings(py, &runner)?;
-    s.set_item("command", "map")?;
+    let manifest = MapManifest::new(
+        Axis::of_values(&x, &x_values),
+        Axis::of_values(&y, &y_values),
+        &runner,
+    )
+    .map_err(json_error)?;
+    let s = manifest_dict(py, &manifest)?;
+    add_missing(&s, &RunnerRecord::of(&runner))?;
+    // The keys by name, their values as lists (map.json's x and y are the axes).
     s.set_item("x", x)?;
     s.set_item("x_values", x_values)?;
     s.set_item("y", y)?;

@@ -319,8 +319,9 @@ class Sweep(Display):
             ``x1_m … xN_m`` (m), one row per recorded period.
         impacts: ``impacts.csv``: ``param``, ``time_s`` (from the start of the point's run),
             ``contact`` (1-based), ``rel_velocity_m_s`` (closing speed, m/s).
-        settings: what ``sweep.json`` records (param, values, continuation, transient and
-            recorded periods, tolerances, the configuration's settings).
+        settings: the keys of ``sweep.json`` with its values (param, values, continuation,
+            transient and recorded periods, tolerances, settling, the configuration's
+            settings), less the shard.
     """
 
     summary: Table
@@ -357,8 +358,9 @@ class Sweep(Display):
 @dataclass(frozen=True, eq=False, repr=False)
 class Map(Display):
     """A two-parameter map of :func:`vibrotribo.map`: ``summary`` is ``map.csv`` (``x``,
-    ``y`` and the columns of a sweep's summary), y outer and x inner; ``settings`` what
-    ``map.json`` records."""
+    ``y`` and the columns of a sweep's summary), y outer and x inner; ``settings`` the keys
+    of ``map.json`` with its values but the shard, its axes as ``x``, ``x_values``, ``y``,
+    ``y_values``."""
 
     summary: Table
     settings: Dict[str, Any] = field(default_factory=dict)

@@ -34,7 +34,9 @@ class Chirp(Display):
             ``impacts``, ``complete``, ``failure``, ``jump`` (``omega_ratio``,
             ``frequency_hz``, ``cycle``, ``mass`` 1-based, ``size_m``, ``relative``; None with
             too few cycles). None for a direction that did not run.
-        settings: the options and the configuration's settings.
+        settings: the keys of ``chirp.json`` but the runs (``up``, ``down``,
+            ``hysteresis``), ``complete`` and the wall time: the options and the
+            configuration's settings.
         complete: whether both chirps ran to the end.
     """
 
@@ -86,7 +88,8 @@ class Basins(Display):
             ``power_se_w``, and a point of its section ``x1_m … v1_m_s …``.
         starts: the starts with their ``error`` ("" if none), as ``starts.csv`` without the
             section fingerprints.
-        settings: the axes (``x``, ``x_values``, ``y``, ``y_values``), periods and the
+        settings: the keys of ``basins.json`` with its values but the shard, its axes as
+            ``x``, ``x_values``, ``y``, ``y_values``: periods, tolerances and the
             configuration's settings.
     """
 
@@ -121,7 +124,9 @@ class Attractors(Display):
         expected_power: ``expected_power.csv``: ``param``, ``expected_power_w`` and
             ``expected_power_se_w`` (the mean power of a random start and its standard
             error, W), ``attractors``, ``starts`` (classified), ``failed``, ``error``.
-        settings: values, samples, seed, periods and the configuration's settings.
+        settings: the keys of ``attractors.json`` with its values but the progress
+            (``complete``, ``done``): values, samples, seed, periods, tolerances and the
+            configuration's settings.
     """
 
     attractors: Table
@@ -157,7 +162,9 @@ class Response(Display):
             ``seeding`` and ``branches`` (each ``branch``, ``seed_sweep``, ``seed_at``,
             ``towards``, ``period``, ``points``, ``stable_points``, ``bifurcations``, ``end``,
             ``end_at``, ``bandwidth``) with ``branches=True``, ``complete``.
-        settings: the key, values, periods and the configuration's settings.
+        settings: the keys of ``response.json`` but the summary (the result's
+            ``summary``) and the wall time: the key, values, periods, settling and the
+            configuration's settings.
     """
 
     response: Table
@@ -194,7 +201,9 @@ class BandResponse(Display):
         summary: what ``band_response.json`` records of the result: ``centres_hz``,
             ``width_hz``, ``rms_acceleration``, ``seeds``, ``bandwidth`` (Hz), ``failed``,
             ``complete``.
-        settings: the periods and the configuration's settings.
+        settings: the keys of ``band_response.json`` but the summary (the result's
+            ``summary``), the centres' range and the wall time: the periods, settling and
+            the configuration's settings.
     """
 
     response: Table

@@ -138,8 +138,9 @@ def sweep(
         pure=False,
     )
     parts: List[Sweep] = _gather(client, futures)
-    settings = dict(parts[0].settings)
-    settings["values"] = vals
+    # The whole sweep's axis (sweep.json's param, from, to, steps, values).
+    settings = dict(parts[0].settings, values=vals, steps=len(vals))
+    settings["from"], settings["to"] = vals[0], vals[-1]
     return Sweep(
         summary=Table.concat([p.summary for p in parts]),
         orbit=Table.concat([p.orbit for p in parts]),
@@ -262,9 +263,9 @@ def basins(
         settle=settle,
         settle_cap=settle_cap,
     )
-    # Checks every argument as the serial function does (one start, one period).
-    probe = _serial_basins(cfg, x, x_from, x_from, y, y_from, y_from, (1, 1), **options,
-                           **dict(run, transient=0, recorded=1, settle="fixed"), threads=1)
+    # Checks every argument as the serial function does, on one start (whose settings are the
+    # grid's but for its axes).
+    probe = _serial_basins(cfg, x, x_from, x_from, y, y_from, y_from, (1, 1), **options, **run, threads=1)
     xs = _vibrotribo.grid(float(x_from), float(x_to), int(nx)).tolist()
     ys = _vibrotribo.grid(float(y_from), float(y_to), int(ny)).tolist()
     kwargs: Dict[str, Any] = dict(options, **run, threads=threads)
@@ -280,12 +281,5 @@ def basins(
     )
     rows: List[list] = _gather(client, futures)
     raw = _vibrotribo.classify_basins(cfg, xs, ys, [f for row in rows for f in row], **options)
-    transient_default, recorded_default = _vibrotribo.DEFAULT_START_PERIODS
-    settings = dict(
-        probe.settings,
-        x_values=xs,
-        y_values=ys,
-        transient_periods=transient_default if transient is None else transient,
-        recorded_periods=recorded_default if recorded is None else recorded,
-    )
+    settings = dict(probe.settings, x_values=xs, y_values=ys)
     return Basins(Table(raw["basins"]), Table(raw["attractors"]), Table(raw["starts"]), settings)

@@ -17,7 +17,7 @@ use vibrotribo::sweep::grid;
 use crate::basins::DEFAULT_PERIODS;
 use crate::config::ConfigArgs;
 use crate::job::{RunArgs, check_all, check_distinct, set_threads};
-use crate::manifest::{AttractorTolerances, AttractorsManifest, Axis, Kind, StartBoxRecord, read, to_value};
+use crate::manifest::{AttractorsManifest, Axis, read, to_value};
 use crate::output::{CsvFile, check_out_dir, create_dir, read_csv, si, write_json};
 use crate::plot::{self, Bands, Figure, Legend, Scale, Series};
 use crate::progress::{Interrupted, Progress, interrupted};
@@ -182,38 +182,14 @@ pub fn manifest_of(
     values: &[f64],
     sampling: &RandomStarts,
 ) -> Result<AttractorsManifest> {
-    let runner = starts.point_runner();
-    let o = runner.options();
-    let options = starts.options();
-    Ok(AttractorsManifest {
-        command: Kind::Attractors,
-        axis: Axis {
-            param: param.to_string(),
-            from,
-            to,
-            steps: values.len(),
-            values: values.to_vec(),
-        },
-        samples: sampling.samples,
-        seed: sampling.seed,
-        start_box: sampling.bounds.map(|b| StartBoxRecord {
-            positions_m: b.positions,
-            velocities_m_s: b.velocities,
-        }),
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        attractor_options: AttractorTolerances {
-            period_tolerance: options.period_tolerance,
-            match_tolerance: options.match_tolerance,
-            cell: options.cell,
-            continuation_distance: options.continuation_distance,
-        },
-        mechanics_only: runner.mechanics_only(),
-        settings: serde_json::to_value(runner.base().table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-        complete: false,
-        done: 0,
-    })
+    let axis = Axis {
+        param: param.to_string(),
+        from,
+        to,
+        steps: values.len(),
+        values: values.to_vec(),
+    };
+    Ok(AttractorsManifest::new(starts, axis, sampling)?)
 }
 
 /// `attractors.csv` and `expected_power.csv` of a census, written value by value.

@@ -16,7 +16,7 @@ use vibrotribo::response::{
 use vibrotribo::sweep::{PointRunner, grid};
 
 use crate::config::ConfigArgs;
-use crate::manifest::{BandResponseManifest, Kind, base_motion_of, to_value};
+use crate::manifest::{BandResponseManifest, to_value};
 use crate::output::{check_out_dir, create_dir, write_json};
 use crate::progress::{Interrupted, Progress, interrupted};
 use crate::response::{PointArgs, check_range, write_rows};
@@ -158,18 +158,10 @@ fn manifest(
     r: &BandResponse,
     elapsed: f64,
 ) -> Result<BandResponseManifest> {
-    let o = runner.options();
-    Ok(BandResponseManifest {
-        command: Kind::BandResponse,
-        from: args.from,
-        to: args.to,
-        steps: args.steps,
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        summary: r.summary(),
-        wall_time_s: elapsed,
-        settings: serde_json::to_value(runner.base().table())?,
-        base_motion: base_motion_of(runner.base()),
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-    })
+    Ok(BandResponseManifest::new(
+        runner,
+        (args.from, args.to, args.steps),
+        r.summary(),
+        elapsed,
+    )?)
 }

@@ -20,7 +20,7 @@ use crate::config::ConfigArgs;
 use crate::job::{CsvSpec, GridOutput, Layout};
 use crate::job::{MergeArgs, RunArgs, Shard, check_distinct, run_chunked, set_threads};
 use crate::limits;
-use crate::manifest::{Axis, BasinTolerances, BasinsManifest, Kind, SectionScaleRecord, ShardRecord, read};
+use crate::manifest::{Axis, BasinsManifest, ShardRecord, read};
 use crate::output::{csv_text, read_csv, si, write_rows};
 use crate::plot::{self, CategoryMap, Figure};
 use crate::progress::Interrupted;
@@ -341,36 +341,12 @@ impl BasinGrid {
 
     /// The grid's manifest (`basins.json`; the shard `shard` of it, if any), nothing done.
     pub fn manifest(&self, shard: Option<Shard>) -> Result<BasinsManifest> {
-        let runner = self.starts.point_runner();
-        let o = runner.options();
-        let options = self.starts.options();
-        let scale = SectionScale::of(runner.base().chain());
-        Ok(BasinsManifest {
-            command: Kind::Basins,
-            x: self.x.clone(),
-            y: self.y.clone(),
-            transient_periods: o.transient_periods,
-            recorded_periods: o.recorded_periods,
-            max_period_detected: o.period_options().max_period,
-            attractor_options: BasinTolerances {
-                period_tolerance: options.period_tolerance,
-                match_tolerance: options.match_tolerance,
-                cell: options.cell,
-            },
-            section_scale: SectionScaleRecord {
-                masses: scale.masses,
-                length_m: scale.length,
-                speed_m_s: scale.speed,
-            },
-            mechanics_only: runner.mechanics_only(),
-            shard: shard.map(|s| ShardRecord {
-                index: s.index,
-                count: s.count,
-            }),
-            settings: serde_json::to_value(runner.base().table())?,
-            vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-            complete: false,
-        })
+        let mut m = BasinsManifest::new(&self.starts, self.x.clone(), self.y.clone())?;
+        m.shard = shard.map(|s| ShardRecord {
+            index: s.index,
+            count: s.count,
+        });
+        Ok(m)
     }
 
     /// Runs the starts `points` (the two keys set to each point's values) in parallel chunks,
@@ -577,7 +553,10 @@ pub fn plot_basins(dir: &Path) -> Result<()> {
         missing: "no run (e.g. overlapping masses)",
     };
     let fig = Figure::new(
-        format!("Basins of attraction ({} transient periods)", m.transient_periods),
+        format!(
+            "Basins of attraction ({} transient periods)",
+            m.periods.transient_periods
+        ),
         m.x.param.clone(),
         m.y.param.clone(),
     );

@@ -23,8 +23,8 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{
-    Axis, BifmapCurveRecord, BifmapManifest, Kind, PowerMapRecord, SeedRecord, SettleRecord, base_motion_of,
-    to_value,
+    Axis, BifmapCurveRecord, BifmapManifest, Kind, PointRecord, PowerMapRecord, SeedRecord, SettleRecord,
+    base_motion_of, to_value,
 };
 use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
 use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
@@ -468,16 +468,14 @@ fn manifest_of(
         untraced: map.untraced,
         codim2_points: map.curves.iter().map(|c| c.codim2.len()).sum(),
         power_map: PowerMapRecord {
-            transient_periods: o.transient_periods,
-            recorded_periods: o.recorded_periods,
-            period_tolerance: o.period_tolerance,
+            point: PointRecord::of(o),
             floquet: o.floquet,
             settle: SettleRecord::of(o),
             done,
             points: xs.len() * ys.len(),
         },
-        settings: serde_json::to_value(base.table()).context("the configuration as JSON")?,
+        settings: crate::manifest::settings_of(base).context("the configuration as JSON")?,
         base_motion: base_motion_of(base),
-        vibrotribo_version: env!("CARGO_PKG_VERSION").into(),
+        vibrotribo_version: crate::manifest::version(),
     })
 }

@@ -15,7 +15,10 @@ use vibrotribo::study::{
 };
 
 use crate::config::ConfigArgs;
-use crate::manifest::{ChirpManifest, ChirpRunRecord, HysteresisRecord, JumpRecord, Kind, read, to_value};
+use crate::manifest::{
+    ChirpManifest, ChirpRunRecord, ChirpSettingsRecord, HysteresisRecord, JumpRecord, Kind, read,
+    settings_of, to_value, version,
+};
 use crate::output::{CsvFile, column, create_dir, numbered, numbers, read_csv, write_json};
 use crate::plot::{self, Figure, Legend, Series, both};
 use crate::progress::{Interrupted, Progress, Watch, interrupted, orbit_cancel};
@@ -34,13 +37,6 @@ impl std::str::FromStr for SweepLaw {
                 "unknown --sweep {other:?}: expected linear or logarithmic"
             )),
         }
-    }
-}
-
-fn sweep_name(s: Sweep) -> &'static str {
-    match s {
-        Sweep::Linear => "linear",
-        Sweep::Logarithmic => "logarithmic",
     }
 }
 
@@ -196,7 +192,7 @@ fn print_summary(config: &Config, options: &ChirpOptions, runs: &[ChirpRun], ela
         options.from * hz,
         options.to * hz,
         options.duration_s,
-        sweep_name(options.sweep),
+        options.sweep.as_str(),
         runs.first()
             .map_or("not reached (no chirp ran)".to_string(), |r| format!(
                 "{} m",
@@ -303,24 +299,11 @@ fn manifest(
     runs: &[ChirpRun],
     elapsed: f64,
 ) -> Result<ChirpManifest> {
-    let chain = config.chain();
-    let hz = chain.omega() / chain.omega_ratio() / std::f64::consts::TAU;
     let find = |d: Direction| runs.iter().find(|r| r.direction == d);
     let jump = |d: Direction| find(d).and_then(|r| r.jump.as_ref()).map(|j| j.omega_ratio);
     Ok(ChirpManifest {
         command: Kind::Chirp,
-        from: options.from,
-        to: options.to,
-        duration_s: options.duration_s,
-        sweep: sweep_name(options.sweep).to_string(),
-        amplitude_m: runs.first().map(|r| r.chirp.amplitude),
-        mechanics_only: options.mechanics_only,
-        start: if options.settled_start { "settled" } else { "initial_state" }.to_string(),
-        samples_per_cycle: options.samples_per_cycle,
-        natural_frequency_hz: hz,
-        sweep_rate_omega_per_s: (options.to - options.from) / options.duration_s,
-        jump_window_cycles: options.jump_window,
-        jump_criterion: "the cycle boundary where the median amplitude of the jump_window cycles after it differs most from that of the jump_window cycles before it, for any mass, relative to that mass's largest amplitude in the chirp; omega_ratio at that boundary".to_string(),
+        chirp: ChirpSettingsRecord::of(config, options, runs.first().map(|r| r.chirp.amplitude)),
         up: find(Direction::Up).map(run_record),
         down: find(Direction::Down).map(run_record),
         hysteresis: match (jump(Direction::Up), jump(Direction::Down)) {
@@ -333,8 +316,8 @@ fn manifest(
         },
         complete: runs.len() == 2 && runs.iter().all(|r| r.outcome.ending == Ending::Completed),
         wall_time_s: elapsed,
-        settings: serde_json::to_value(config.table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        settings: settings_of(config)?,
+        vibrotribo_version: version(),
     })
 }
 
@@ -372,8 +355,8 @@ pub fn plot_chirp(dir: &Path) -> Result<()> {
         ..Figure::new(
             format!(
                 "Chirp response, {} s each way ({})",
-                serde_json::Value::from(m.duration_s),
-                m.sweep
+                serde_json::Value::from(m.chirp.duration_s),
+                m.chirp.sweep
             ),
             "Ω = ω/√(k1/m1)",
             "amplitude relative to the base (m)",

@@ -431,8 +431,8 @@ fn write_files(
             feigenbaum_ratios: vibrotribo::orbits::feigenbaum_ratios(&points),
             period_doublings: points,
         },
-        settings: serde_json::to_value(config.table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
+        settings: crate::manifest::settings_of(config)?,
+        vibrotribo_version: crate::manifest::version(),
     };
     write_json(&dir.join("continue.json"), &to_value(&manifest)?)
 }

@@ -275,8 +275,8 @@ fn write_files(
         transient_periods: args.transient,
         max_points: args.max_points,
         mechanics_only: args.mechanics_only,
-        settings: serde_json::to_value(config.table())?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").into(),
+        settings: crate::manifest::settings_of(config)?,
+        vibrotribo_version: crate::manifest::version(),
     };
     crate::manifest::write(&dir.join("curve.json"), &manifest)
 }

@@ -172,7 +172,7 @@ pub fn run(args: &LoadSweepArgs) -> Result<()> {
             periods: spec.periods,
             transient_periods: spec.transient_periods,
             harvester,
-            settings: serde_json::to_value(config.table())?,
+            settings: crate::manifest::settings_of(&config)?,
             base_motion: vibrotribo::report::BaseMotionSummary::of(&spec),
         };
         write_json(&dir.join("load_sweep.json"), &to_value(&manifest)?)?;

@@ -167,7 +167,7 @@ fn manifest(
         transient_periods: args.transient,
         seed: args.seed,
         interrupted,
-        settings: serde_json::to_value(config.table())?,
+        settings: crate::manifest::settings_of(config)?,
     })
 }
 

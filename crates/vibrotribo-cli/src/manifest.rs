@@ -1,13 +1,11 @@
-//! The manifests of output directories, each a serde type written and read through that one
+//! The manifests of output directories, each a serde type of the library
+//! ([`vibrotribo::report::manifest`], re-exported here) written and read through that one
 //! type, and what a directory holds, told by its manifest's `command` (its [`Kind`]).
 //!
 //! A grid job's manifest (`sweep.json`, `map.json`) is its settings; the job machinery
 //! ([`crate::job`]) adds the progress keys `complete`, `done` and `rows` when it writes it,
-//! and the types here ignore them when they read it.
-//!
-//! A command's manifest type lives in its own file here (grid jobs in `grid.rs`, `curve` in
-//! `curve.rs`, `bifmap` in `bifmap.rs`, `response` and `band-response` in `response.rs`, the others in `commands.rs`); its kind is a [`Kind`] and a line of the table
-//! in `kind.rs`, and `plot DIR` draws it by that kind (`plots.rs`).
+//! and the types ignore them when they read it. `plot DIR` draws a directory by its kind
+//! (`plots.rs`).
 
 use std::path::Path;
 
@@ -16,20 +14,10 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-mod bifmap;
-mod commands;
-mod curve;
-mod grid;
 mod kind;
-mod response;
 
-pub use bifmap::*;
-pub use commands::*;
-pub use curve::{Codim2Record, CurveManifest};
-pub use grid::{Axis, MapManifest, ShardRecord, SweepManifest, base_motion_of};
-pub use kind::{Kind, kind_of, shard_kind};
-pub use response::*;
-pub use vibrotribo::report::SettleRecord;
+pub use kind::{kind_of, shard_kind};
+pub use vibrotribo::report::manifest::*;
 
 /// Reads the manifest `path` as `T`; the error names the file and the key at fault.
 pub fn read<T: DeserializeOwned>(path: &Path) -> Result<T> {
@@ -50,4 +38,11 @@ pub fn write<T: Serialize>(path: &Path, manifest: &T) -> Result<()> {
 /// The manifest of a directory as the JSON value the job machinery writes.
 pub fn to_value<T: Serialize>(manifest: &T) -> Result<Value> {
     serde_json::to_value(manifest).context("cannot write the manifest")
+}
+
+/// The configuration a manifest's `settings` records.
+pub fn config_of(settings: &Value) -> Result<vibrotribo::config::Config> {
+    let table: toml::Table =
+        serde_json::from_value(settings.clone()).context("the recorded settings are not a table")?;
+    Ok(vibrotribo::config::Config::from_table(table)?)
 }

@@ -18,8 +18,7 @@ use crate::job::{
 };
 use crate::limits;
 use crate::manifest::{
-    Axis, FitManifest, FitRecord, Kind, MapManifest, PaperFitRecord, SettleRecord, ShardRecord,
-    base_motion_of, to_value,
+    Axis, FitManifest, FitRecord, Kind, MapManifest, PaperFitRecord, PeriodsRecord, ShardRecord, to_value,
 };
 pub use crate::mass_ratio_picture::plot_optimal_mass_ratio;
 use crate::mass_ratio_picture::plot_optimize_mass_ratio;
@@ -164,7 +163,6 @@ pub fn run(args: &MapArgs) -> Result<()> {
         )?;
     }
     let columns = point_columns(runner.contacts(), runner.options().floquet, false);
-    let o = runner.options();
     let axis = |param: &str, from: f64, to: f64, steps: usize, values: &[f64]| Axis {
         param: param.to_string(),
         from,
@@ -172,23 +170,17 @@ pub fn run(args: &MapArgs) -> Result<()> {
         steps,
         values: values.to_vec(),
     };
-    let settings = to_value(&MapManifest {
-        command: Kind::Map,
-        x: axis(&args.x, args.x_from, args.x_to, args.x_steps, &xs),
-        y: axis(&args.y, args.y_from, args.y_to, args.y_steps, &ys),
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        period_tolerance: o.period_tolerance,
-        mechanics_only: runner.mechanics_only(),
-        shard: args.shard.map(|s| ShardRecord {
-            index: s.index,
-            count: s.count,
-        }),
-        settings: serde_json::to_value(runner.base().table()).context("the configuration as JSON")?,
-        floquet: o.floquet,
-        settle: SettleRecord::of(o),
-        base_motion: base_motion_of(runner.base()),
-    })?;
+    let mut manifest = MapManifest::new(
+        axis(&args.x, args.x_from, args.x_to, args.x_steps, &xs),
+        axis(&args.y, args.y_from, args.y_to, args.y_steps, &ys),
+        &runner,
+    )
+    .context("the configuration as JSON")?;
+    manifest.shard = args.shard.map(|s| ShardRecord {
+        index: s.index,
+        count: s.count,
+    });
+    let settings = to_value(&manifest)?;
     let keys: Vec<String> = points.iter().map(point_key).collect();
     let (mut out, skip) = match &args.out {
         None => (None, 0),
@@ -516,9 +508,8 @@ pub fn optimize(args: &OptimizeArgs) -> Result<()> {
             },
             omega_ratio: ws,
             optimal_mass_ratio: rs,
-            transient_periods: runner.options().transient_periods,
-            recorded_periods: runner.options().recorded_periods,
-            settings: serde_json::to_value(runner.base().table())?,
+            periods: PeriodsRecord::of(runner.options()),
+            settings: crate::manifest::settings_of(runner.base())?,
         };
         write_json(&dir.join("fit.json"), &to_value(&manifest)?)?;
         if args.plot {

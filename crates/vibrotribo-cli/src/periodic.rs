@@ -215,7 +215,7 @@ fn manifest(
         excitation_period_s: orbit.params.period(),
         omega_ratio: orbit.params.omega_ratio(),
         parameters: orbit.params.clone(),
-        settings: serde_json::to_value(config.table())?,
+        settings: crate::manifest::settings_of(config)?,
     })
 }
 

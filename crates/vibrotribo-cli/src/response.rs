@@ -22,7 +22,7 @@ use crate::config::ConfigArgs;
 use crate::continuation::end_text;
 use crate::job::{RunArgs, estimate_point_memory};
 use crate::limits;
-use crate::manifest::{Kind, ResponseManifest, SettleRecord, base_motion_of, to_value};
+use crate::manifest::{Axis, ResponseManifest, to_value};
 use crate::output::{CsvFile, check_out_dir, create_dir, write_json};
 use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
 use crate::response_picture::band_text;
@@ -309,22 +309,12 @@ fn manifest(
     seeding: Option<&BranchSeeding>,
     elapsed: f64,
 ) -> Result<ResponseManifest> {
-    let o = runner.options();
-    Ok(ResponseManifest {
-        command: Kind::Response,
+    let axis = Axis {
         param: args.param.clone(),
         from: args.from,
         to: args.to,
         steps: args.steps,
         values: r.values.clone(),
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        period_tolerance: o.period_tolerance,
-        settle: SettleRecord::of(o),
-        summary: r.summary(seeding),
-        wall_time_s: elapsed,
-        settings: serde_json::to_value(runner.base().table())?,
-        base_motion: base_motion_of(runner.base()),
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-    })
+    };
+    Ok(ResponseManifest::new(runner, axis, r.summary(seeding), elapsed)?)
 }

@@ -137,7 +137,7 @@ pub fn plot_response(dir: &Path) -> Result<()> {
             branches.push((xs, pick(true), pick(false)));
         }
     }
-    let marks = BandMarks::of(m.summary.bandwidth.as_ref(), (m.from, m.to));
+    let marks = BandMarks::of(m.summary.bandwidth.as_ref(), (m.axis.from, m.axis.to));
     let mut lines = vec![
         Series::new("up sweep", &x, &up).colour(0),
         Series::new("down sweep", &x, &down).dashed().colour(1),
@@ -156,13 +156,13 @@ pub fn plot_response(dir: &Path) -> Result<()> {
     }
     lines.push(marks.lines());
     let figure = Figure {
-        legend: legend_corner(&[(&x, &up), (&x, &down)], (m.from, m.to)),
+        legend: legend_corner(&[(&x, &up), (&x, &down)], (m.axis.from, m.axis.to)),
         ..Figure::new(
             format!(
                 "Frequency response: {}",
                 band_text(m.summary.bandwidth.as_ref(), "")
             ),
-            m.param.clone(),
+            m.axis.param.clone(),
             "average power P (W)",
         )
     };

@@ -23,7 +23,7 @@ use crate::job::{
     estimate_point_output, header_len, point_columns, run_points, set_threads,
 };
 use crate::limits;
-use crate::manifest::{Axis, Kind, SettleRecord, ShardRecord, SweepManifest, base_motion_of, to_value};
+use crate::manifest::{Axis, ShardRecord, SweepManifest, to_value};
 use crate::progress::{Interrupted, Progress, interrupted, orbit_cancel};
 
 /// Options of `vibrotribo sweep`.
@@ -132,35 +132,20 @@ fn manifest(
     values: &[f64],
     shard: Option<Shard>,
 ) -> Result<SweepManifest> {
-    let o = runner.options();
-    Ok(SweepManifest {
-        command: Kind::Sweep,
-        axis: Axis {
-            param: args.param.clone(),
-            from: args.from,
-            to: args.to,
-            steps: args.steps,
-            values: values.to_vec(),
-        },
-        continuation: args.continuation,
-        transient_periods: o.transient_periods,
-        recorded_periods: o.recorded_periods,
-        period_tolerance: o.period_tolerance,
-        max_period_detected: o.period_options().max_period,
-        grazing_ratio: o.grazing_ratio,
-        electrical_warmup_periods: o.electrical_warmup_periods,
-        mechanics_only: runner.mechanics_only(),
-        shard: shard.map(|s| ShardRecord {
-            index: s.index,
-            count: s.count,
-        }),
-        settings: serde_json::to_value(runner.base().table()).context("the configuration as JSON")?,
-        vibrotribo_version: env!("CARGO_PKG_VERSION").to_string(),
-        floquet: o.floquet,
-        settle: SettleRecord::of(o),
-        base_motion: base_motion_of(runner.base()),
-        lyapunov: args.lyapunov,
-    })
+    let axis = Axis {
+        param: args.param.clone(),
+        from: args.from,
+        to: args.to,
+        steps: args.steps,
+        values: values.to_vec(),
+    };
+    let mut m = SweepManifest::new(axis, args.continuation, runner, args.lyapunov)
+        .context("the configuration as JSON")?;
+    m.shard = shard.map(|s| ShardRecord {
+        index: s.index,
+        count: s.count,
+    });
+    Ok(m)
 }
 
 /// Runs `vibrotribo sweep`.

@@ -32,7 +32,9 @@
 //!   run's description (chain, base motion, harvester, initial state) and observers and
 //!   returns typed results, and the studies built on it (a sweep point with its settling and
 //!   motion label, load studies, chirp experiments). [`sweep`] runs grids of points in
-//!   parallel and returns their results in columns; [`report`] summarises a run.
+//!   parallel and returns their results in columns; [`report`] summarises a run and holds the
+//!   manifests of the command line's output directories ([`report::manifest`]), from which
+//!   Python's results state their settings.
 //! - **Analyses.** [`analysis`] has Poincaré sections, period detection, power spectra and
 //!   fits. [`sensitivity`] differentiates the non-smooth flow exactly (state-transition
 //!   matrix with saltation matrices at impacts, sticking, release and chatter jumps) and in

@@ -19,6 +19,16 @@ pub enum Sweep {
     Logarithmic,
 }
 
+impl Sweep {
+    /// Its name: `linear` or `logarithmic`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Sweep::Linear => "linear",
+            Sweep::Logarithmic => "logarithmic",
+        }
+    }
+}
+
 /// A chirp of the base displacement over `[0, D]`: `y(t) = A sin φ(t)` with φ(0) = 0 and
 /// φ'(t) = 2π f(t) (the amplitude is a displacement, constant over the sweep; the base
 /// acceleration then grows as f²). An up-sweep has f₁ > f₀, a down-sweep f₁ < f₀.

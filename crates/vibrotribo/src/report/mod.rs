@@ -2,9 +2,12 @@
 //! ([`RunSummary`]) as the command line writes it to `summary.json` and reads it back, and as
 //! Python returns it as a dict, one type for both so that they hold the same keys and the same
 //! numbers; with its parts that other results share: the motion of a run or a sweep point
-//! ([`MotionRecord`]) and the base motion as the engine ran it ([`BaseMotionSummary`]).
+//! ([`MotionRecord`]) and the base motion as the engine ran it ([`BaseMotionSummary`]); and the
+//! manifests of the command line's output directories ([`manifest`]), from which Python's
+//! results state their settings.
 
 mod base_motion;
+pub mod manifest;
 mod motion;
 mod settle;
 mod summary;

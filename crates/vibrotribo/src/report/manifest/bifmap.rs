@@ -4,7 +4,9 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use super::{Axis, Kind, SettleRecord};
+use crate::report::BaseMotionSummary;
+
+use super::{Axis, Kind, PointRecord, SettleRecord};
 
 /// One start of a seed value, continued towards one end of the first key's range.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,12 +59,9 @@ pub struct BifmapCurveRecord {
 /// it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PowerMapRecord {
-    /// Transient periods per point.
-    pub transient_periods: u64,
-    /// Recorded periods per point.
-    pub recorded_periods: u64,
-    /// Relative tolerance of the period detection.
-    pub period_tolerance: f64,
+    /// Transient and recorded periods per point and the period detection's tolerance.
+    #[serde(flatten)]
+    pub point: PointRecord,
     /// Whether `map.csv` has the Floquet column.
     pub floquet: bool,
     /// How each point settled.
@@ -120,7 +119,7 @@ pub struct BifmapManifest {
     pub settings: Value,
     /// The base motion, when it is not the chain's own harmonic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub base_motion: Option<vibrotribo::report::BaseMotionSummary>,
+    pub base_motion: Option<BaseMotionSummary>,
     /// The program's version.
     pub vibrotribo_version: String,
 }

@@ -2,220 +2,14 @@
 //! writes and `plot DIR` (and `--resume`, `merge`) reads. The fields are in the order of the
 //! files' keys.
 
+use crate::electrical::breakdown::BreakdownMargin;
+use crate::electrical::{HarvesterParams, LoadPoint};
+use crate::model::ChainParams;
+use crate::report::BaseMotionSummary;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use vibrotribo::electrical::breakdown::BreakdownMargin;
-use vibrotribo::electrical::{HarvesterParams, LoadPoint};
-use vibrotribo::model::ChainParams;
-use vibrotribo::report::BaseMotionSummary;
 
-use super::{Axis, Kind, ShardRecord};
-
-/// The classification tolerances of `basins.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BasinTolerances {
-    /// Relative tolerance of the period detection.
-    pub period_tolerance: f64,
-    /// Relative distance under which two attractors are one.
-    pub match_tolerance: f64,
-    /// Side of a fingerprint's cell, relative.
-    pub cell: f64,
-}
-
-/// The scales that make a section point dimensionless.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SectionScaleRecord {
-    /// Number of masses.
-    pub masses: usize,
-    /// Length scale, m.
-    pub length_m: f64,
-    /// Speed scale, m/s.
-    pub speed_m_s: f64,
-}
-
-/// `basins.json`: everything that determines a basins job's output.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BasinsManifest {
-    /// Always [`Kind::Basins`].
-    pub command: Kind,
-    /// The x axis.
-    pub x: Axis,
-    /// The y axis.
-    pub y: Axis,
-    /// Transient periods per start.
-    pub transient_periods: u64,
-    /// Recorded periods per start.
-    pub recorded_periods: u64,
-    /// Longest period detected, in excitation periods.
-    pub max_period_detected: usize,
-    /// How attractors are told apart.
-    pub attractor_options: BasinTolerances,
-    /// The scales of the section.
-    pub section_scale: SectionScaleRecord,
-    /// Mechanics only (no harvester).
-    pub mechanics_only: bool,
-    /// The shard, if the job is one.
-    pub shard: Option<ShardRecord>,
-    /// The configuration (the library's document).
-    pub settings: Value,
-    /// The program's version.
-    pub vibrotribo_version: String,
-    /// Whether the job finished (written by the job machinery; read only).
-    #[serde(default, skip_serializing)]
-    pub complete: bool,
-}
-
-/// The box random starts are drawn from, around the configured state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StartBoxRecord {
-    /// Half-width of the positions, m.
-    pub positions_m: f64,
-    /// Half-width of the velocities, m/s.
-    pub velocities_m_s: f64,
-}
-
-/// The classification settings of `attractors.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct AttractorTolerances {
-    /// Relative tolerance of the period detection.
-    pub period_tolerance: f64,
-    /// Relative distance under which two attractors are one.
-    pub match_tolerance: f64,
-    /// Side of a fingerprint's cell, relative.
-    pub cell: f64,
-    /// Relative distance under which an attractor continues one of the previous value.
-    pub continuation_distance: f64,
-}
-
-/// `attractors.json`: the settings of an attractors study and how far it got.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct AttractorsManifest {
-    /// Always [`Kind::Attractors`].
-    pub command: Kind,
-    /// The varied key and its values (`param`, `from`, `to`, `steps`, `values`).
-    #[serde(flatten)]
-    pub axis: Axis,
-    /// Random starts per value.
-    pub samples: usize,
-    /// Seed of the starts.
-    pub seed: u64,
-    /// The box of the starts (`None`: the library's default).
-    pub start_box: Option<StartBoxRecord>,
-    /// Transient periods per start.
-    pub transient_periods: u64,
-    /// Recorded periods per start.
-    pub recorded_periods: u64,
-    /// How attractors are told apart and followed.
-    pub attractor_options: AttractorTolerances,
-    /// Mechanics only (no harvester).
-    pub mechanics_only: bool,
-    /// The configuration (the library's document).
-    pub settings: Value,
-    /// The program's version.
-    pub vibrotribo_version: String,
-    /// Whether every value was run.
-    pub complete: bool,
-    /// Values run.
-    pub done: usize,
-}
-
-/// The jump of one chirp direction.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct JumpRecord {
-    /// Ω at the jump.
-    pub omega_ratio: f64,
-    /// Excitation frequency at the jump, Hz.
-    pub frequency_hz: f64,
-    /// The cycle at the jump.
-    pub cycle: u64,
-    /// The mass whose amplitude jumps most (1-based).
-    pub mass: usize,
-    /// The jump's size, m.
-    pub size_m: f64,
-    /// The jump relative to that mass's largest amplitude.
-    pub relative: f64,
-}
-
-/// One direction of a chirp.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ChirpRunRecord {
-    /// Frequency at the start, Hz.
-    pub f_start_hz: f64,
-    /// Frequency the end would have had, Hz.
-    pub f_end_hz_requested: f64,
-    /// Duration run, s.
-    pub run_duration_s: f64,
-    /// Excitation periods run.
-    pub periods: u64,
-    /// Cycles measured.
-    pub cycles: usize,
-    /// Impacts over the run.
-    pub impacts: u64,
-    /// Whether it ran to its end.
-    pub complete: bool,
-    /// Why it stopped early.
-    pub failure: Option<String>,
-    /// Its jump, if any.
-    pub jump: Option<JumpRecord>,
-    /// Its base motion, when it is not the chain's own harmonic.
-    pub base_motion: Option<BaseMotionSummary>,
-}
-
-/// The hysteresis of a chirp: the up and down jumps.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct HysteresisRecord {
-    /// Ω of the up jump.
-    pub up_jump_omega_ratio: f64,
-    /// Ω of the down jump.
-    pub down_jump_omega_ratio: f64,
-    /// Their difference.
-    pub width: f64,
-}
-
-/// `chirp.json`: the settings, per direction the run and its jump, the hysteresis.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ChirpManifest {
-    /// Always [`Kind::Chirp`].
-    pub command: Kind,
-    /// Ω at the start of the up chirp.
-    pub from: f64,
-    /// Ω at its end.
-    pub to: f64,
-    /// Duration of each direction, s.
-    pub duration_s: f64,
-    /// `linear` or `exponential`.
-    pub sweep: String,
-    /// Base amplitude, m.
-    pub amplitude_m: Option<f64>,
-    /// Mechanics only (no harvester).
-    pub mechanics_only: bool,
-    /// `settled` or `initial_state`.
-    pub start: String,
-    /// Samples per excitation cycle.
-    pub samples_per_cycle: u64,
-    /// Natural frequency √(k1/m1)/2π, Hz.
-    pub natural_frequency_hz: f64,
-    /// dΩ/dt, 1/s.
-    pub sweep_rate_omega_per_s: f64,
-    /// Cycles on each side of a jump.
-    pub jump_window_cycles: usize,
-    /// How a jump is found, in words.
-    pub jump_criterion: String,
-    /// The up chirp.
-    pub up: Option<ChirpRunRecord>,
-    /// The down chirp.
-    pub down: Option<ChirpRunRecord>,
-    /// Both jumps, when both were found.
-    pub hysteresis: Option<HysteresisRecord>,
-    /// Whether both directions ran to their end.
-    pub complete: bool,
-    /// Wall-clock time, s.
-    pub wall_time_s: f64,
-    /// The configuration (the library's document).
-    pub settings: Value,
-    /// The program's version.
-    pub vibrotribo_version: String,
-}
+use super::{Kind, PeriodsRecord};
 
 /// Where a branch of a continuation comes from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -485,10 +279,9 @@ pub struct FitManifest {
     pub omega_ratio: Vec<f64>,
     /// The optimal mass ratio there.
     pub optimal_mass_ratio: Vec<f64>,
-    /// Transient periods per point.
-    pub transient_periods: u64,
-    /// Recorded periods per point.
-    pub recorded_periods: u64,
+    /// Transient and recorded periods per point.
+    #[serde(flatten)]
+    pub periods: PeriodsRecord,
     /// The configuration (the library's document).
     pub settings: Value,
 }
@@ -559,14 +352,6 @@ pub struct LyapunovManifest {
     pub settings: Value,
 }
 
-/// The configuration a manifest's `settings` records.
-pub fn config_of(settings: &Value) -> anyhow::Result<vibrotribo::config::Config> {
-    use anyhow::Context;
-    let table: toml::Table =
-        serde_json::from_value(settings.clone()).context("the recorded settings are not a table")?;
-    Ok(vibrotribo::config::Config::from_table(table)?)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -578,37 +363,6 @@ mod tests {
         let m: T = serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"));
         assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
         m
-    }
-
-    #[test]
-    fn basins_manifest_round_trips_byte_for_byte() {
-        round_trips::<BasinsManifest>(
-            r#"{"command":"basins","x":{"param":"run.initial_positions[0]","from":-0.01,"to":0.01,"steps":3,"values":[-0.01,0.0,0.01]},"y":{"param":"run.initial_velocities[0]","from":-0.1,"to":0.1,"steps":3,"values":[-0.1,0.0,0.1]},"transient_periods":20,"recorded_periods":10,"max_period_detected":5,"attractor_options":{"period_tolerance":0.001,"match_tolerance":0.003,"cell":0.05},"section_scale":{"masses":3,"length_m":0.12,"speed_m_s":4.2},"mechanics_only":false,"shard":null,"settings":{},"vibrotribo_version":"0.1.0"}"#,
-        );
-    }
-
-    /// The job machinery's progress keys are read (`complete`) or ignored (`rows`).
-    #[test]
-    fn a_finished_basins_manifest_reads_as_complete() {
-        let text = r#"{"command":"basins","x":{"param":"a","from":0.0,"to":1.0,"steps":2,"values":[0.0,1.0]},"y":{"param":"b","from":0.0,"to":1.0,"steps":2,"values":[0.0,1.0]},"transient_periods":20,"recorded_periods":10,"max_period_detected":5,"attractor_options":{"period_tolerance":0.001,"match_tolerance":0.003,"cell":0.05},"section_scale":{"masses":3,"length_m":0.12,"speed_m_s":4.2},"mechanics_only":false,"shard":null,"settings":{},"vibrotribo_version":"0.1.0","complete":true,"done":4,"rows":{"starts.csv":4}}"#;
-        let m: BasinsManifest = serde_json::from_str(text).expect("a basins manifest");
-        assert!(m.complete);
-        let fresh = serde_json::to_string(&m).expect("serialises");
-        assert!(fresh.ends_with(r#""vibrotribo_version":"0.1.0"}"#), "{fresh}");
-    }
-
-    #[test]
-    fn attractors_manifest_round_trips_byte_for_byte() {
-        round_trips::<AttractorsManifest>(
-            r#"{"command":"attractors","param":"omega_ratio","from":0.7,"to":0.8,"steps":2,"values":[0.7],"samples":3,"seed":1,"start_box":null,"transient_periods":20,"recorded_periods":10,"attractor_options":{"period_tolerance":0.001,"match_tolerance":0.003,"cell":0.05,"continuation_distance":0.25},"mechanics_only":false,"settings":{},"vibrotribo_version":"0.1.0","complete":true,"done":2}"#,
-        );
-    }
-
-    #[test]
-    fn chirp_manifest_round_trips_byte_for_byte() {
-        round_trips::<ChirpManifest>(
-            r#"{"command":"chirp","from":2.3,"to":2.6,"duration_s":2.0,"sweep":"linear","amplitude_m":0.01,"mechanics_only":false,"start":"settled","samples_per_cycle":200,"natural_frequency_hz":7.7969680123367615,"sweep_rate_omega_per_s":0.15000000000000013,"jump_window_cycles":5,"jump_criterion":"the cycle boundary where the median amplitude of the jump_window cycles after it differs most from that of the jump_window cycles before it, for any mass, relative to that mass's largest amplitude in the chirp; omega_ratio at that boundary","up":{"f_start_hz":17.93302642837455,"f_end_hz_requested":20.272116832075582,"run_duration_s":2.000777735052508,"periods":39,"cycles":38,"impacts":38,"complete":true,"failure":null,"jump":{"omega_ratio":2.341448798185491,"frequency_hz":18.256201381976624,"cycle":5,"mass":1,"size_m":-0.000786467814282342,"relative":0.04832352312363258},"base_motion":{"kind":"chirp","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"15320","duration_s":"2.000777735052508e0","knot_spacing_s":"1.3059906886765717e-4","spline_error_bound_m":"9.99934915351887e-12","spline_velocity_error_bound_m_s":"2.45008770496561e-7"}},"down":{"f_start_hz":20.272116832075582,"f_end_hz_requested":17.93302642837455,"run_duration_s":2.000777735052508,"periods":39,"cycles":38,"impacts":38,"complete":true,"failure":null,"jump":{"omega_ratio":2.343133728181077,"frequency_hz":18.26933872725524,"cycle":33,"mass":1,"size_m":0.0005788544347253843,"relative":0.03631401105581164},"base_motion":{"kind":"chirp","run_as":"exact per-interval cubic forces k_i y + c_i y' of the spline","spline_intervals":"15320","duration_s":"2.000777735052508e0","knot_spacing_s":"1.3059906886765717e-4","spline_error_bound_m":"9.997557130923704e-12","spline_velocity_error_bound_m_s":"2.4496486151348593e-7"}},"hysteresis":{"up_jump_omega_ratio":2.341448798185491,"down_jump_omega_ratio":2.343133728181077,"width":-0.0016849299955863373},"complete":true,"wall_time_s":1.5,"settings":{},"vibrotribo_version":"0.1.0"}"#,
-        );
     }
 
     #[test]

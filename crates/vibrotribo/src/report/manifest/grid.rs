@@ -1,13 +1,11 @@
 //! The manifests of the grid jobs, `sweep.json` and `map.json`, and the records they share
 //! with the other jobs (shards, settling).
 
+use super::{Kind, PointRecord, RunnerRecord, base_motion_of, settings_of, version};
+use crate::report::{BaseMotionSummary, SettleRecord};
+use crate::sweep::{Continuation, PointRunner};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use vibrotribo::config::Config;
-use vibrotribo::report::{BaseMotionSummary, SettleRecord};
-use vibrotribo::sweep::Continuation;
-
-use super::Kind;
 
 fn is_false(b: &bool) -> bool {
     !*b
@@ -22,12 +20,6 @@ pub struct ShardRecord {
     pub count: usize,
 }
 
-/// The base motion of `config` when it is not the chain's own harmonic (kind, how it was run,
-/// spline accuracy, record scaling).
-pub fn base_motion_of(config: &Config) -> Option<BaseMotionSummary> {
-    BaseMotionSummary::of(&config.run_spec(true))
-}
-
 /// `sweep.json`: everything that determines a sweep's output.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepManifest {
@@ -39,27 +31,9 @@ pub struct SweepManifest {
     /// How the values start.
     #[serde(default)]
     pub continuation: Continuation,
-    /// Transient periods per value.
-    #[serde(default)]
-    pub transient_periods: u64,
-    /// Recorded periods per value.
-    #[serde(default)]
-    pub recorded_periods: u64,
-    /// Relative tolerance of the period detection.
-    #[serde(default)]
-    pub period_tolerance: f64,
-    /// Longest period detected, in excitation periods.
-    #[serde(default)]
-    pub max_period_detected: usize,
-    /// Grazing threshold of the closing speed, relative.
-    #[serde(default)]
-    pub grazing_ratio: f64,
-    /// Periods the charge solver warms up over before its recorded window.
-    #[serde(default)]
-    pub electrical_warmup_periods: u64,
-    /// Mechanics only (no harvester).
-    #[serde(default)]
-    pub mechanics_only: bool,
+    /// The point runner's periods, tolerances and `mechanics_only`.
+    #[serde(flatten)]
+    pub runner: RunnerRecord,
     /// The shard, if the job is one.
     #[serde(default)]
     pub shard: Option<ShardRecord>,
@@ -110,15 +84,9 @@ pub struct MapManifest {
     pub x: Axis,
     /// The y axis.
     pub y: Axis,
-    /// Transient periods per point.
-    #[serde(default)]
-    pub transient_periods: u64,
-    /// Recorded periods per point.
-    #[serde(default)]
-    pub recorded_periods: u64,
-    /// Relative tolerance of the period detection.
-    #[serde(default)]
-    pub period_tolerance: f64,
+    /// The periods of each point and the period detection's tolerance.
+    #[serde(flatten)]
+    pub point: PointRecord,
     /// Mechanics only (no harvester).
     #[serde(default)]
     pub mechanics_only: bool,
@@ -139,6 +107,65 @@ pub struct MapManifest {
     pub base_motion: Option<BaseMotionSummary>,
 }
 
+impl SweepManifest {
+    /// The manifest of a sweep of `axis` by `runner`, its values started as `continuation`
+    /// says, with Lyapunov columns if `lyapunov`; not a shard.
+    pub fn new(
+        axis: Axis,
+        continuation: Continuation,
+        runner: &PointRunner,
+        lyapunov: bool,
+    ) -> Result<Self, serde_json::Error> {
+        let o = runner.options();
+        Ok(SweepManifest {
+            command: Kind::Sweep,
+            axis,
+            continuation,
+            runner: RunnerRecord::of(runner),
+            shard: None,
+            settings: settings_of(runner.base())?,
+            vibrotribo_version: version(),
+            floquet: o.floquet,
+            settle: SettleRecord::of(o),
+            base_motion: base_motion_of(runner.base()),
+            lyapunov,
+        })
+    }
+}
+
+impl MapManifest {
+    /// The manifest of a map of the axes `x` and `y` by `runner`; not a shard.
+    pub fn new(x: Axis, y: Axis, runner: &PointRunner) -> Result<Self, serde_json::Error> {
+        let o = runner.options();
+        Ok(MapManifest {
+            command: Kind::Map,
+            x,
+            y,
+            point: PointRecord::of(o),
+            mechanics_only: runner.mechanics_only(),
+            shard: None,
+            settings: settings_of(runner.base())?,
+            floquet: o.floquet,
+            settle: SettleRecord::of(o),
+            base_motion: base_motion_of(runner.base()),
+        })
+    }
+}
+
+impl Axis {
+    /// The axis of `param` over `values`, its range their first and last (`0` when there are
+    /// none) and its steps their number.
+    pub fn of_values(param: &str, values: &[f64]) -> Self {
+        Axis {
+            param: param.to_string(),
+            from: values.first().copied().unwrap_or(0.0),
+            to: values.last().copied().unwrap_or(0.0),
+            steps: values.len(),
+            values: values.to_vec(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,6 +183,7 @@ mod tests {
         );
         let m: SweepManifest = serde_json::from_str(&fixed).expect("a sweep manifest");
         assert!(m.floquet && m.lyapunov && m.settle.settle_cap_periods.is_none());
+        assert_eq!(m.runner.detection.max_period_detected, 32);
         assert_eq!(serde_json::to_string(&m).expect("serialises"), fixed);
     }
 
