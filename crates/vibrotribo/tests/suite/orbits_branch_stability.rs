@@ -5,44 +5,15 @@
 //! "stable", and leaves it where they say "unstable", over as many periods as they predict
 //! for a factor of 10⁶ (the test asks for 10).
 
-use nalgebra::DVector;
-use vibrotribo::ChainState;
-use vibrotribo::orbits::{
-    ContinuationOptions, ShootingOptions, continue_orbit, periodic_orbit_from_transient,
-};
+use vibrotribo::orbits::{ContinuationOptions, continue_orbit};
 use vibrotribo::sensitivity::{Horizon, length_scale, speed_scale, state_vector};
-use vibrotribo::{ChainParams, Frequency};
 
+use super::common::default_case::{chain, size, start_orbit};
 use super::common::fd;
-
-fn chain(omega: f64) -> ChainParams {
-    let mut p = ChainParams::default();
-    p.excitation.frequency = Frequency::OmegaRatio(omega);
-    p
-}
-
-/// The size of a state deviation, positions over the length scale and velocities over the
-/// speed scale.
-fn size(params: &ChainParams, d: &DVector<f64>) -> f64 {
-    let n = d.len() / 2;
-    let (lx, lv) = (length_scale(params), speed_scale(params));
-    (0..d.len())
-        .map(|i| d[i] / if i < n { lx } else { lv })
-        .map(|x| x * x)
-        .sum::<f64>()
-        .sqrt()
-}
 
 #[test]
 fn branch_stability_is_what_a_perturbed_run_from_its_states_shows() {
-    let start = periodic_orbit_from_transient(
-        &chain(0.7),
-        &ChainState::at_rest(3),
-        300,
-        Some(1),
-        &ShootingOptions::default(),
-    )
-    .unwrap();
+    let start = start_orbit();
     let options = ContinuationOptions {
         doubling_depth: 1,
         ..ContinuationOptions::default()

@@ -5,45 +5,15 @@
 //! of each, run forward by the plain simulator (not the shooting map), returns to its state
 //! after twice the period of its parent and not after once.
 
-use nalgebra::DVector;
-use vibrotribo::ChainState;
-use vibrotribo::orbits::{
-    BifurcationKind, BranchEnd, ContinuationOptions, ShootingOptions, continue_orbit,
-    periodic_orbit_from_transient,
-};
-use vibrotribo::sensitivity::{Horizon, length_scale, speed_scale, state_vector};
-use vibrotribo::{ChainParams, Frequency};
+use vibrotribo::orbits::{BifurcationKind, BranchEnd, ContinuationOptions, continue_orbit};
+use vibrotribo::sensitivity::{Horizon, state_vector};
 
+use super::common::default_case::{chain, size, start_orbit};
 use super::common::fd;
-
-fn chain(omega: f64) -> ChainParams {
-    let mut p = ChainParams::default();
-    p.excitation.frequency = Frequency::OmegaRatio(omega);
-    p
-}
-
-/// The size of a state deviation, positions over the length scale and velocities over the
-/// speed scale.
-fn size(params: &ChainParams, d: &DVector<f64>) -> f64 {
-    let n = d.len() / 2;
-    let (lx, lv) = (length_scale(params), speed_scale(params));
-    (0..d.len())
-        .map(|i| d[i] / if i < n { lx } else { lv })
-        .map(|x| x * x)
-        .sum::<f64>()
-        .sqrt()
-}
 
 #[test]
 fn both_mirror_image_doublings_switch_onto_a_true_doubled_orbit() {
-    let start = periodic_orbit_from_transient(
-        &chain(0.7),
-        &ChainState::at_rest(3),
-        300,
-        Some(1),
-        &ShootingOptions::default(),
-    )
-    .unwrap();
+    let start = start_orbit();
     let options = ContinuationOptions {
         doubling_depth: 1,
         ..ContinuationOptions::default()

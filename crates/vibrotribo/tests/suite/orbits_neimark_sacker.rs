@@ -6,20 +6,14 @@
 //! the other, turning by that angle each period.
 
 use nalgebra::{DMatrix, DVector};
+use vibrotribo::ChainParams;
 use vibrotribo::orbits::{
     BifurcationKind, ContinuationOptions, ShootingOptions, continue_orbit, find_periodic_orbit,
-    periodic_orbit_from_transient,
 };
 use vibrotribo::sensitivity::{Horizon, length_scale, speed_scale, state_vector};
-use vibrotribo::{ChainParams, ChainState, Frequency};
 
+use super::common::default_case::{chain, start_orbit};
 use super::common::fd;
-
-fn chain(omega: f64) -> ChainParams {
-    let mut p = ChainParams::default();
-    p.excitation.frequency = Frequency::OmegaRatio(omega);
-    p
-}
 
 /// The Jacobian of the one-period stroboscopic map at `z` by central differences of plain
 /// runs, each coordinate stepped by 1e-6 of its scale.
@@ -54,14 +48,7 @@ fn pair(j: DMatrix<f64>) -> (f64, f64) {
 
 #[test]
 fn a_neimark_sacker_point_is_where_direct_simulation_starts_to_spiral_out() {
-    let start = periodic_orbit_from_transient(
-        &chain(0.7),
-        &ChainState::at_rest(3),
-        300,
-        Some(1),
-        &ShootingOptions::default(),
-    )
-    .unwrap();
+    let start = start_orbit();
     let result = continue_orbit(
         "omega_ratio",
         chain,

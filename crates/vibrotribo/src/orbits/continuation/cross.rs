@@ -246,6 +246,30 @@ fn orbit_beyond<F: Fn(f64) -> ChainParams>(
     arclength: f64,
     old: &[(EventKind, usize)],
 ) -> Option<StepPoint> {
+    let target = flow_sequence(problem, z, p)?;
+    if target == old {
+        return None;
+    }
+    orbit_keeping(problem, z, p, arclength, &target)
+}
+
+/// The orbit at `p` from `z` with the event sequence of the flow from `z` (Newton's method
+/// held to it).
+pub(super) fn orbit_following<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    z: &DVector<f64>,
+    p: f64,
+    arclength: f64,
+) -> Option<StepPoint> {
+    orbit_keeping(problem, z, p, arclength, &flow_sequence(problem, z, p)?)
+}
+
+/// The event sequence over the problem's period of the flow from `z` at `p`.
+fn flow_sequence<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    z: &DVector<f64>,
+    p: f64,
+) -> Option<Vec<(EventKind, usize)>> {
     let params = (problem.family)(p);
     let opts = &problem.options.shooting;
     let first = evaluate(
@@ -258,11 +282,7 @@ fn orbit_beyond<F: Fn(f64) -> ChainParams>(
     )
     .ok()?;
     let end = problem.phase + f64::from(problem.period) * params.period();
-    let target = sequence(&first.events, end);
-    if target == old {
-        return None;
-    }
-    orbit_keeping(problem, z, p, arclength, &target)
+    Some(sequence(&first.events, end))
 }
 
 /// A unit vector along the parameter, signed.

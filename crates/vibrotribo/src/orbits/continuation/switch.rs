@@ -21,10 +21,9 @@ use nalgebra::DVector;
 
 use super::super::error::NewtonFailure;
 use super::corrector::{Evaluated, Failure, Problem};
-use super::cross::{orbit_keeping, sequence};
+use super::cross::orbit_following;
 use super::locate::{Step, StepPoint};
 use crate::model::ChainParams;
-use crate::orbits::map::evaluate;
 
 /// How a branch leaves its parent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -204,7 +203,7 @@ fn doubled_at_fixed_parameter<F: Fn(f64) -> ChainParams>(
                     return None;
                 }
                 let guess = problem.state(&(u + &v * eps));
-                let Some(found) = orbit_near(problem, &guess, p) else {
+                let Some(found) = orbit_following(problem, &guess, p, 0.0) else {
                     continue;
                 };
                 let away = &found.ev.u - u;
@@ -224,28 +223,6 @@ fn doubled_at_fixed_parameter<F: Fn(f64) -> ChainParams>(
 /// The length of the state part of the scaled vector `d`.
 fn state_distance(d: &DVector<f64>, dim: usize) -> f64 {
     d.rows(0, dim).norm()
-}
-
-/// The orbit at `p` from `z`, Newton's method held to the event sequence of the flow from `z`.
-fn orbit_near<F: Fn(f64) -> ChainParams>(
-    problem: &Problem<'_, F>,
-    z: &DVector<f64>,
-    p: f64,
-) -> Option<StepPoint> {
-    let params = (problem.family)(p);
-    let opts = &problem.options.shooting;
-    let first = evaluate(
-        &params,
-        z,
-        problem.period,
-        problem.phase,
-        &opts.sim,
-        &opts.sensitivity,
-    )
-    .ok()?;
-    let end = problem.phase + f64::from(problem.period) * params.period();
-    let keep = sequence(&first.events, end);
-    orbit_keeping(problem, z, p, 0.0, &keep)
 }
 
 /// Whether the first point `p` of a branch leaving the fork at `u` fell back onto the

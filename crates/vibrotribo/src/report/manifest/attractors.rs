@@ -180,15 +180,8 @@ impl AttractorsManifest {
 
 #[cfg(test)]
 mod tests {
+    use super::super::round_trips;
     use super::*;
-    use serde::de::DeserializeOwned;
-
-    /// `text` read as `T` and written back gives the same text.
-    fn round_trips<T: DeserializeOwned + Serialize>(text: &str) -> T {
-        let m: T = serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"));
-        assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
-        m
-    }
 
     #[test]
     fn basins_manifest_round_trips_byte_for_byte() {

@@ -149,13 +149,8 @@ pub struct ChirpManifest {
 
 #[cfg(test)]
 mod tests {
+    use super::super::round_trips;
     use super::*;
-
-    fn round_trips<T: serde::de::DeserializeOwned + Serialize>(text: &str) -> T {
-        let m: T = serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"));
-        assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
-        m
-    }
 
     #[test]
     fn chirp_manifest_round_trips_byte_for_byte() {

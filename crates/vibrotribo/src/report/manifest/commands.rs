@@ -354,16 +354,8 @@ pub struct LyapunovManifest {
 
 #[cfg(test)]
 mod tests {
+    use super::super::round_trips;
     use super::*;
-    use serde::de::DeserializeOwned;
-
-    /// `text` (a command's manifest as the program wrote it, with its `settings` emptied and
-    /// its long lists cut) read as `T` and written back gives the same text.
-    fn round_trips<T: DeserializeOwned + Serialize>(text: &str) -> T {
-        let m: T = serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"));
-        assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
-        m
-    }
 
     #[test]
     fn continue_manifest_round_trips_byte_for_byte() {

@@ -33,3 +33,12 @@ pub use records::{
 pub use response::*;
 
 pub use super::SettleRecord;
+
+/// `text` (a command's manifest as the program wrote it, with its `settings` emptied and its
+/// long lists cut) read as `T` and written back gives the same text.
+#[cfg(test)]
+fn round_trips<T: serde::de::DeserializeOwned + serde::Serialize>(text: &str) -> T {
+    let m: T = serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"));
+    assert_eq!(serde_json::to_string(&m).expect("serialises"), text);
+    m
+}

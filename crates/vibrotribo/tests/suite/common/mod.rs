@@ -4,6 +4,7 @@
 
 pub mod balance;
 pub mod base_motion;
+pub mod default_case;
 pub mod electrostatics;
 pub mod fd;
 pub mod impact_oscillator;

@@ -1,0 +1,39 @@
+//! The paper's default case as the continuation tests use it: its chain at a frequency ratio,
+//! the stable period-1 orbit at Ω = 0.7 a transient from rest settles on, and the size of a
+//! state deviation in the scales of the chain.
+
+use nalgebra::DVector;
+use vibrotribo::orbits::{PeriodicOrbit, ShootingOptions, periodic_orbit_from_transient};
+use vibrotribo::sensitivity::{length_scale, speed_scale};
+use vibrotribo::{ChainParams, ChainState, Frequency};
+
+/// The default chain at the frequency ratio `omega`.
+pub fn chain(omega: f64) -> ChainParams {
+    let mut p = ChainParams::default();
+    p.excitation.frequency = Frequency::OmegaRatio(omega);
+    p
+}
+
+/// The period-1 orbit at Ω = 0.7, after 300 periods from rest.
+pub fn start_orbit() -> PeriodicOrbit {
+    periodic_orbit_from_transient(
+        &chain(0.7),
+        &ChainState::at_rest(3),
+        300,
+        Some(1),
+        &ShootingOptions::default(),
+    )
+    .expect("the default case's period-1 orbit at Ω = 0.7")
+}
+
+/// The size of a state deviation, positions over the length scale and velocities over the
+/// speed scale.
+pub fn size(params: &ChainParams, d: &DVector<f64>) -> f64 {
+    let n = d.len() / 2;
+    let (lx, lv) = (length_scale(params), speed_scale(params));
+    (0..d.len())
+        .map(|i| d[i] / if i < n { lx } else { lv })
+        .map(|x| x * x)
+        .sum::<f64>()
+        .sqrt()
+}
