@@ -128,15 +128,12 @@ pub fn basins<'py>(
         &results,
         &options,
     )?;
-    let axis = |param: &str, from: f64, to: f64, values: &[f64]| Axis {
-        param: param.to_string(),
-        from,
-        to,
-        steps: values.len(),
-        values: values.to_vec(),
-    };
-    let manifest = BasinsManifest::new(&starts, axis(&x, x_from, x_to, &xs), axis(&y, y_from, y_to, &ys))
-        .map_err(json_error)?;
+    let manifest = BasinsManifest::new(
+        &starts,
+        Axis::new(&x, (x_from, x_to), xs.clone()),
+        Axis::new(&y, (y_from, y_to), ys.clone()),
+    )
+    .map_err(json_error)?;
     let s = manifest_dict(py, &manifest)?;
     // The keys by name, their values as lists (basins.json's x and y are the axes).
     s.set_item("x", x)?;

@@ -182,13 +182,7 @@ pub fn manifest_of(
     values: &[f64],
     sampling: &RandomStarts,
 ) -> Result<AttractorsManifest> {
-    let axis = Axis {
-        param: param.to_string(),
-        from,
-        to,
-        steps: values.len(),
-        values: values.to_vec(),
-    };
+    let axis = Axis::new(param, (from, to), values.to_vec());
     Ok(AttractorsManifest::new(starts, axis, sampling)?)
 }
 

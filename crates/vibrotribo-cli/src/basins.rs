@@ -247,17 +247,10 @@ pub fn run(args: &BasinsArgs) -> Result<()> {
     }
     let o = starts.point_runner().options();
     crate::job::check_recorded(o)?;
-    let axis = |param: &String, from: f64, to: f64, values: Vec<f64>| Axis {
-        param: param.clone(),
-        from,
-        to,
-        steps: values.len(),
-        values,
-    };
     let grid = BasinGrid {
         starts,
-        x: axis(&args.x, args.x_from, args.x_to, xs),
-        y: axis(&args.y, args.y_from, args.y_to, ys),
+        x: Axis::new(&args.x, (args.x_from, args.x_to), xs),
+        y: Axis::new(&args.y, (args.y_from, args.y_to), ys),
     };
     let settings = crate::manifest::to_value(&grid.manifest(args.shard)?)?;
     let keys: Vec<String> = points.iter().map(key_of).collect();

@@ -401,13 +401,6 @@ fn manifest_of(
     done: usize,
     complete: bool,
 ) -> Result<BifmapManifest> {
-    let axis = |param: &str, from: f64, to: f64, values: &[f64]| Axis {
-        param: param.to_string(),
-        from,
-        to,
-        steps: values.len(),
-        values: values.to_vec(),
-    };
     let seeds = map
         .seeds
         .iter()
@@ -451,8 +444,8 @@ fn manifest_of(
     Ok(BifmapManifest {
         command: Kind::Bifmap,
         complete,
-        x: axis(&map.x, args.x_from, args.x_to, xs),
-        y: axis(&map.y, args.y_from, args.y_to, ys),
+        x: Axis::new(&map.x, (args.x_from, args.x_to), xs.to_vec()),
+        y: Axis::new(&map.y, (args.y_from, args.y_to), ys.to_vec()),
         seed_values: grid(args.y_from, args.y_to, args.seeds),
         x_starts: grid(args.x_from, args.x_to, args.x_starts),
         kinds: args.kinds.iter().map(|k| k.trim().to_string()).collect(),

@@ -79,19 +79,29 @@ pub enum BranchError {
 /// corrector evaluating it fails and the branch ends there.
 ///
 /// The key is resolved once ([`Param`]), so that each value is set in the document's types
-/// directly rather than written and read back as TOML.
+/// directly rather than written and read back as TOML; a key that cannot apply to `config`
+/// gives the invalid chain at every value.
 pub fn config_family(config: &Config, key: &str) -> impl Fn(f64) -> ChainParams {
-    let n = config.chain().len();
     let param = Param::new(config, key).ok();
-    move |v: f64| match match &param {
-        Some(p) => config.with_values(&[(p, v)]),
-        None => config.with(key, toml::Value::Float(v)),
-    } {
-        Ok(c) => c.chain().clone(),
-        Err(_) => ChainParams {
-            masses: vec![f64::NAN; n],
-            ..config.chain().clone()
-        },
+    move |v: f64| match &param {
+        Some(p) => chain_with(config, &[(p, v)]),
+        None => invalid_chain(config),
+    }
+}
+
+/// The chain of `config` with `values` set, or [`invalid_chain`] where they make an invalid
+/// configuration.
+pub(crate) fn chain_with(config: &Config, values: &[(&Param, f64)]) -> ChainParams {
+    config
+        .with_values(values)
+        .map_or_else(|_| invalid_chain(config), |c| c.chain().clone())
+}
+
+/// The chain of `config` with not-a-number masses, which fails its validation.
+pub(crate) fn invalid_chain(config: &Config) -> ChainParams {
+    ChainParams {
+        masses: vec![f64::NAN; config.chain().len()],
+        ..config.chain().clone()
     }
 }
 

@@ -8,7 +8,10 @@
 use thiserror::Error;
 
 use crate::ChainParams;
-use crate::branch::{BRANCH_POWER_PERIODS, BRANCH_POWER_WARMUP, BranchError, BranchOptions, continue_config};
+use crate::branch::{
+    BRANCH_POWER_PERIODS, BRANCH_POWER_WARMUP, BranchError, BranchOptions, chain_with, continue_config,
+    invalid_chain,
+};
 use crate::config::{Config, ConfigError, Param};
 use crate::orbits::curve::{Curve, CurveError, CurveKind, CurveOptions, CurveStart, continue_curve};
 use crate::orbits::{
@@ -151,21 +154,13 @@ pub fn canonical_key(key: &str) -> String {
 /// corrector fails there and the curve ends.
 ///
 /// The keys are resolved once ([`Param`]), so that each pair of values is set in the
-/// document's types directly rather than written and read back as TOML.
+/// document's types directly rather than written and read back as TOML; a key that cannot
+/// apply to `config` gives the invalid chain at every value.
 pub fn config_family2(config: &Config, key: &str, key2: &str) -> impl Fn(f64, f64) -> ChainParams {
-    let n = config.chain().len();
     let params = Param::new(config, key).ok().zip(Param::new(config, key2).ok());
-    move |p1: f64, p2: f64| match match &params {
-        Some((a, b)) => config.with_values(&[(a, p1), (b, p2)]),
-        None => config
-            .with(key, toml::Value::Float(p1))
-            .and_then(|c| c.with(key2, toml::Value::Float(p2))),
-    } {
-        Ok(c) => c.chain().clone(),
-        Err(_) => ChainParams {
-            masses: vec![f64::NAN; n],
-            ..config.chain().clone()
-        },
+    move |p1: f64, p2: f64| match &params {
+        Some((a, b)) => chain_with(config, &[(a, p1), (b, p2)]),
+        None => invalid_chain(config),
     }
 }
 

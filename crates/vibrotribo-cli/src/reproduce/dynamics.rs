@@ -295,13 +295,7 @@ fn basins(ctx: &Ctx, name: &str, sets: &[&str], x: (f64, f64)) -> Result<(usize,
         AttractorOptions::default(),
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let axis = |param: &str, (from, to): (f64, f64)| Axis {
-        param: param.into(),
-        from,
-        to,
-        steps: n,
-        values: grid(from, to, n),
-    };
+    let axis = |param: &str, (from, to): (f64, f64)| Axis::new(param, (from, to), grid(from, to, n));
     let grid = BasinGrid {
         starts,
         x: axis("run.initial_positions[1]", x),

@@ -207,7 +207,7 @@ fn doubled_at_fixed_parameter<F: Fn(f64) -> ChainParams>(
                     continue;
                 };
                 let away = &found.ev.u - u;
-                if collapsed(problem, &found) || state_distance(&away, dim) > 2.0 * eps {
+                if collapsed(problem, &found) || away.rows(0, dim).norm() > 2.0 * eps {
                     continue;
                 }
                 let Some(t) = problem.tangent(&found.ev, &away) else {
@@ -218,11 +218,6 @@ fn doubled_at_fixed_parameter<F: Fn(f64) -> ChainParams>(
         }
     }
     None
-}
-
-/// The length of the state part of the scaled vector `d`.
-fn state_distance(d: &DVector<f64>, dim: usize) -> f64 {
-    d.rows(0, dim).norm()
 }
 
 /// Whether the first point `p` of a branch leaving the fork at `u` fell back onto the

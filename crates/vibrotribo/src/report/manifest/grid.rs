@@ -153,6 +153,17 @@ impl MapManifest {
 }
 
 impl Axis {
+    /// The axis of `param` from `from` to `to` over `values`, its steps their number.
+    pub fn new(param: impl Into<String>, (from, to): (f64, f64), values: Vec<f64>) -> Self {
+        Axis {
+            param: param.into(),
+            from,
+            to,
+            steps: values.len(),
+            values,
+        }
+    }
+
     /// The axis of `param` over `values`, its range their first and last (`0` when there are
     /// none) and its steps their number.
     pub fn of_values(param: &str, values: &[f64]) -> Self {
