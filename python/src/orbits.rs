@@ -320,6 +320,11 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
             d.set_item("branch", branch)?;
             "rejoined"
         }
+        BranchEnd::RunsOnto { parameter, branch } => {
+            d.set_item("parameter", parameter)?;
+            d.set_item("branch", branch)?;
+            "runs_onto"
+        }
         _ => "other",
     };
     d.set_item("reason", reason)?;

@@ -545,7 +545,8 @@ class Branch(Display):
             ``step_floor``, ``grazing``, ``cascade_depth``, ``unlocated`` with the
             ``between`` bracket of a multiplier near −1 that could not be located,
             ``switch_failed``, ``collapsed``, ``closed``, ``rejoined`` with the ``branch``
-            it reached, ``stopped``) and its details.
+            it reached, ``runs_onto`` with the ``branch`` it ran onto past a change of
+            sequence, ``stopped``) and its details.
     """
 
     period: int

@@ -207,6 +207,11 @@ pub fn end_text(end: &BranchEnd) -> String {
         BranchEnd::Rejoined { parameter, branch } => {
             format!("reaches the branch point of branch {branch} at {parameter}, followed from there")
         }
+        BranchEnd::RunsOnto { parameter, branch } => {
+            format!(
+                "runs onto branch {branch} at {parameter} past a change of sequence (from there on it is that branch)"
+            )
+        }
         BranchEnd::Stopped { parameter } => format!("stopped by a signal after {parameter}"),
         other => format!("{other:?}"),
     }

@@ -52,6 +52,7 @@ mod orbits_doubling_switch;
 mod orbits_grazing;
 mod orbits_neimark_sacker;
 mod orbits_non_smooth_fold;
+mod orbits_runs_onto;
 mod orbits_shooting;
 mod properties;
 mod reference_default_case;

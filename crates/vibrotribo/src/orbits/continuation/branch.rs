@@ -9,6 +9,7 @@ use super::corrector::{Failure, Problem};
 use super::cross::{Bridged, cross};
 use super::detect::{Context, Ending, KnownBranchPoint, crossing_point, detect};
 use super::locate::{Step, StepPoint, locate_root};
+use super::onto::runs_onto;
 use super::phase::{move_section, too_close};
 use super::switch::{Fork, Found, Seed, Start, collapsed, cycle_amplitude, failure, flipped, start};
 use super::types::{BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions};
@@ -359,7 +360,14 @@ fn follow<F: Fn(f64) -> ChainParams>(
                     let before = b.crossing.and(last_crossed.as_deref())?;
                     Some((b.parameter, before))
                 });
-                match cross(&problem, &current, progress.signum(), (lo, hi), came_from) {
+                match cross(
+                    &problem,
+                    &current,
+                    progress.signum(),
+                    (lo, hi),
+                    came_from,
+                    branches,
+                ) {
                     Some(Bridged::Same(target, t_new)) => {
                         let target = *target;
                         branch.points.push(target.described.point.clone());
@@ -382,11 +390,18 @@ fn follow<F: Fn(f64) -> ChainParams>(
                             c.precision,
                             c.kind,
                         ));
-                        branch.points.push(c.after.described.point.clone());
-                        branch
-                            .points
-                            .extend(c.onward.iter().map(|o| o.described.point.clone()));
-                        let last = c.onward.into_iter().last().unwrap_or(c.after);
+                        // The orbits past the change, up to the first on a branch followed before.
+                        for o in std::iter::once(&c.after).chain(&c.onward) {
+                            branch.points.push(o.described.point.clone());
+                            if let Some(other) = runs_onto(&problem, branches, o) {
+                                branch.end = BranchEnd::RunsOnto {
+                                    parameter: o.described.point.parameter,
+                                    branch: other,
+                                };
+                                return Followed::New(Box::new(branch), doublings);
+                            }
+                        }
+                        let last = c.onward.last().unwrap_or(&c.after).clone();
                         let p = last.described.point.parameter;
                         if p <= lo || p >= hi {
                             branch.end = BranchEnd::RangeEnd { parameter: p };

@@ -40,7 +40,8 @@ use nalgebra::DVector;
 use super::corrector::Problem;
 use super::locate::{MAX_LOCATE, StepPoint};
 use super::nordmark::SquareRootModel;
-use super::types::CrossingKind;
+use super::onto::known_guesses;
+use super::types::{Branch, CrossingKind};
 use crate::dynamics::EventKind;
 use crate::model::ChainParams;
 use crate::orbits::gaps::{gap_gradient, smallest_gap_minimum};
@@ -98,13 +99,16 @@ pub(crate) enum Bridged {
 /// `[lo, hi]` (module docs).
 ///
 /// `came_from`: the parameter of the last change crossed and the sequence before it; the
-/// branch does not cross back onto that sequence there.
+/// branch does not cross back onto that sequence there. `known`: the branches followed
+/// before, whose orbits near the edge are tried last as orbits with the new sequence (the
+/// branch may land on one of them: see [`runs_onto`](super::onto::runs_onto)).
 pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
     current: &StepPoint,
     direction: f64,
     (lo, hi): (f64, f64),
     came_from: Option<(f64, &[(EventKind, usize)])>,
+    known: &[Branch],
 ) -> Option<Bridged> {
     let parameter = |s: &StepPoint| s.described.point.parameter;
     let signature = &current.described.signature;
@@ -186,7 +190,8 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                 .iter()
                 .chain(&edge_guesses)
                 .find_map(&beyond)
-                .or_else(|| guesses(problem, &ok, p).iter().skip(1).find_map(&beyond));
+                .or_else(|| guesses(problem, &ok, p).iter().skip(1).find_map(&beyond))
+                .or_else(|| known_guesses(problem, known, &ok, p).iter().find_map(&beyond));
             if let Some(o) = found {
                 return crossed(
                     problem,

@@ -52,6 +52,7 @@ mod cross;
 mod detect;
 mod locate;
 mod nordmark;
+mod onto;
 mod phase;
 mod switch;
 mod types;

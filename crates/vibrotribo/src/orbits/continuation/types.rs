@@ -401,6 +401,17 @@ pub enum BranchEnd {
         /// The branch it lies on.
         branch: usize,
     },
+    /// Past a change of its event sequence the branch runs onto a branch followed before
+    /// (`branch`): its last point lies on that branch (on a chord between two of its
+    /// consecutive points with the same impacts, in the scaled state and parameter), so from
+    /// there on it would repeat that branch. Several families meet so where a grazing joins
+    /// them, such as the two asymmetric orbits of a pitchfork and their symmetric parent.
+    RunsOnto {
+        /// Parameter of the last point.
+        parameter: f64,
+        /// The branch it runs onto.
+        branch: usize,
+    },
     /// The caller asked the continuation to stop
     /// ([`ShootingOptions::cancel`](crate::orbits::ShootingOptions::cancel), polled at every
     /// step): the branch is cut after its last point, and no further branch is followed.
@@ -426,6 +437,7 @@ impl BranchEnd {
             BranchEnd::Collapsed { .. } => "collapsed",
             BranchEnd::Closed { .. } => "closed",
             BranchEnd::Rejoined { .. } => "rejoined",
+            BranchEnd::RunsOnto { .. } => "runs_onto",
             BranchEnd::Stopped { .. } => "stopped",
         }
     }
@@ -443,6 +455,7 @@ impl BranchEnd {
             | BranchEnd::Collapsed { parameter }
             | BranchEnd::Closed { parameter }
             | BranchEnd::Rejoined { parameter, .. }
+            | BranchEnd::RunsOnto { parameter, .. }
             | BranchEnd::Stopped { parameter } => Some(*parameter),
             BranchEnd::MaxPoints => None,
         }

@@ -1,0 +1,121 @@
+//! Whether a branch, past a change of its event sequence, has run onto a branch followed
+//! before.
+//!
+//! Two smooth branches of one period meet only at a branch point (found by the detector); past
+//! a grazing or another change of sequence a branch can also land on a branch followed before,
+//! as where a grazing joins the two asymmetric orbits of a pitchfork to their symmetric
+//! parent. From there on it would repeat that branch, so it ends there.
+
+use nalgebra::DVector;
+
+use super::corrector::Problem;
+use super::cross::orbit_keeping;
+use super::locate::StepPoint;
+use super::types::{Branch, BranchPoint};
+use crate::dynamics::Simulator;
+use crate::model::ChainParams;
+use crate::sensitivity::{Sensitivity, state_from_vector, state_vector};
+
+/// Orbits of the branches followed before tried as guesses at a crossing: the nearest chords.
+const KNOWN_GUESSES: usize = 4;
+
+/// Largest distance of a point from a chord of a branch followed before, as a fraction of the
+/// chord's length, for the chord to be a candidate. A chord between two points whose tangents
+/// turn by at most ~25° (the corrector's limit) departs from the curve by at most about 6 % of
+/// its length.
+const ON_CHORD: f64 = 0.1;
+
+/// Largest distance, in the scaled state, between the point and the orbit Newton's method
+/// finds from the candidate chord for the two to be one orbit (both are converged far below).
+const SAME_ORBIT: f64 = 1e-6;
+
+/// The branch followed before (of `branches`) that `point` lies on, if any.
+///
+/// A candidate is a chord between two consecutive points of a branch with the period, impacts
+/// and sticking of `point`, inside which `point` projects within [`ON_CHORD`] of the chord's
+/// length (in the scaled state and parameter). It is confirmed by Newton's method, held to the
+/// event sequence of `point`, from the chord's state at the parameter of `point`: it must
+/// converge to `point` itself (within [`SAME_ORBIT`]).
+pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    branches: &[Branch],
+    point: &StepPoint,
+) -> Option<usize> {
+    let me = &point.described.point;
+    let at = |q: &BranchPoint| problem.point(&state_vector(&q.state), q.parameter);
+    let x = at(me);
+    let alike = |q: &BranchPoint| q.impacts_per_period == me.impacts_per_period && q.sticks == me.sticks;
+    // Points are reported at t ≡ 0 (mod PT): the confirmation runs on that section.
+    let section = problem.with_phase(0.0);
+    let z = state_vector(&me.state);
+    let confirms = |a: &BranchPoint, b: &BranchPoint, s: f64| {
+        let (za, zb) = (state_vector(&a.state), state_vector(&b.state));
+        let guess = &za + (zb - &za) * s;
+        orbit_keeping(
+            &section,
+            &guess,
+            me.parameter,
+            me.arclength,
+            &point.described.signature,
+        )
+        .is_some_and(|o| problem.scale.norm(&(state_vector(&o.described.point.state) - &z)) <= SAME_ORBIT)
+    };
+    branches.iter().position(|b| {
+        b.period == problem.period
+            && b.points.windows(2).any(|w| {
+                if !(alike(&w[0]) && alike(&w[1])) {
+                    return false;
+                }
+                let (a, d) = (at(&w[0]), at(&w[1]) - at(&w[0]));
+                let length = d.norm();
+                if length == 0.0 {
+                    return false;
+                }
+                let s = d.dot(&(&x - &a)) / (length * length);
+                (0.0..=1.0).contains(&s)
+                    && (&a + &d * s - &x).norm() <= ON_CHORD * length
+                    && confirms(&w[0], &w[1], s)
+            })
+    })
+}
+
+/// Initial states at the parameter `p`, on the problem's section, from the branches followed
+/// before (of the problem's period): each chord between two consecutive points whose
+/// parameters bracket `p`, interpolated there, carried from t ≡ 0 to the section by the flow
+/// at `p`; the [`KNOWN_GUESSES`] nearest the edge orbit `edge` (at t ≡ 0, in the scaled
+/// state), nearest first.
+pub(super) fn known_guesses<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    branches: &[Branch],
+    edge: &StepPoint,
+    p: f64,
+) -> Vec<DVector<f64>> {
+    let here = state_vector(&edge.described.point.state);
+    let mut near: Vec<(f64, DVector<f64>)> = branches
+        .iter()
+        .filter(|b| b.period == problem.period)
+        .flat_map(|b| b.points.windows(2))
+        .filter(|w| w[0].parameter != w[1].parameter && (w[0].parameter - p) * (w[1].parameter - p) <= 0.0)
+        .map(|w| {
+            let s = (p - w[0].parameter) / (w[1].parameter - w[0].parameter);
+            let (a, b) = (state_vector(&w[0].state), state_vector(&w[1].state));
+            let z = &a + (b - &a) * s;
+            (problem.scale.norm(&(&z - &here)), z)
+        })
+        .collect();
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let params = (problem.family)(p);
+    let sim = &problem.options.shooting.sim;
+    near.into_iter()
+        .take(KNOWN_GUESSES)
+        .filter_map(|(_, z)| {
+            if problem.phase == 0.0 {
+                return Some(z);
+            }
+            let mut run =
+                Simulator::new_at(&params, 0.0, &state_from_vector(z.as_slice()), sim.clone()).ok()?;
+            run.run_until(problem.phase, &mut None::<Sensitivity>).ok()?;
+            Some(state_vector(&run.state()))
+        })
+        .collect()
+}
