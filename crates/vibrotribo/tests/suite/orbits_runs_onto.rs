@@ -107,3 +107,102 @@ fn the_pitchforks_branches_end_where_they_run_onto_the_first_branch() {
         assert!(b.points.len() < 400, "branch {i} has {} points", b.points.len());
     }
 }
+
+/// The slowest impact's closing speed over `period` periods from `z` at `p`, m/s, by the plain
+/// simulator.
+fn slowest_impact(
+    at: &impl Fn(f64) -> vibrotribo::ChainParams,
+    p: f64,
+    z: &DVector<f64>,
+    period: u32,
+) -> f64 {
+    let (_, events) = fd::run(&at(p), z, Horizon::Periods(period)).expect("a plain run");
+    events
+        .iter()
+        .filter(|e| e.kind == vibrotribo::dynamics::EventKind::Impact)
+        .map(|e| e.velocity_before.abs())
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Where an impact of the old orbit disappears across a change of sequence, the point is a
+/// grazing only if that impact vanishes there: by the plain simulator, the edge orbit's
+/// slowest impact speed, over its rate of change from the branch's point before it,
+/// extrapolates to zero within 1e-6 of the range of the edge. Where it does not (the impact
+/// is still as fast as ~1e-3 m/s at an edge located to 1e-8), the point is a
+/// `sequence_change`: the old orbit was lost there and the orbit found beyond is of another
+/// family.
+#[test]
+fn an_impact_that_disappears_at_a_grazing_vanishes_there() {
+    // The default case's first four branches: the pitchfork's branches lose their
+    // eight-impact orbits where those are still striking at ~1e-3 m/s.
+    let (grazings, changes) = lost_impacts(Config::default(), (0.7, 0.3), None);
+    println!("{grazings} grazings");
+    assert!(
+        changes >= 2,
+        "the pitchfork's branches lose their eight-impact orbits: {changes}"
+    );
+}
+
+/// Follows `config` over `(from, to)` in Ω (four branches) and checks every change of
+/// sequence that loses an impact (test above); the grazings and sequence changes seen.
+fn lost_impacts(config: Config, (from, to): (f64, f64), period: Option<u32>) -> (usize, usize) {
+    let key = "excitation.omega_ratio";
+    let options = BranchOptions {
+        period,
+        continuation: ContinuationOptions {
+            doubling_depth: 1,
+            max_branches: 4,
+            ..ContinuationOptions::default()
+        },
+        ..BranchOptions::default()
+    };
+    let result = continue_config(&config, key, from, to, None, &options).unwrap();
+    let range = (to - from).abs();
+    let at = |p: f64| config.with(key, toml::Value::Float(p)).unwrap().chain().clone();
+    let (mut grazings, mut changes) = (0, 0);
+    for (i, b) in result.branches.iter().enumerate() {
+        for f in b.bifurcations.iter().filter(|f| f.crossing.is_some()) {
+            let Some(after) = &f.after else { continue };
+            let lost =
+                f.point.impacts_per_period.iter().sum::<f64>() > after.impacts_per_period.iter().sum::<f64>();
+            if !lost {
+                continue;
+            }
+            // The branch's point before the edge, on the old sequence.
+            let Some(prev) = b.points.iter().rev().find(|q| {
+                q.impacts_per_period == f.point.impacts_per_period
+                    && q.parameter != f.parameter
+                    && (q.parameter - f.parameter).abs() < 1e-3 * range
+            }) else {
+                continue;
+            };
+            let v_edge = slowest_impact(&at, f.parameter, &state_vector(&f.point.state), b.period);
+            let v_prev = slowest_impact(&at, prev.parameter, &state_vector(&prev.state), b.period);
+            let rate = (v_prev - v_edge).abs() / (prev.parameter - f.parameter).abs();
+            let to_zero = v_edge / rate;
+            println!(
+                "branch {i}, {:?} at {:.10}: slowest impact {v_edge:.3e} m/s, zero {to_zero:.2e} away",
+                f.kind, f.parameter
+            );
+            match f.kind {
+                BifurcationKind::Grazing { appears: false, .. } => {
+                    grazings += 1;
+                    assert!(
+                        to_zero < 1e-6 * range,
+                        "a grazing whose impact does not vanish: {to_zero:e}"
+                    );
+                }
+                BifurcationKind::SequenceChange => {
+                    changes += 1;
+                    assert!(
+                        to_zero > 1e-5 * range,
+                        "a vanishing impact not called a grazing: {to_zero:e}"
+                    );
+                }
+                _ => {}
+            }
+        }
+    }
+    println!("{grazings} grazings and {changes} sequence changes where an impact is lost");
+    (grazings, changes)
+}

@@ -388,6 +388,7 @@ fn follow<F: Fn(f64) -> ChainParams>(
                             &c.before,
                             &c.after,
                             c.precision,
+                            c.behind_speed,
                             c.kind,
                         ));
                         // The orbits past the change, up to the first on a branch followed before.

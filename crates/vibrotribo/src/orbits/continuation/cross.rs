@@ -81,6 +81,9 @@ pub(crate) struct Crossed {
     pub onward: Vec<StepPoint>,
     /// Accuracy of the point in the parameter.
     pub precision: f64,
+    /// The slowest impact (contact, closing speed in m/s) of the orbit with the old sequence
+    /// a little behind the edge, where it was found.
+    pub behind_speed: Option<(usize, f64)>,
     pub kind: CrossingKind,
     /// Tangent of the branch at the last of `onward` (or `after`), oriented the way it goes
     /// on.
@@ -153,14 +156,17 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
     // it, then from the generic guesses.
     let back =
         parameter(&ok) - direction * (1e-6 * problem.p_scale).max(10.0 * problem.options.location_tolerance);
-    let model = orbit_keeping(
+    let behind = orbit_keeping(
         problem,
         &problem.state(&ok.ev.u),
         back,
         arclength(back),
         signature,
-    )
-    .and_then(|behind| SquareRootModel::new(problem, &ok, &behind));
+    );
+    let model = behind
+        .as_ref()
+        .and_then(|b| SquareRootModel::new(problem, &ok, b));
+    let behind_speed = behind.and_then(|b| b.described.point.min_closing_speed);
     let edge_guesses = guesses(problem, &ok, parameter(&ok));
     // The persistence side first, at every distance: a symmetric orbit that grazes two
     // contacts at once may also meet orbits striking only one of them at a fold.
@@ -197,7 +203,7 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                     problem,
                     (ok, o),
                     model.as_ref(),
-                    precision,
+                    (precision, behind_speed),
                     (sigma, kind),
                     (lo, hi),
                 );
@@ -301,7 +307,7 @@ fn crossed<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
     (before, after): (StepPoint, StepPoint),
     model: Option<&SquareRootModel>,
-    precision: f64,
+    (precision, behind_speed): (f64, Option<(usize, f64)>),
     (direction, kind): (f64, CrossingKind),
     (lo, hi): (f64, f64),
 ) -> Option<Bridged> {
@@ -352,6 +358,7 @@ fn crossed<F: Fn(f64) -> ChainParams>(
         after,
         onward,
         precision,
+        behind_speed,
         kind,
         tangent,
     })))

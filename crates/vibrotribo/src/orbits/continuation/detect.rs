@@ -93,7 +93,7 @@ pub(super) fn detect<F: Fn(f64) -> ChainParams>(
         };
         found.push((
             left.theta,
-            crossing_point(problem, &left, &right, precision, kind),
+            crossing_point(problem, &left, &right, precision, None, kind),
             None,
         ));
         // The multipliers may jump across the change; look for smooth crossings on either
@@ -294,15 +294,37 @@ fn bifurcation(kind: BifurcationKind, l: &Located) -> Bifurcation {
 
 /// A change of the event sequence crossed between `before` and `after`: its kind, and for a
 /// grazing what the square-root map predicts from the multipliers of the orbit without the
-/// impact.
+/// impact. `behind_speed`: the slowest impact (contact, m/s) of the old orbit a little behind
+/// the edge `before`, where known; an impact that does not vanish at the edge makes the point
+/// a `sequence_change`, not a grazing.
 pub(super) fn crossing_point<F: Fn(f64) -> ChainParams>(
     problem: &Problem<'_, F>,
     before: &StepPoint,
     after: &StepPoint,
     precision: f64,
+    behind_speed: Option<(usize, f64)>,
     crossing: CrossingKind,
 ) -> Bifurcation {
-    let kind = classify(&before.described, &after.described, problem.scale.speed);
+    let mut kind = classify(&before.described, &after.described, problem.scale.speed);
+    // An impact that disappears at a grazing has a closing speed falling to zero at the edge
+    // (linearly in the parameter): from the orbit behind the edge its speed extrapolates to
+    // zero within the distance between the two, where the edge is located far closer. One
+    // that is still as fast as its change over that distance is not vanishing there: the edge
+    // is where the old orbit was lost, and the orbit found beyond is of another family.
+    if let (
+        BifurcationKind::Grazing {
+            contact,
+            appears: false,
+        },
+        Some((c_b, v_b)),
+        Some((c_e, v_e)),
+    ) = (kind, behind_speed, before.described.point.min_closing_speed)
+        && c_b == contact
+        && c_e == contact
+        && v_e > (v_b - v_e).abs()
+    {
+        kind = BifurcationKind::SequenceChange;
+    }
     let nordmark = match kind {
         BifurcationKind::Grazing { appears, .. } => {
             let free = if appears { before } else { after };
