@@ -17,6 +17,8 @@
 #   LOADS           load resistances to measure, Ω (default "1e5", the paper's 100 kΩ)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=bench/timing.sh
+. bench/timing.sh
 runs=${1:-3}
 shift || true
 rtols=("$@")
@@ -30,14 +32,6 @@ fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
-# CPU seconds (user + system) of one run of the command given.
-cpu() {
-    local TIMEFORMAT='%U %S'
-    local t
-    t=$({ time "$@" >/dev/null 2>&1; } 2>&1) || { echo "failed: $*" >&2; exit 1; }
-    awk '{printf "%.4f\n", $1 + $2}' <<<"$t"
-}
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 
 # The figures of one rtol's runs: steps and rejected steps per period (long run), the power
 # and per-period energy errors against the reference (short run).

@@ -8,6 +8,8 @@
 # Usage: bench/continuation.sh [RUNS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=bench/timing.sh
+. bench/timing.sh
 runs=${1:-3}
 cargo build --release -q -p vibrotribo-cli
 bin="${CARGO_TARGET_DIR:-target}"/release/vibrotribo
@@ -15,7 +17,6 @@ out=target/bench-continuation
 rm -rf "$out"
 mkdir -p "$out"
 
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 
 # Runs "$@" RUNS times into $out/$name; prints the median wall and CPU (user + system) seconds.
 timed() {

@@ -16,6 +16,8 @@
 #   ONLY            "harvester" or "coupling" to run one part
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=bench/timing.sh
+. bench/timing.sh
 runs=${1:-7}
 long=${2:-1000}
 bin=${VIBROTRIBO_BIN:-}
@@ -28,14 +30,6 @@ only=${ONLY:-}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
-# CPU seconds (user + system) of one run of the command given.
-cpu() {
-    local TIMEFORMAT='%U %S'
-    local t
-    t=$({ time "$@" >/dev/null 2>&1; } 2>&1) || { echo "failed: $*" >&2; exit 1; }
-    awk '{printf "%.4f\n", $1 + $2}' <<<"$t"
-}
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 
 # pair LABEL "A command" "B command": RUNS alternated pairs after one warm-up each; prints
 # the medians of A and B and the median of the pairs' ratios A/B.

@@ -9,6 +9,8 @@
 # Usage: bench/scaling.sh [RUNS] [STEPS]    (VIBROTRIBO_BIN: the binary to time)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=bench/timing.sh
+. bench/timing.sh
 runs=${1:-3}
 steps=${2:-81}
 bin=${VIBROTRIBO_BIN:-}
@@ -33,7 +35,6 @@ for _ in $(seq 1 "$runs"); do
     read -r w c < <(one 1); w1+=("$w"); c1+=("$c")
     read -r w c < <(one 2); w2+=("$w"); c2+=("$c")
 done
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 mw1=$(median "${w1[@]}"); mw2=$(median "${w2[@]}")
 echo "1 thread:  wall ${w1[*]} s (median $mw1), cpu ${c1[*]} s (median $(median "${c1[@]}"))"
 echo "2 threads: wall ${w2[*]} s (median $mw2), cpu ${c2[*]} s (median $(median "${c2[@]}"))"

@@ -6,6 +6,8 @@
 # ratio and how the auto run classified the values. Usage: bench/settle.sh [RUNS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=bench/timing.sh
+. bench/timing.sh
 runs=${1:-3}
 cargo build --release -q -p vibrotribo-cli
 out=target/bench-settle
@@ -26,7 +28,6 @@ for i in $(seq 1 "$runs"); do
     fixed+=("$(sweep fixed "$out/fixed-$i")")
     auto+=("$(sweep auto "$out/auto-$i")")
 done
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 ma=$(median "${auto[@]}")
 mf=$(median "${fixed[@]}")
 echo "fixed: ${fixed[*]} s, median $mf s"

@@ -8,7 +8,7 @@
 use vibrotribo::orbits::{BifurcationKind, BranchEnd, ContinuationOptions, continue_orbit};
 use vibrotribo::sensitivity::{Horizon, state_vector};
 
-use super::common::default_case::{chain, size, start_orbit};
+use super::common::default_case::{chain, pitchfork_branches, size, start_orbit};
 use super::common::fd;
 
 #[test]
@@ -21,13 +21,7 @@ fn both_mirror_image_doublings_switch_onto_a_true_doubled_orbit() {
     let result = continue_orbit("omega_ratio", chain, 0.7, 0.45, &start.state, 1, &options).unwrap();
     let branches = &result.branches;
     // The two branches born at the first branch's branch point.
-    let mirrors: Vec<usize> = (0..branches.len())
-        .filter(|&i| {
-            branches[i].parent.is_some_and(|(b, k)| {
-                b == 0 && matches!(branches[0].bifurcations[k].kind, BifurcationKind::BranchPoint)
-            })
-        })
-        .collect();
+    let mirrors = pitchfork_branches(branches);
     assert_eq!(mirrors.len(), 2, "the pitchfork's two branches: {mirrors:?}");
     // Their first period doublings, at the same Ω.
     let doubling = |i: usize| {

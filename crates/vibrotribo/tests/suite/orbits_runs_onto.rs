@@ -14,7 +14,7 @@ use vibrotribo::orbits::{
 };
 use vibrotribo::sensitivity::{Horizon, state_from_vector, state_vector};
 
-use super::common::default_case::size;
+use super::common::default_case::{pitchfork_branches, size};
 use super::common::fd;
 
 #[test]
@@ -46,13 +46,7 @@ fn the_pitchforks_branches_end_where_they_run_onto_the_first_branch() {
             b.end
         );
     }
-    let mirrors: Vec<usize> = (0..branches.len())
-        .filter(|&i| {
-            branches[i].parent.is_some_and(|(b, k)| {
-                b == 0 && matches!(branches[0].bifurcations[k].kind, BifurcationKind::BranchPoint)
-            })
-        })
-        .collect();
+    let mirrors = pitchfork_branches(branches);
     assert_eq!(mirrors.len(), 2, "the pitchfork's two branches: {mirrors:?}");
     for i in mirrors {
         let b = &branches[i];

@@ -3,13 +3,11 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::DVector;
-
 use super::corrector::{Failure, Problem};
 use super::cross::{Bridged, cross};
 use super::detect::{Context, Ending, KnownBranchPoint, crossing_point, detect};
 use super::locate::{Step, StepPoint, locate_root};
-use super::onto::runs_onto;
+use super::onto::{chord, runs_onto};
 use super::phase::{move_section, too_close};
 use super::switch::{Fork, Found, Seed, Start, collapsed, cycle_amplitude, failure, flipped, start};
 use super::types::{BifurcationKind, Branch, BranchEnd, BranchPoint, Continuation, ContinuationOptions};
@@ -228,17 +226,12 @@ fn followed_before<F: Fn(f64) -> ChainParams>(
     let point = |q: &BranchPoint| problem.point(&state_vector(&q.state), q.parameter);
     let x = point(first);
     let reach = (&x - point(fork)).norm();
-    let chord = |a: &DVector<f64>, b: &DVector<f64>| {
-        let d = b - a;
-        let s = (d.dot(&(&x - a)) / d.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-        (a + d * s - &x).norm()
-    };
     branches.iter().enumerate().position(|(i, b)| {
         i != parent
             && b.period == problem.period
             && b.points
                 .windows(2)
-                .any(|w| chord(&point(&w[0]), &point(&w[1])) < 0.25 * reach)
+                .any(|w| chord(&point(&w[0]), &point(&w[1]), &x).1 < 0.25 * reach)
     })
 }
 

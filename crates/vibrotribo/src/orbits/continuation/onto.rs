@@ -29,6 +29,20 @@ const ON_CHORD: f64 = 0.1;
 /// finds from the candidate chord for the two to be one orbit (both are converged far below).
 const SAME_ORBIT: f64 = 1e-6;
 
+/// Where `x` projects on the chord from `a` to `b`: the fraction `s` of the way along it (not
+/// clamped), and the distance from `x` to the chord's nearest point (within its ends).
+pub(super) fn chord(a: &DVector<f64>, b: &DVector<f64>, x: &DVector<f64>) -> (f64, f64) {
+    let d = b - a;
+    let s = d.dot(&(x - a)) / d.norm_squared().max(f64::MIN_POSITIVE);
+    (s, (a + d * s.clamp(0.0, 1.0) - x).norm())
+}
+
+/// The state a fraction `s` of the way from the point `a` to the point `b` (at t ≡ 0).
+fn between(a: &BranchPoint, b: &BranchPoint, s: f64) -> DVector<f64> {
+    let za = state_vector(&a.state);
+    &za + (state_vector(&b.state) - &za) * s
+}
+
 /// The branch followed before (of `branches`) that `point` lies on, if any.
 ///
 /// A candidate is a chord between two consecutive points of a branch with the period, impacts
@@ -49,8 +63,7 @@ pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
     let section = problem.with_phase(0.0);
     let z = state_vector(&me.state);
     let confirms = |a: &BranchPoint, b: &BranchPoint, s: f64| {
-        let (za, zb) = (state_vector(&a.state), state_vector(&b.state));
-        let guess = &za + (zb - &za) * s;
+        let guess = between(a, b, s);
         orbit_keeping(
             &section,
             &guess,
@@ -66,14 +79,12 @@ pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
                 if !(alike(&w[0]) && alike(&w[1])) {
                     return false;
                 }
-                let (a, d) = (at(&w[0]), at(&w[1]) - at(&w[0]));
-                let length = d.norm();
-                if length == 0.0 {
-                    return false;
-                }
-                let s = d.dot(&(&x - &a)) / (length * length);
-                (0.0..=1.0).contains(&s)
-                    && (&a + &d * s - &x).norm() <= ON_CHORD * length
+                let (a, b) = (at(&w[0]), at(&w[1]));
+                let length = (&b - &a).norm();
+                let (s, distance) = chord(&a, &b, &x);
+                length > 0.0
+                    && (0.0..=1.0).contains(&s)
+                    && distance <= ON_CHORD * length
                     && confirms(&w[0], &w[1], s)
             })
     })
@@ -97,9 +108,11 @@ pub(super) fn known_guesses<F: Fn(f64) -> ChainParams>(
         .flat_map(|b| b.points.windows(2))
         .filter(|w| w[0].parameter != w[1].parameter && (w[0].parameter - p) * (w[1].parameter - p) <= 0.0)
         .map(|w| {
-            let s = (p - w[0].parameter) / (w[1].parameter - w[0].parameter);
-            let (a, b) = (state_vector(&w[0].state), state_vector(&w[1].state));
-            let z = &a + (b - &a) * s;
+            let z = between(
+                &w[0],
+                &w[1],
+                (p - w[0].parameter) / (w[1].parameter - w[0].parameter),
+            );
             (problem.scale.norm(&(&z - &here)), z)
         })
         .collect();

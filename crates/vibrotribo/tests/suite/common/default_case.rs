@@ -3,7 +3,9 @@
 //! state deviation in the scales of the chain.
 
 use nalgebra::DVector;
-use vibrotribo::orbits::{PeriodicOrbit, ShootingOptions, periodic_orbit_from_transient};
+use vibrotribo::orbits::{
+    BifurcationKind, Branch, PeriodicOrbit, ShootingOptions, periodic_orbit_from_transient,
+};
 use vibrotribo::sensitivity::{length_scale, speed_scale};
 use vibrotribo::{ChainParams, ChainState, Frequency};
 
@@ -36,4 +38,15 @@ pub fn size(params: &ChainParams, d: &DVector<f64>) -> f64 {
         .map(|x| x * x)
         .sum::<f64>()
         .sqrt()
+}
+
+/// The branches born at a branch point of the first branch (its pitchfork's two branches).
+pub fn pitchfork_branches(branches: &[Branch]) -> Vec<usize> {
+    (0..branches.len())
+        .filter(|&i| {
+            branches[i].parent.is_some_and(|(b, k)| {
+                b == 0 && matches!(branches[0].bifurcations[k].kind, BifurcationKind::BranchPoint)
+            })
+        })
+        .collect()
 }

@@ -1,0 +1,12 @@
+# Shared by the bench scripts (sourced from the repository's root).
+
+# CPU seconds (user + system) of one run of the command given; stops the script if it fails.
+cpu() {
+    local TIMEFORMAT='%U %S'
+    local t
+    t=$({ time "$@" >/dev/null 2>&1; } 2>&1) || { echo "failed: $*" >&2; exit 1; }
+    awk '{printf "%.4f\n", $1 + $2}' <<<"$t"
+}
+
+# The median of the numbers given.
+median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
