@@ -40,19 +40,22 @@ use nalgebra::DVector;
 use super::corrector::Problem;
 use super::locate::{MAX_LOCATE, StepPoint};
 use super::nordmark::SquareRootModel;
-use super::onto::known_guesses;
 use super::types::{Branch, CrossingKind};
-use crate::dynamics::EventKind;
+use crate::dynamics::{EventKind, Simulator};
 use crate::model::ChainParams;
 use crate::orbits::gaps::{gap_gradient, smallest_gap_minimum};
 use crate::orbits::map::{chatter_bounces, evaluate, signature};
 use crate::orbits::shooting::newton_within;
+use crate::sensitivity::{Sensitivity, state_from_vector, state_vector};
 
 /// Parameter steps of the forward search, as fractions of the range: 1e-6 · 4^k.
 const FORWARD_TRIES: i32 = 8;
 
 /// Distances from the edge at which the new orbit is sought, fractions of the range.
 const SIDE_STEPS: [f64; 4] = [1e-6, 1e-5, 1e-4, 1e-3];
+
+/// Orbits of the branches followed before tried as guesses at a crossing: the nearest chords.
+const KNOWN_GUESSES: usize = 4;
 
 /// Penetrations (or lifts) of the guesses moved along the gap gradient, in the length unit.
 pub(super) const PENETRATIONS: [f64; 4] = [1e-12, 1e-10, 1e-8, 1e-6];
@@ -432,4 +435,43 @@ fn guesses<F: Fn(f64) -> ChainParams>(
         }
     }
     out
+}
+
+/// Initial states at the parameter `p`, on the problem's section, from the branches followed
+/// before (of the problem's period): each chord between two consecutive points whose
+/// parameters bracket `p`, interpolated there, carried from t ≡ 0 to the section by the flow
+/// at `p`; the [`KNOWN_GUESSES`] nearest the edge orbit `edge` (at t ≡ 0, in the scaled
+/// state), nearest first.
+fn known_guesses<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    branches: &[Branch],
+    edge: &StepPoint,
+    p: f64,
+) -> Vec<DVector<f64>> {
+    let here = state_vector(&edge.described.point.state);
+    let mut near: Vec<(f64, DVector<f64>)> = branches
+        .iter()
+        .filter(|b| b.period == problem.period)
+        .flat_map(|b| b.points.windows(2))
+        .filter(|w| w[0].parameter != w[1].parameter && (w[0].parameter - p) * (w[1].parameter - p) <= 0.0)
+        .map(|w| {
+            let z = w[0].towards(&w[1], (p - w[0].parameter) / (w[1].parameter - w[0].parameter));
+            (problem.scale.norm(&(&z - &here)), z)
+        })
+        .collect();
+    near.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let params = (problem.family)(p);
+    let sim = &problem.options.shooting.sim;
+    near.into_iter()
+        .take(KNOWN_GUESSES)
+        .filter_map(|(_, z)| {
+            if problem.phase == 0.0 {
+                return Some(z);
+            }
+            let mut run =
+                Simulator::new_at(&params, 0.0, &state_from_vector(z.as_slice()), sim.clone()).ok()?;
+            run.run_until(problem.phase, &mut None::<Sensitivity>).ok()?;
+            Some(state_vector(&run.state()))
+        })
+        .collect()
 }

@@ -12,12 +12,8 @@ use super::corrector::Problem;
 use super::cross::orbit_keeping;
 use super::locate::StepPoint;
 use super::types::{Branch, BranchPoint};
-use crate::dynamics::Simulator;
 use crate::model::ChainParams;
-use crate::sensitivity::{Sensitivity, state_from_vector, state_vector};
-
-/// Orbits of the branches followed before tried as guesses at a crossing: the nearest chords.
-const KNOWN_GUESSES: usize = 4;
+use crate::sensitivity::state_vector;
 
 /// Largest distance of a point from a chord of a branch followed before, as a fraction of the
 /// chord's length, for the chord to be a candidate. A chord between two points whose tangents
@@ -35,12 +31,6 @@ pub(super) fn chord(a: &DVector<f64>, b: &DVector<f64>, x: &DVector<f64>) -> (f6
     let d = b - a;
     let s = d.dot(&(x - a)) / d.norm_squared().max(f64::MIN_POSITIVE);
     (s, (a + d * s.clamp(0.0, 1.0) - x).norm())
-}
-
-/// The state a fraction `s` of the way from the point `a` to the point `b` (at t ≡ 0).
-fn between(a: &BranchPoint, b: &BranchPoint, s: f64) -> DVector<f64> {
-    let za = state_vector(&a.state);
-    &za + (state_vector(&b.state) - &za) * s
 }
 
 /// The branch followed before (of `branches`) that `point` lies on, if any.
@@ -63,7 +53,7 @@ pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
     let section = problem.with_phase(0.0);
     let z = state_vector(&me.state);
     let confirms = |a: &BranchPoint, b: &BranchPoint, s: f64| {
-        let guess = between(a, b, s);
+        let guess = a.towards(b, s);
         orbit_keeping(
             &section,
             &guess,
@@ -88,47 +78,4 @@ pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
                     && confirms(&w[0], &w[1], s)
             })
     })
-}
-
-/// Initial states at the parameter `p`, on the problem's section, from the branches followed
-/// before (of the problem's period): each chord between two consecutive points whose
-/// parameters bracket `p`, interpolated there, carried from t ≡ 0 to the section by the flow
-/// at `p`; the [`KNOWN_GUESSES`] nearest the edge orbit `edge` (at t ≡ 0, in the scaled
-/// state), nearest first.
-pub(super) fn known_guesses<F: Fn(f64) -> ChainParams>(
-    problem: &Problem<'_, F>,
-    branches: &[Branch],
-    edge: &StepPoint,
-    p: f64,
-) -> Vec<DVector<f64>> {
-    let here = state_vector(&edge.described.point.state);
-    let mut near: Vec<(f64, DVector<f64>)> = branches
-        .iter()
-        .filter(|b| b.period == problem.period)
-        .flat_map(|b| b.points.windows(2))
-        .filter(|w| w[0].parameter != w[1].parameter && (w[0].parameter - p) * (w[1].parameter - p) <= 0.0)
-        .map(|w| {
-            let z = between(
-                &w[0],
-                &w[1],
-                (p - w[0].parameter) / (w[1].parameter - w[0].parameter),
-            );
-            (problem.scale.norm(&(&z - &here)), z)
-        })
-        .collect();
-    near.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let params = (problem.family)(p);
-    let sim = &problem.options.shooting.sim;
-    near.into_iter()
-        .take(KNOWN_GUESSES)
-        .filter_map(|(_, z)| {
-            if problem.phase == 0.0 {
-                return Some(z);
-            }
-            let mut run =
-                Simulator::new_at(&params, 0.0, &state_from_vector(z.as_slice()), sim.clone()).ok()?;
-            run.run_until(problem.phase, &mut None::<Sensitivity>).ok()?;
-            Some(state_vector(&run.state()))
-        })
-        .collect()
 }

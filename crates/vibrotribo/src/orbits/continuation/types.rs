@@ -1,12 +1,12 @@
 //! What a continuation returns, and its settings.
 
-use nalgebra::Complex;
+use nalgebra::{Complex, DVector};
 
 use super::super::error::NewtonFailure;
 use super::super::shooting::ShootingOptions;
 use crate::error::{ParamError, check, check_positive};
 use crate::model::ChainState;
-use crate::sensitivity::NonSmoothPoint;
+use crate::sensitivity::{NonSmoothPoint, state_vector};
 
 /// Settings of [`continue_orbit`](super::continue_orbit).
 #[derive(Debug, Clone, PartialEq)]
@@ -140,6 +140,12 @@ impl BranchPoint {
     /// Largest multiplier modulus.
     pub fn spectral_radius(&self) -> f64 {
         self.multipliers.first().map_or(0.0, |l| l.norm())
+    }
+
+    /// The state (at t ≡ 0) a fraction `s` of the way from this point to `other`.
+    pub(super) fn towards(&self, other: &BranchPoint, s: f64) -> DVector<f64> {
+        let z = state_vector(&self.state);
+        &z + (state_vector(&other.state) - &z) * s
     }
 }
 
