@@ -23,6 +23,12 @@ use crate::sensitivity::state_vector;
 /// the length unit L.
 const GRAZING_GAP: f64 = 1e-4;
 
+/// Least distance from an edge, in multiples of the edge's precision, of the branch point
+/// whose slowest impact says whether an impact lost at the edge vanishes there: an impact
+/// vanishing like the square root of the distance to an edge within the precision still
+/// extrapolates to zero within that distance from ten precisions away.
+const BEHIND_PRECISIONS: f64 = 10.0;
+
 /// Pseudo-arclength continuation of the periodic orbit of period `period` near `guess` at
 /// parameter `from`, for the family `family` (any scalar that changes [`ChainParams`],
 /// called `name`), towards `to`; see the [module docs](crate::orbits::continuation).
@@ -212,6 +218,30 @@ enum Followed {
     Known(usize),
 }
 
+/// The slowest impact (contact, closing speed in m/s) of the branch's last point on the
+/// sequence of the edge orbit `edge` that lies at least [`BEHIND_PRECISIONS`] times the
+/// edge's `precision` behind it (and within 1e-3 of the range `p_scale`): where no orbit of
+/// that sequence converges at the fixed distance behind the edge that a crossing tries, the
+/// branch's own points are such orbits.
+fn behind_speed(
+    points: &[BranchPoint],
+    edge: &StepPoint,
+    precision: f64,
+    p_scale: f64,
+) -> Option<(usize, f64)> {
+    let e = &edge.described.point;
+    points
+        .iter()
+        .rev()
+        .take_while(|q| (q.parameter - e.parameter).abs() <= 1e-3 * p_scale)
+        .find(|q| {
+            q.impacts_per_period == e.impacts_per_period
+                && q.sticks == e.sticks
+                && (q.parameter - e.parameter).abs() >= BEHIND_PRECISIONS * precision
+        })?
+        .min_closing_speed
+}
+
 /// The branch followed before (of `branches`, but the parent) that the first point `first`
 /// of a branch leaving the branch point `fork` lies on: nearer a chord between two of its
 /// consecutive points than a quarter of its distance from the branch point, in the units of
@@ -381,7 +411,9 @@ fn follow<F: Fn(f64) -> ChainParams>(
                             &c.before,
                             &c.after,
                             c.precision,
-                            c.behind_speed,
+                            c.behind_speed.or_else(|| {
+                                behind_speed(&branch.points, &c.before, c.precision, problem.p_scale)
+                            }),
                             c.kind,
                         ));
                         // The orbits past the change, up to the first on a branch followed before.
