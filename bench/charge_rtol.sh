@@ -24,13 +24,7 @@ shift || true
 rtols=("$@")
 [ ${#rtols[@]} -eq 0 ] && rtols=(1e-5 1e-4 1e-3 1e-2)
 loads=${LOADS:-1e5}
-bin=${VIBROTRIBO_BIN:-}
-if [ -z "$bin" ]; then
-    cargo build --release -q -p vibrotribo-cli
-    bin=${CARGO_TARGET_DIR:-target}/release/vibrotribo
-fi
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+binary_and_scratch
 
 
 # The figures of one rtol's runs: steps and rejected steps per period (long run), the power

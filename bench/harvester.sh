@@ -20,15 +20,9 @@ cd "$(dirname "$0")/.."
 . bench/timing.sh
 runs=${1:-7}
 long=${2:-1000}
-bin=${VIBROTRIBO_BIN:-}
-if [ -z "$bin" ]; then
-    cargo build --release -q -p vibrotribo-cli
-    bin=${CARGO_TARGET_DIR:-target}/release/vibrotribo
-fi
+binary_and_scratch
 base=${BASE_BIN:-}
 only=${ONLY:-}
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
 
 
 # pair LABEL "A command" "B command": RUNS alternated pairs after one warm-up each; prints

@@ -13,13 +13,7 @@ cd "$(dirname "$0")/.."
 . bench/timing.sh
 runs=${1:-3}
 steps=${2:-81}
-bin=${VIBROTRIBO_BIN:-}
-if [ -z "$bin" ]; then
-    cargo build --release -q -p vibrotribo-cli
-    bin=${CARGO_TARGET_DIR:-target}/release/vibrotribo
-fi
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+binary_and_scratch
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 one() {
     local threads=$1

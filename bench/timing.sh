@@ -10,3 +10,15 @@ cpu() {
 
 # The median of the numbers given.
 median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
+
+# Sets `bin` to $VIBROTRIBO_BIN, or else to the release binary (built here), and `out` to a
+# scratch folder removed when the script exits.
+binary_and_scratch() {
+    bin=${VIBROTRIBO_BIN:-}
+    if [ -z "$bin" ]; then
+        cargo build --release -q -p vibrotribo-cli
+        bin=${CARGO_TARGET_DIR:-target}/release/vibrotribo
+    fi
+    out=$(mktemp -d)
+    trap 'rm -rf "$out"' EXIT
+}
