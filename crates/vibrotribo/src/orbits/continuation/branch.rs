@@ -234,11 +234,7 @@ fn behind_speed(
         .iter()
         .rev()
         .take_while(|q| (q.parameter - e.parameter).abs() <= 1e-3 * p_scale)
-        .find(|q| {
-            q.impacts_per_period == e.impacts_per_period
-                && q.sticks == e.sticks
-                && (q.parameter - e.parameter).abs() >= BEHIND_PRECISIONS * precision
-        })?
+        .find(|q| q.alike(e) && (q.parameter - e.parameter).abs() >= BEHIND_PRECISIONS * precision)?
         .min_closing_speed
 }
 
@@ -602,13 +598,11 @@ fn closes<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, branch: &Branch, 
     };
     let (last, before) = (&branch.points[n - 1], &branch.points[n - 2]);
     // The same orbit has the same impacts: two branches meeting at a non-smooth fold do not.
-    let same =
-        |old: &BranchPoint| old.impacts_per_period == last.impacts_per_period && old.sticks == last.sticks;
     // Arriving: the newest point is within a step of an old one and nearer it than the one
     // before (so that a branch that merely moves slowly is not taken for closed).
-    branch.points[..n - CLOSED_MIN_POINTS]
-        .iter()
-        .position(|old| same(old) && distance(last, old) < ds && distance(last, old) < distance(before, old))
+    branch.points[..n - CLOSED_MIN_POINTS].iter().position(|old| {
+        old.alike(last) && distance(last, old) < ds && distance(last, old) < distance(before, old)
+    })
 }
 
 fn step_floor(parameter: f64, f: Failure) -> BranchEnd {

@@ -48,7 +48,6 @@ pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
     let me = &point.described.point;
     let at = |q: &BranchPoint| problem.point(&state_vector(&q.state), q.parameter);
     let x = at(me);
-    let alike = |q: &BranchPoint| q.impacts_per_period == me.impacts_per_period && q.sticks == me.sticks;
     // Points are reported at t ≡ 0 (mod PT): the confirmation runs on that section.
     let section = problem.with_phase(0.0);
     let z = state_vector(&me.state);
@@ -66,7 +65,7 @@ pub(super) fn runs_onto<F: Fn(f64) -> ChainParams>(
     branches.iter().position(|b| {
         b.period == problem.period
             && b.points.windows(2).any(|w| {
-                if !(alike(&w[0]) && alike(&w[1])) {
+                if !(w[0].alike(me) && w[1].alike(me)) {
                     return false;
                 }
                 let (a, b) = (at(&w[0]), at(&w[1]));

@@ -137,6 +137,12 @@ pub struct BranchPoint {
 }
 
 impl BranchPoint {
+    /// Whether `other` has the same impacts per period at each contact and the same sticking
+    /// (a necessary condition for the two to lie on one smooth family).
+    pub fn alike(&self, other: &BranchPoint) -> bool {
+        self.impacts_per_period == other.impacts_per_period && self.sticks == other.sticks
+    }
+
     /// Largest multiplier modulus.
     pub fn spectral_radius(&self) -> f64 {
         self.multipliers.first().map_or(0.0, |l| l.norm())
