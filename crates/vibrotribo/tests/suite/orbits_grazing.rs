@@ -553,7 +553,12 @@ fn every_point_of_a_branch_is_a_true_orbit() {
 
 /// The orbit through `state` returns to it after `period` excitation periods, and no gap is
 /// negative on the way (sampled 4000 times per period, and at every event).
-fn check_orbit(params: &ChainParams, state: &ChainState, period: u32) {
+pub(crate) fn check_orbit(params: &ChainParams, state: &ChainState, period: u32) {
+    check_orbit_to(params, state, period, 1e-9);
+}
+
+/// [`check_orbit`], returning to `state` within `tolerance` of the length and speed units.
+pub(crate) fn check_orbit_to(params: &ChainParams, state: &ChainState, period: u32, tolerance: f64) {
     let n = params.len();
     let duration = f64::from(period) * params.period();
     let mut sim = Simulator::new(params, state, SimOptions::default()).unwrap();
@@ -568,7 +573,7 @@ fn check_orbit(params: &ChainParams, state: &ChainState, period: u32) {
     for i in 0..2 * n {
         let unit = if i < n { length } else { speed };
         assert!(
-            (z1[i] - z0[i]).abs() <= 1e-9 * unit,
+            (z1[i] - z0[i]).abs() <= tolerance * unit,
             "not periodic: component {i} {} → {} (unit {unit})",
             z0[i],
             z1[i]

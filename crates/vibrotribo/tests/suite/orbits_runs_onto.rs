@@ -7,15 +7,21 @@
 //! there), so that the claim does not rest on the continuation's own test.
 
 use nalgebra::DVector;
+use vibrotribo::ChainParams;
 use vibrotribo::branch::{BranchOptions, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
-    BifurcationKind, BranchEnd, ContinuationOptions, ShootingOptions, find_periodic_orbit,
+    BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions, ShootingOptions,
+    find_periodic_orbit,
 };
 use vibrotribo::sensitivity::{Horizon, state_from_vector, state_vector};
 
 use super::common::default_case::{pitchfork_branches, size};
 use super::common::fd;
+use super::orbits_grazing::check_orbit_to;
+
+/// The continuation parameter of these tests.
+const KEY: &str = "excitation.omega_ratio";
 
 #[test]
 fn the_pitchforks_branches_end_where_they_run_onto_the_first_branch() {
@@ -129,7 +135,9 @@ fn slowest_impact(
 fn an_impact_that_disappears_at_a_grazing_vanishes_there() {
     // The default case's first four branches: the pitchfork's branches lose their
     // eight-impact orbits where those are still striking at ~1e-3 m/s.
-    let (grazings, changes) = lost_impacts(Config::default(), (0.7, 0.3), None, first_four());
+    let config = Config::default();
+    let result = follow(&config, (0.7, 0.3), None, first_four());
+    let (grazings, changes) = lost_impacts(&config, &result, 0.4);
     println!("{grazings} grazings");
     assert!(
         changes >= 2,
@@ -139,19 +147,59 @@ fn an_impact_that_disappears_at_a_grazing_vanishes_there() {
 
 /// The same over every branch `vibrotribo continue` follows by default (16 on this range,
 /// to period 8): deep in the period-doubling window, where the shooting at a fixed distance
-/// behind an edge does not converge, the branch's own points before the edge decide.
+/// behind an edge does not converge, the branch's own points before the edge decide. There,
+/// too, no branch ends at a grazing; every point of every branch is a true orbit by the plain
+/// simulator (it returns to itself after its period, no gap below zero on the way); and at
+/// every grazing crossed the orbit beyond is one born there, next to the edge orbit: no
+/// farther from it than the square-root law allows (the distance, Euclidean in the length
+/// and speed scales, below three times the square root of the parameter step over the
+/// range), not an orbit of another family that has the new sequence.
 #[test]
 fn every_impact_lost_on_the_default_continuation_vanishes_where_called_a_grazing() {
-    let (grazings, changes) = lost_impacts(
-        Config::default(),
-        (0.7, 0.3),
-        None,
-        ContinuationOptions::default(),
-    );
+    let config = Config::default();
+    let result = follow(&config, (0.7, 0.3), None, ContinuationOptions::default());
+    let (grazings, changes) = lost_impacts(&config, &result, 0.4);
     assert!(
         changes >= 5,
         "sequence changes where an impact is lost: {changes} ({grazings} grazings)"
     );
+    let at = |p: f64| at(&config, p);
+    let mut crossed = 0;
+    for (i, b) in result.branches.iter().enumerate() {
+        assert!(
+            !matches!(b.end, BranchEnd::Grazing { .. }),
+            "branch {i} ends at a grazing: {:?}",
+            b.end
+        );
+        for p in &b.points {
+            check_orbit_to(&at(p.parameter), &p.state, b.period, returns_to(p));
+        }
+        for f in &b.bifurcations {
+            let (BifurcationKind::Grazing { appears, .. }, Some(after)) = (&f.kind, &f.after) else {
+                continue;
+            };
+            let params = at(after.parameter);
+            check_orbit_to(&params, &after.state, b.period, returns_to(after));
+            let (z0, z1) = (state_vector(&f.point.state), state_vector(&after.state));
+            let distance = size(&params, &(&z1 - &z0));
+            let step = (after.parameter - f.parameter).abs() / 0.4;
+            println!(
+                "branch {i}: grazing at {:.10} ({}): beyond it {distance:.2e} from the edge orbit {step:.1e} of the range on",
+                f.parameter,
+                if *appears {
+                    "impact appears"
+                } else {
+                    "impact disappears"
+                },
+            );
+            assert!(
+                distance < 3.0 * step.sqrt(),
+                "the orbit beyond is not next to the edge orbit: {distance:e} at {step:e}"
+            );
+            crossed += 1;
+        }
+    }
+    assert!(crossed >= 5, "grazings crossed: {crossed}");
 }
 
 /// The first branch, its first period doubling's branch and the pitchfork's two branches.
@@ -163,23 +211,39 @@ fn first_four() -> ContinuationOptions {
     }
 }
 
-/// Follows `config` over `(from, to)` in Ω with `continuation` and checks every change of
-/// sequence that loses an impact (tests above); the grazings and sequence changes seen.
-fn lost_impacts(
-    config: Config,
+/// How closely a plain run from a branch point's state returns to it after its period, in
+/// the length and speed units: 1e-9, and more for an unstable orbit, whose state the
+/// corrector converges to 1e-11 on its own section and whose run from it amplifies what is
+/// left by its largest multiplier (up to ~1e5 next to a grazing).
+fn returns_to(p: &BranchPoint) -> f64 {
+    1e-9 + 1e-10 * p.spectral_radius()
+}
+
+/// `config`'s branches over `(from, to)` in Ω with `continuation`, as `vibrotribo continue`
+/// follows them.
+fn follow(
+    config: &Config,
     (from, to): (f64, f64),
     period: Option<u32>,
     continuation: ContinuationOptions,
-) -> (usize, usize) {
-    let key = "excitation.omega_ratio";
+) -> Continuation {
     let options = BranchOptions {
         period,
         continuation,
         ..BranchOptions::default()
     };
-    let result = continue_config(&config, key, from, to, None, &options).unwrap();
-    let range = (to - from).abs();
-    let at = |p: f64| config.with(key, toml::Value::Float(p)).unwrap().chain().clone();
+    continue_config(config, KEY, from, to, None, &options).unwrap()
+}
+
+/// The default chain of `config` at Ω = `p`.
+fn at(config: &Config, p: f64) -> ChainParams {
+    config.with(KEY, toml::Value::Float(p)).unwrap().chain().clone()
+}
+
+/// Checks every change of sequence of `result` (over a range `range` wide) that loses an
+/// impact (tests above); the grazings and sequence changes seen.
+fn lost_impacts(config: &Config, result: &Continuation, range: f64) -> (usize, usize) {
+    let at = |p: f64| at(config, p);
     let (mut grazings, mut changes) = (0, 0);
     for (i, b) in result.branches.iter().enumerate() {
         for f in b.bifurcations.iter().filter(|f| f.crossing.is_some()) {

@@ -40,6 +40,7 @@ use nalgebra::DVector;
 use super::corrector::Problem;
 use super::locate::{MAX_LOCATE, StepPoint};
 use super::nordmark::SquareRootModel;
+use super::segments::{Impact, shoot};
 use super::types::{Branch, CrossingKind};
 use crate::dynamics::{EventKind, Simulator};
 use crate::model::ChainParams;
@@ -171,45 +172,57 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
         .and_then(|b| SquareRootModel::new(problem, &ok, b));
     let behind_speed = behind.and_then(|b| b.described.point.min_closing_speed);
     let edge_guesses = guesses(problem, &ok, parameter(&ok));
+    let sequences = new_sequences(problem, &ok);
     // The persistence side first, at every distance: a symmetric orbit that grazes two
-    // contacts at once may also meet orbits striking only one of them at a fold.
-    for (sigma, kind) in [
-        (direction, CrossingKind::Persistence),
-        (-direction, CrossingKind::NonSmoothFold),
-    ] {
-        for step in SIDE_STEPS {
-            let eps = (step * problem.p_scale).max(10.0 * problem.options.location_tolerance);
-            let p = parameter(&ok) + sigma * eps;
-            if p < lo || p > hi {
-                continue;
-            }
-            let predicted = model.as_ref().map_or_else(Vec::new, |m| m.guesses(sigma * eps));
-            let beyond = |z: &DVector<f64>| {
-                orbit_beyond(problem, z, p, arclength(p), signature).filter(|o| {
-                    o.described.signature != *signature
-                        && !came_from.is_some_and(|(q, s)| {
-                            o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
-                        })
-                })
-            };
-            // From the edge's flow first; only then from the flow at p (the clearance a fold's
-            // side opens taken into account), whose gap and gradient cost evaluations of their
-            // own.
-            let found = predicted
-                .iter()
-                .chain(&edge_guesses)
-                .find_map(&beyond)
-                .or_else(|| guesses(problem, &ok, p).iter().skip(1).find_map(&beyond))
-                .or_else(|| known_guesses(problem, known, &ok, p).iter().find_map(&beyond));
-            if let Some(o) = found {
-                return crossed(
-                    problem,
-                    (ok, o),
-                    model.as_ref(),
-                    (precision, behind_speed),
-                    (sigma, kind),
-                    (lo, hi),
-                );
+    // contacts at once may also meet orbits striking only one of them at a fold. Orbits
+    // shot with a prescribed impact sequence only where no guess of the first pass leads to
+    // one, on either side.
+    for prescribed_pass in [false, true] {
+        for (sigma, kind) in [
+            (direction, CrossingKind::Persistence),
+            (-direction, CrossingKind::NonSmoothFold),
+        ] {
+            for step in SIDE_STEPS {
+                let eps = (step * problem.p_scale).max(10.0 * problem.options.location_tolerance);
+                let p = parameter(&ok) + sigma * eps;
+                if p < lo || p > hi {
+                    continue;
+                }
+                let beyond = |z: &DVector<f64>| {
+                    orbit_beyond(problem, z, p, arclength(p), signature).filter(|o| {
+                        o.described.signature != *signature
+                            && !came_from.is_some_and(|(q, s)| {
+                                o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
+                            })
+                    })
+                };
+                let found = if prescribed_pass {
+                    sequences
+                        .iter()
+                        .filter_map(|impacts| prescribed(problem, &ok, impacts, p))
+                        .find_map(|z| beyond(&z))
+                } else {
+                    // From the edge's flow first; only then from the flow at p (the clearance a
+                    // fold's side opens taken into account), whose gap and gradient cost
+                    // evaluations of their own.
+                    let predicted = model.as_ref().map_or_else(Vec::new, |m| m.guesses(sigma * eps));
+                    predicted
+                        .iter()
+                        .chain(&edge_guesses)
+                        .find_map(&beyond)
+                        .or_else(|| guesses(problem, &ok, p).iter().skip(1).find_map(&beyond))
+                        .or_else(|| known_guesses(problem, known, &ok, p).iter().find_map(&beyond))
+                };
+                if let Some(o) = found {
+                    return crossed(
+                        problem,
+                        (ok, o),
+                        model.as_ref(),
+                        (precision, behind_speed),
+                        (sigma, kind),
+                        (lo, hi),
+                    );
+                }
             }
         }
     }
@@ -474,4 +487,95 @@ fn known_guesses<F: Fn(f64) -> ChainParams>(
             Some(state_vector(&run.state()))
         })
         .collect()
+}
+
+/// The impact sequences the orbit with the new sequence may have next to the edge orbit
+/// `edge`, each with the edge's times as guesses: the edge's impacts with the grazing gap's
+/// minimum added as an impact (if it is near zero), and without its slowest impact. None if
+/// the edge orbit sticks or chatters (only sequences of impacts are prescribed).
+fn new_sequences<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, edge: &StepPoint) -> Vec<Vec<Impact>> {
+    let Some(impacts) = impacts_of(problem, edge) else {
+        return Vec::new();
+    };
+    let params = (problem.family)(edge.described.point.parameter);
+    let mut out = Vec::new();
+    let z = problem.state(&edge.ev.u);
+    let sim = &problem.options.shooting.sim;
+    if let Some(m) = smallest_gap_minimum(&params, &z, problem.period, problem.phase, sim)
+        && m.gap < NEAR_GRAZING * problem.scale.length
+    {
+        let mut added = impacts.clone();
+        let at = added.partition_point(|i| i.time < m.time);
+        added.insert(
+            at,
+            Impact {
+                contact: m.contact,
+                time: m.time,
+            },
+        );
+        out.push(added);
+    }
+    let speeds = edge.ev.eval.events.iter().map(|e| e.velocity_before);
+    if let Some(slowest) = speeds
+        .take(impacts.len())
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+    {
+        let mut lost = impacts;
+        lost.remove(slowest);
+        out.push(lost);
+    }
+    out
+}
+
+/// The impacts of the orbit `point` over one period of the problem, in time order; `None` if
+/// it has events of other kinds (sticking, chatter).
+fn impacts_of<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, point: &StepPoint) -> Option<Vec<Impact>> {
+    let params = (problem.family)(point.described.point.parameter);
+    let end = problem.phase + f64::from(problem.period) * params.period();
+    point
+        .ev
+        .eval
+        .events
+        .iter()
+        .filter(|e| e.time < end)
+        .map(|e| {
+            (e.kind == EventKind::Impact).then_some(Impact {
+                contact: e.contact,
+                time: e.time,
+            })
+        })
+        .collect()
+}
+
+/// The start state at `p` of an orbit with the impacts `impacts` near the edge orbit `edge`,
+/// by multiple shooting in the impact times ([`segments`](super::segments)), if that orbit
+/// tends to the edge orbit: shot again a sixteenth as far from the edge, it is at most half
+/// as far from the edge orbit (an orbit born at the edge moves like the distance, or its
+/// square root; a distant orbit with that sequence does not come nearer).
+fn prescribed<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    edge: &StepPoint,
+    impacts: &[Impact],
+    p: f64,
+) -> Option<DVector<f64>> {
+    let p_edge = edge.described.point.parameter;
+    let z_edge = problem.state(&edge.ev.u);
+    let at = |p: f64, z: &DVector<f64>, impacts: &[Impact]| {
+        let params = (problem.family)(p);
+        let duration = f64::from(problem.period) * params.period();
+        shoot(
+            &params,
+            z,
+            impacts,
+            (problem.phase, duration),
+            &problem.scale,
+            &problem.options.shooting.sim,
+        )
+    };
+    let (z, found) = at(p, &z_edge, impacts)?;
+    let (z_near, _) = at(p_edge + (p - p_edge) / 16.0, &z, &found)?;
+    let distance = |z: &DVector<f64>| problem.scale.norm(&(z - &z_edge));
+    (distance(&z_near) <= 0.5 * distance(&z)).then_some(z)
 }

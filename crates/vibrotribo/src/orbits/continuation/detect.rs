@@ -325,6 +325,20 @@ pub(super) fn crossing_point<F: Fn(f64) -> ChainParams>(
     {
         kind = BifurcationKind::SequenceChange;
     }
+    // An orbit born (or lost) at a grazing is continuous with the grazing orbit: it moves
+    // from it like the distance in the parameter, or its square root. One farther from the
+    // edge orbit than the square root of that distance (both in their scales) is an orbit of
+    // another family that has the new sequence.
+    if matches!(kind, BifurcationKind::Grazing { .. }) {
+        let step =
+            (after.described.point.parameter - before.described.point.parameter).abs() / problem.p_scale;
+        let distance = problem
+            .scale
+            .norm(&(problem.state(&after.ev.u) - problem.state(&before.ev.u)));
+        if distance > step.sqrt() {
+            kind = BifurcationKind::SequenceChange;
+        }
+    }
     let nordmark = match kind {
         BifurcationKind::Grazing { appears, .. } => {
             let free = if appears { before } else { after };

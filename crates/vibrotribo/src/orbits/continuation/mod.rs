@@ -54,6 +54,7 @@ mod locate;
 mod nordmark;
 mod onto;
 mod phase;
+mod segments;
 mod switch;
 mod types;
 pub(in crate::orbits) use types::check_path;
