@@ -663,3 +663,60 @@ fn the_impact_oscillators_cascade_is_followed_and_each_doubling_is_where_the_bru
         assert_eq!(after, Some(2 * period), "after the doubling at {p}");
     }
 }
+
+/// The impact oscillator of the tests above followed as `vibrotribo continue` follows it from
+/// the orbit a transient from rest settles on at Ω = 3.6 (period 2) down to 2.4, four
+/// doublings deep: no branch ends at a grazing, and every orbit beyond a grazing crossed, and
+/// every point of a branch within 1e-3 of the range of one, is a true orbit by the engine run
+/// from it for its period, with no gap below zero (to 1e-9 of the units, and 1e-10 times its
+/// largest multiplier, which a run from an unstable orbit amplifies its state's rounding by).
+#[test]
+fn the_impact_oscillators_branches_from_period_two_cross_every_grazing() {
+    let text = format!(
+        "[oscillator]\nmasses = [{M}]\nstiffness = {K}\ndamping = {C}\n\
+         [oscillator.stops.upper]\ngap = {GAP}\nrestitution = {R}\nframe = \"fixed\"\n\
+         [excitation]\namplitude = {A}\nomega_ratio = 3.6\n"
+    );
+    let config = vibrotribo::config::Config::from_toml_str(&text).unwrap();
+    let key = "excitation.omega_ratio";
+    let options = vibrotribo::branch::BranchOptions {
+        continuation: ContinuationOptions {
+            doubling_depth: 4,
+            ..ContinuationOptions::default()
+        },
+        ..vibrotribo::branch::BranchOptions::default()
+    };
+    let result = vibrotribo::branch::continue_config(&config, key, 3.6, 2.4, None, &options).unwrap();
+    let at = |p: f64| config.with(key, toml::Value::Float(p)).unwrap().chain().clone();
+    let tolerance = |p: &vibrotribo::orbits::BranchPoint| 1e-9 + 1e-10 * p.spectral_radius();
+    let mut crossed = 0;
+    for (i, b) in result.branches.iter().enumerate() {
+        println!(
+            "branch {i} (period {}): {} points, {:?}",
+            b.period,
+            b.points.len(),
+            b.end
+        );
+        assert!(
+            !matches!(b.end, BranchEnd::Grazing { .. }),
+            "branch {i} ends at a grazing: {:?}",
+            b.end
+        );
+        for f in &b.bifurcations {
+            let (BifurcationKind::Grazing { .. }, Some(after)) = (&f.kind, &f.after) else {
+                continue;
+            };
+            crossed += 1;
+            check_orbit_to(&at(after.parameter), &after.state, b.period, tolerance(after));
+            for p in b
+                .points
+                .iter()
+                .filter(|p| (p.parameter - f.parameter).abs() < 1.2e-3)
+            {
+                check_orbit_to(&at(p.parameter), &p.state, b.period, tolerance(p));
+            }
+        }
+    }
+    println!("{crossed} grazings crossed");
+    assert!(crossed >= 3, "grazings crossed: {crossed}");
+}

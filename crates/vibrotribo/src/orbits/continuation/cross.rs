@@ -37,7 +37,7 @@
 
 use nalgebra::DVector;
 
-use super::corrector::Problem;
+use super::corrector::{Problem, rounding_floor};
 use super::locate::{MAX_LOCATE, StepPoint};
 use super::nordmark::SquareRootModel;
 use super::segments::{Impact, shoot};
@@ -188,19 +188,19 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
                 if p < lo || p > hi {
                     continue;
                 }
-                let beyond = |z: &DVector<f64>| {
-                    orbit_beyond(problem, z, p, arclength(p), signature).filter(|o| {
-                        o.described.signature != *signature
-                            && !came_from.is_some_and(|(q, s)| {
-                                o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
-                            })
-                    })
+                let fresh = |o: &StepPoint| {
+                    o.described.signature != *signature
+                        && !came_from.is_some_and(|(q, s)| {
+                            o.described.signature == s && (p - q).abs() < 1e-3 * problem.p_scale
+                        })
                 };
+                let beyond =
+                    |z: &DVector<f64>| orbit_beyond(problem, z, p, arclength(p), signature).filter(&fresh);
                 let found = if prescribed_pass {
                     sequences
                         .iter()
                         .filter_map(|impacts| prescribed(problem, &ok, impacts, p))
-                        .find_map(|z| beyond(&z))
+                        .find_map(|z| confirmed(problem, &z, p, arclength(p), signature).filter(&fresh))
                 } else {
                     // From the edge's flow first; only then from the flow at p (the clearance a
                     // fold's side opens taken into account), whose gap and gradient cost
@@ -528,6 +528,66 @@ fn new_sequences<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, edge: &Ste
     }
     out
 }
+
+/// The orbit at `p` with the event sequence of the flow from `z` (a start state shot with a
+/// prescribed impact sequence), if that is not `old`: by Newton's method held to it, or where
+/// that stops above its tolerance, by Newton's method at the fixed parameter with the
+/// corrector's acceptance. Next to a grazing the map's derivative grows like the inverse of
+/// the slow impact's speed, and so does the rounding its residual cannot fall below
+/// ([`rounding_floor`]), which the shooting's own tolerance does not allow for.
+fn confirmed<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    z: &DVector<f64>,
+    p: f64,
+    arclength: f64,
+    old: &[(EventKind, usize)],
+) -> Option<StepPoint> {
+    let keep = flow_sequence(problem, z, p).filter(|s| s != old)?;
+    if let Some(o) = orbit_keeping(problem, z, p, arclength, &keep) {
+        return Some(o);
+    }
+    let params = (problem.family)(p);
+    let end = problem.phase + f64::from(problem.period) * params.period();
+    let dim = problem.dim();
+    let mut u = problem.point(z, p);
+    let mut last = f64::INFINITY;
+    for _ in 0..CONFIRM_ITERATIONS {
+        let ev = problem.evaluate(&u).ok()?;
+        if sequence(&ev.eval.events, end) != keep {
+            return None;
+        }
+        let r = ev.residual.amax();
+        if r <= problem
+            .options
+            .corrector_tolerance
+            .max(rounding_floor(&ev.jacobian))
+        {
+            let described = problem.describe(&ev, arclength)?;
+            return (described.signature == keep).then_some(StepPoint {
+                theta: 0.0,
+                ev,
+                described,
+            });
+        }
+        if r >= last {
+            return None;
+        }
+        last = r;
+        let step = ev
+            .jacobian
+            .columns(0, dim)
+            .into_owned()
+            .lu()
+            .solve(&(-&ev.residual))?;
+        for i in 0..dim {
+            u[i] += step[i];
+        }
+    }
+    None
+}
+
+/// Newton iterations of [`confirmed`] at the fixed parameter.
+const CONFIRM_ITERATIONS: usize = 8;
 
 /// The impacts of the orbit `point` over one period of the problem, in time order; `None` if
 /// it has events of other kinds (sticking, chatter).

@@ -32,6 +32,12 @@ use crate::sensitivity::{Sensitivity, state_from_vector, state_vector};
 /// Converged when the scaled residual is at most this.
 const TOLERANCE: f64 = 1e-12;
 
+/// Below [`TOLERANCE`], Newton's method goes on while it still gains, down to this: a gap
+/// left at an impact of closing speed `v` moves the impact by `gap/v` and the state after it
+/// by about `a·gap/v` (`a` the acceleration), so the slow impacts next to a grazing need the
+/// gaps far below the tolerance for the stroboscopic map to confirm the orbit.
+const ROUNDING: f64 = 1e-16;
+
 /// Newton iterations allowed.
 const MAX_ITERATIONS: usize = 30;
 
@@ -223,7 +229,7 @@ pub(super) fn shoot(
     let (mut r, mut speeds) = system.residual(&u)?;
     for _ in 0..MAX_ITERATIONS {
         let norm = r.amax();
-        if norm <= TOLERANCE {
+        if norm <= ROUNDING {
             break;
         }
         let mut jacobian = DMatrix::zeros(u.len(), u.len());
@@ -246,7 +252,11 @@ pub(super) fn shoot(
             }
             damping *= 0.5;
         }
-        (u, r, speeds) = accepted?;
+        match accepted {
+            Some(next) => (u, r, speeds) = next,
+            None if norm <= TOLERANCE => break,
+            None => return None,
+        }
     }
     if r.amax() > TOLERANCE || speeds.iter().any(|&v| v < 0.0) {
         return None;
