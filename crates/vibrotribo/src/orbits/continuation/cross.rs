@@ -119,43 +119,14 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
 ) -> Option<Bridged> {
     let parameter = |s: &StepPoint| s.described.point.parameter;
     let signature = &current.described.signature;
-    let s0 = current.described.point.arclength;
-    let arclength = |p: f64| s0 + (p - parameter(current)).abs() / problem.p_scale;
-    // 1. Forward, as far as the old sequence goes (at most 1.6e-2 of the range).
-    let mut ok = current.clone();
-    let mut bad = None;
-    for k in 0..FORWARD_TRIES {
-        let p = (parameter(current) + direction * 1e-6 * 4f64.powi(k) * problem.p_scale).clamp(lo, hi);
-        if p == parameter(&ok) {
-            break;
+    let arclength = |p: f64| arclength_at(problem, current, p);
+    let (ok, precision) = match edge(problem, current, direction, (lo, hi))? {
+        Edge::Open(ok) => {
+            let t = problem.tangent(&ok.ev, &along(problem, direction))?;
+            return Some(Bridged::Same(Box::new(ok), t));
         }
-        match orbit_keeping(problem, &problem.state(&ok.ev.u), p, arclength(p), signature) {
-            Some(o) => ok = o,
-            None => {
-                bad = Some(p);
-                break;
-            }
-        }
-    }
-    let Some(mut p_bad) = bad else {
-        if parameter(&ok) == parameter(current) {
-            return None;
-        }
-        let t = problem.tangent(&ok.ev, &along(problem, direction))?;
-        return Some(Bridged::Same(Box::new(ok), t));
+        Edge::At { ok, precision } => (ok, precision),
     };
-    // 2. The edge of the old sequence.
-    for _ in 0..MAX_LOCATE {
-        if (p_bad - parameter(&ok)).abs() <= problem.options.location_tolerance {
-            break;
-        }
-        let p = 0.5 * (parameter(&ok) + p_bad);
-        match orbit_keeping(problem, &problem.state(&ok.ev.u), p, arclength(p), signature) {
-            Some(o) => ok = o,
-            None => p_bad = p,
-        }
-    }
-    let precision = (p_bad - parameter(&ok)).abs();
     // 3. The new sequence on either side of the edge: first where the square-root map puts
     // it, then from the generic guesses.
     let back =
@@ -227,6 +198,63 @@ pub(crate) fn cross<F: Fn(f64) -> ChainParams>(
         }
     }
     None
+}
+
+/// How far the old sequence goes from `current` in the parameter's `direction`.
+enum Edge {
+    /// Past every forward try (or to the range end): the last orbit reached.
+    Open(StepPoint),
+    /// It ends next to `ok`, its last orbit, located to `precision`.
+    At { ok: StepPoint, precision: f64 },
+}
+
+/// The arclength at `p` of an orbit reached from `current` by natural steps.
+fn arclength_at<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, current: &StepPoint, p: f64) -> f64 {
+    current.described.point.arclength + (p - current.described.point.parameter).abs() / problem.p_scale
+}
+
+/// Steps 1 and 2 of [`cross`] (module docs): forward as far as the old sequence goes (at
+/// most 1.6e-2 of the range), then its edge by bisection. `None` if not even the first
+/// step leaves `current` (at the range end).
+fn edge<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    current: &StepPoint,
+    direction: f64,
+    (lo, hi): (f64, f64),
+) -> Option<Edge> {
+    let parameter = |s: &StepPoint| s.described.point.parameter;
+    let signature = &current.described.signature;
+    let arclength = |p: f64| arclength_at(problem, current, p);
+    let mut ok = current.clone();
+    let mut bad = None;
+    for k in 0..FORWARD_TRIES {
+        let p = (parameter(current) + direction * 1e-6 * 4f64.powi(k) * problem.p_scale).clamp(lo, hi);
+        if p == parameter(&ok) {
+            break;
+        }
+        match orbit_keeping(problem, &problem.state(&ok.ev.u), p, arclength(p), signature) {
+            Some(o) => ok = o,
+            None => {
+                bad = Some(p);
+                break;
+            }
+        }
+    }
+    let Some(mut p_bad) = bad else {
+        return (parameter(&ok) != parameter(current)).then_some(Edge::Open(ok));
+    };
+    for _ in 0..MAX_LOCATE {
+        if (p_bad - parameter(&ok)).abs() <= problem.options.location_tolerance {
+            break;
+        }
+        let p = 0.5 * (parameter(&ok) + p_bad);
+        match orbit_keeping(problem, &problem.state(&ok.ev.u), p, arclength(p), signature) {
+            Some(o) => ok = o,
+            None => p_bad = p,
+        }
+    }
+    let precision = (p_bad - parameter(&ok)).abs();
+    Some(Edge::At { ok, precision })
 }
 
 /// The orbit at `p` with the event sequence `keep`, from `z` (Newton's method held to it).
