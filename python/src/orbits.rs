@@ -315,6 +315,10 @@ fn end_to_py<'py>(py: Python<'py>, end: &BranchEnd) -> PyResult<Bound<'py, PyDic
             d.set_item("parameter", parameter)?;
             "closed"
         }
+        BranchEnd::Retraced { parameter } => {
+            d.set_item("parameter", parameter)?;
+            "retraced"
+        }
         BranchEnd::Rejoined { parameter, branch } => {
             d.set_item("parameter", parameter)?;
             d.set_item("branch", branch)?;

@@ -544,7 +544,8 @@ class Branch(Display):
         end: why the branch ended: ``reason`` (``range_end``, ``max_points``,
             ``step_floor``, ``grazing``, ``cascade_depth``, ``unlocated`` with the
             ``between`` bracket of a multiplier near −1 that could not be located,
-            ``switch_failed``, ``collapsed``, ``closed``, ``rejoined`` with the ``branch``
+            ``switch_failed``, ``collapsed``, ``closed``, ``retraced`` (back on its own
+            orbits going the other way), ``rejoined`` with the ``branch``
             it reached, ``runs_onto`` with the ``branch`` it ran onto past a change of
             sequence, ``stopped``) and its details.
     """

@@ -204,6 +204,9 @@ pub fn end_text(end: &BranchEnd) -> String {
         }
         BranchEnd::Collapsed { parameter } => format!("fell back onto the half-period orbit at {parameter}"),
         BranchEnd::Closed { parameter } => format!("closes on itself at {parameter} (followed once round)"),
+        BranchEnd::Retraced { parameter } => format!(
+            "turns back along its own orbits at {parameter} past a change of sequence (from there on it repeats them in reverse)"
+        ),
         BranchEnd::Rejoined { parameter, branch } => {
             format!("reaches the branch point of branch {branch} at {parameter}, followed from there")
         }

@@ -670,6 +670,9 @@ fn the_impact_oscillators_cascade_is_followed_and_each_doubling_is_where_the_bru
 /// every point of a branch within 1e-3 of the range of one, is a true orbit by the engine run
 /// from it for its period, with no gap below zero (to 1e-9 of the units, and 1e-10 times its
 /// largest multiplier, which a run from an unstable orbit amplifies its state's rounding by).
+/// The period-2 branch crosses a grazing onto a short stretch of orbits with one more impact,
+/// whose impact vanishes again, and is then back on its own orbits going the other way: it
+/// ends `retraced`, and its last orbit is the one shooting finds from its earlier points.
 #[test]
 fn the_impact_oscillators_branches_from_period_two_cross_every_grazing() {
     let text = format!(
@@ -719,4 +722,50 @@ fn the_impact_oscillators_branches_from_period_two_cross_every_grazing() {
     }
     println!("{crossed} grazings crossed");
     assert!(crossed >= 3, "grazings crossed: {crossed}");
+    // A branch that ends `retraced` is back on its own orbits going the other way: shooting
+    // from the chord of two of its earlier points around its last parameter (same impacts)
+    // finds its last orbit, and along that chord the parameter moved the other way.
+    let shooting = ShootingOptions::default();
+    let mut retraced = 0;
+    for b in result
+        .branches
+        .iter()
+        .filter(|b| matches!(b.end, BranchEnd::Retraced { .. }))
+    {
+        let [.., before, last] = &b.points[..] else {
+            panic!("a retraced branch with one point");
+        };
+        let params = at(last.parameter);
+        let z = state_vector(&last.state);
+        let back = b.points[..b.points.len() - 8].windows(2).any(|w| {
+            let (p0, p1) = (w[0].parameter, w[1].parameter);
+            if !(w[0].alike(last) && w[1].alike(last)) || (p0 - last.parameter) * (p1 - last.parameter) > 0.0
+            {
+                return false;
+            }
+            let s = (last.parameter - p0) / (p1 - p0);
+            let (a, c) = (state_vector(&w[0].state), state_vector(&w[1].state));
+            let guess = &a + (c - &a) * s;
+            let Ok(orbit) = vibrotribo::orbits::find_periodic_orbit(
+                &params,
+                &vibrotribo::sensitivity::state_from_vector(guess.as_slice()),
+                b.period,
+                &shooting,
+            ) else {
+                return false;
+            };
+            let d = crate::common::default_case::size(&params, &(state_vector(&orbit.state) - &z));
+            d < 1e-6 && (p1 - p0) * (last.parameter - before.parameter) < 0.0
+        });
+        assert!(
+            back,
+            "a branch ending retraced at {} is not back on its own orbits",
+            last.parameter
+        );
+        retraced += 1;
+    }
+    assert!(
+        retraced >= 1,
+        "the period-2 branch turns back past its grazing's short stretch"
+    );
 }

@@ -3,6 +3,8 @@
 
 use std::collections::VecDeque;
 
+use nalgebra::DVector;
+
 use super::corrector::{Failure, Problem};
 use super::cross::{Bridged, cross};
 use super::detect::{Context, Ending, KnownBranchPoint, crossing_point, detect};
@@ -517,9 +519,12 @@ fn follow<F: Fn(f64) -> ChainParams>(
             return Followed::New(Box::new(branch), doublings);
         }
         branch.points.push(target.described.point.clone());
-        if let Some(k) = closes(&problem, &branch, ds) {
-            branch.end = BranchEnd::Closed {
-                parameter: branch.points[k].parameter,
+        if let Some((k, back)) = closes(&problem, &branch, ds) {
+            let parameter = branch.points[k].parameter;
+            branch.end = if back {
+                BranchEnd::Retraced { parameter }
+            } else {
+                BranchEnd::Closed { parameter }
             };
             return Followed::New(Box::new(branch), doublings);
         }
@@ -579,11 +584,17 @@ fn falls_back(
 /// Points a branch must have before it can be found closed.
 const CLOSED_MIN_POINTS: usize = 8;
 
-/// The earlier point the branch's newest point is back at (within a step `ds` in the scaled
-/// units of the state and the parameter), if any: from there on the branch repeats itself.
-/// A smooth solution curve can only come back to its first point (a closed curve); one with
-/// corners (non-smooth points crossed by [`cross`]) can also run into a loop further on.
-fn closes<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, branch: &Branch, ds: f64) -> Option<usize> {
+/// The earlier point the branch's newest point is back at (the nearest within a step `ds`
+/// in the scaled units of the state and the parameter), if any, and whether it arrives going the other way
+/// (its last step against the branch's step from that point): from there on the branch
+/// repeats itself, forwards or in reverse. A smooth solution curve can only come back to its
+/// first point (a closed curve); one with corners (non-smooth points crossed by [`cross`])
+/// can also run into a loop further on, or back along its own path.
+fn closes<F: Fn(f64) -> ChainParams>(
+    problem: &Problem<'_, F>,
+    branch: &Branch,
+    ds: f64,
+) -> Option<(usize, bool)> {
     let n = branch.points.len();
     if n < CLOSED_MIN_POINTS {
         return None;
@@ -600,9 +611,29 @@ fn closes<F: Fn(f64) -> ChainParams>(problem: &Problem<'_, F>, branch: &Branch, 
     // The same orbit has the same impacts: two branches meeting at a non-smooth fold do not.
     // Arriving: the newest point is within a step of an old one and nearer it than the one
     // before (so that a branch that merely moves slowly is not taken for closed).
-    branch.points[..n - CLOSED_MIN_POINTS].iter().position(|old| {
-        old.alike(last) && distance(last, old) < ds && distance(last, old) < distance(before, old)
-    })
+    // The nearest such point: where a fold has brought the branch past the same parameter
+    // twice, its two stretches there are both within a step.
+    let (k, _) = branch.points[..n - CLOSED_MIN_POINTS]
+        .iter()
+        .enumerate()
+        .filter(|(_, old)| {
+            old.alike(last) && distance(last, old) < ds && distance(last, old) < distance(before, old)
+        })
+        .min_by(|a, b| distance(last, a.1).total_cmp(&distance(last, b.1)))?;
+    let scaled = |a: &BranchPoint| {
+        let z = state_vector(&a.state);
+        let n = z.len() / 2;
+        DVector::from_fn(z.len() + 1, |i, _| {
+            if i < z.len() {
+                z[i] / problem.scale.of_component(i, n)
+            } else {
+                a.parameter / problem.p_scale
+            }
+        })
+    };
+    let arriving = scaled(last) - scaled(before);
+    let onward = scaled(&branch.points[k + 1]) - scaled(&branch.points[k]);
+    Some((k, arriving.dot(&onward) < 0.0))
 }
 
 fn step_floor(parameter: f64, f: Failure) -> BranchEnd {

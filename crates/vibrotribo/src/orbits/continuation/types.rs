@@ -404,6 +404,14 @@ pub enum BranchEnd {
         /// Parameter of the point it came back to.
         parameter: f64,
     },
+    /// The branch came back to one of its earlier points going the other way: past a change
+    /// of the event sequence crossed (a short stretch of orbits with another sequence, left
+    /// again at a second change) it is back on its own orbits, heading back along them, and
+    /// from there on it would repeat them in reverse.
+    Retraced {
+        /// Parameter of the point it came back to.
+        parameter: f64,
+    },
     /// The branch reached a branch point found earlier on another branch (`branch`), where
     /// it crosses that one: the branches beyond leave that branch point and are followed
     /// from there.
@@ -435,8 +443,8 @@ pub enum BranchEnd {
 
 impl BranchEnd {
     /// Its name in files: `range_end`, `max_points`, `step_floor`, `grazing`,
-    /// `cascade_depth`, `unlocated`, `switch_failed`, `collapsed`, `closed`, `rejoined`,
-    /// `stopped`.
+    /// `cascade_depth`, `unlocated`, `switch_failed`, `collapsed`, `closed`, `retraced`,
+    /// `rejoined`, `runs_onto`, `stopped`.
     pub fn name(&self) -> &'static str {
         match self {
             BranchEnd::RangeEnd { .. } => "range_end",
@@ -448,6 +456,7 @@ impl BranchEnd {
             BranchEnd::SwitchFailed { .. } => "switch_failed",
             BranchEnd::Collapsed { .. } => "collapsed",
             BranchEnd::Closed { .. } => "closed",
+            BranchEnd::Retraced { .. } => "retraced",
             BranchEnd::Rejoined { .. } => "rejoined",
             BranchEnd::RunsOnto { .. } => "runs_onto",
             BranchEnd::Stopped { .. } => "stopped",
@@ -466,6 +475,7 @@ impl BranchEnd {
             | BranchEnd::SwitchFailed { parameter }
             | BranchEnd::Collapsed { parameter }
             | BranchEnd::Closed { parameter }
+            | BranchEnd::Retraced { parameter }
             | BranchEnd::Rejoined { parameter, .. }
             | BranchEnd::RunsOnto { parameter, .. }
             | BranchEnd::Stopped { parameter } => Some(*parameter),
