@@ -570,10 +570,10 @@ fn confirmed<F: Fn(f64) -> ChainParams>(
     arclength: f64,
     old: &[(EventKind, usize)],
 ) -> Option<StepPoint> {
-    let keep = flow_sequence(problem, z, p).filter(|s| s != old)?;
-    if let Some(o) = orbit_keeping(problem, z, p, arclength, &keep) {
+    if let Some(o) = orbit_beyond(problem, z, p, arclength, old) {
         return Some(o);
     }
+    let keep = flow_sequence(problem, z, p).filter(|s| s != old)?;
     let params = (problem.family)(p);
     let end = problem.phase + f64::from(problem.period) * params.period();
     let dim = problem.dim();
