@@ -11,14 +11,13 @@ use vibrotribo::ChainParams;
 use vibrotribo::branch::{BranchOptions, continue_config};
 use vibrotribo::config::Config;
 use vibrotribo::orbits::{
-    BifurcationKind, BranchEnd, BranchPoint, Continuation, ContinuationOptions, ShootingOptions,
-    find_periodic_orbit,
+    BifurcationKind, BranchEnd, Continuation, ContinuationOptions, ShootingOptions, find_periodic_orbit,
 };
 use vibrotribo::sensitivity::{Horizon, state_from_vector, state_vector};
 
 use super::common::default_case::{pitchfork_branches, size};
 use super::common::fd;
-use super::orbits_grazing::check_orbit_to;
+use super::orbits_grazing::check_branch_point;
 
 /// The continuation parameter of these tests.
 const KEY: &str = "excitation.omega_ratio";
@@ -172,14 +171,14 @@ fn every_impact_lost_on_the_default_continuation_vanishes_where_called_a_grazing
             b.end
         );
         for p in &b.points {
-            check_orbit_to(&at(p.parameter), &p.state, b.period, returns_to(p));
+            check_branch_point(&at(p.parameter), p, b.period);
         }
         for f in &b.bifurcations {
             let (BifurcationKind::Grazing { appears, .. }, Some(after)) = (&f.kind, &f.after) else {
                 continue;
             };
             let params = at(after.parameter);
-            check_orbit_to(&params, &after.state, b.period, returns_to(after));
+            check_branch_point(&params, after, b.period);
             let (z0, z1) = (state_vector(&f.point.state), state_vector(&after.state));
             let distance = size(&params, &(&z1 - &z0));
             let step = (after.parameter - f.parameter).abs() / 0.4;
@@ -209,14 +208,6 @@ fn first_four() -> ContinuationOptions {
         max_branches: 4,
         ..ContinuationOptions::default()
     }
-}
-
-/// How closely a plain run from a branch point's state returns to it after its period, in
-/// the length and speed units: 1e-9, and more for an unstable orbit, whose state the
-/// corrector converges to 1e-11 on its own section and whose run from it amplifies what is
-/// left by its largest multiplier (up to ~1e5 next to a grazing).
-fn returns_to(p: &BranchPoint) -> f64 {
-    1e-9 + 1e-10 * p.spectral_radius()
 }
 
 /// `config`'s branches over `(from, to)` in Ω with `continuation`, as `vibrotribo continue`

@@ -3,8 +3,6 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::DVector;
-
 use super::corrector::{Failure, Problem};
 use super::cross::{Bridged, cross};
 use super::detect::{Context, Ending, KnownBranchPoint, crossing_point, detect};
@@ -620,17 +618,7 @@ fn closes<F: Fn(f64) -> ChainParams>(
             old.alike(last) && distance(last, old) < ds && distance(last, old) < distance(before, old)
         })
         .min_by(|a, b| distance(last, a.1).total_cmp(&distance(last, b.1)))?;
-    let scaled = |a: &BranchPoint| {
-        let z = state_vector(&a.state);
-        let n = z.len() / 2;
-        DVector::from_fn(z.len() + 1, |i, _| {
-            if i < z.len() {
-                z[i] / problem.scale.of_component(i, n)
-            } else {
-                a.parameter / problem.p_scale
-            }
-        })
-    };
+    let scaled = |a: &BranchPoint| problem.point(&state_vector(&a.state), a.parameter);
     let arriving = scaled(last) - scaled(before);
     let onward = scaled(&branch.points[k + 1]) - scaled(&branch.points[k]);
     Some((k, arriving.dot(&onward) < 0.0))

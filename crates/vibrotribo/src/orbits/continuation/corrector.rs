@@ -77,6 +77,16 @@ impl<F: Fn(f64) -> ChainParams> Problem<'_, F> {
         }
     }
 
+    /// The problem's period `P·T` for the chain `params`, s.
+    pub fn duration(&self, params: &ChainParams) -> f64 {
+        f64::from(self.period) * params.period()
+    }
+
+    /// The end of that period from the section, `θ + P·T`, s.
+    pub fn end(&self, params: &ChainParams) -> f64 {
+        self.phase + self.duration(params)
+    }
+
     pub fn dim(&self) -> usize {
         2 * self.n()
     }
@@ -220,7 +230,7 @@ impl<F: Fn(f64) -> ChainParams> Problem<'_, F> {
         let phi = ev.eval.stm.as_ref().ok()?;
         let multipliers = floquet_multipliers(phi).ok()?;
         let params = (self.family)(self.parameter(&ev.u));
-        let end = self.phase + f64::from(self.period) * params.period();
+        let end = self.end(&params);
         let events: Vec<_> = ev.eval.events.iter().filter(|e| e.time < end).copied().collect();
         let mut impacts = vec![0.0; params.contact_count()];
         for e in events.iter().filter(|e| e.kind == EventKind::Impact) {

@@ -240,7 +240,7 @@ impl SquareRootModel {
         };
         let params = (problem.family)(p);
         let opts = &problem.options.shooting;
-        let end = problem.phase + f64::from(problem.period) * params.period();
+        let end = problem.end(&params);
         let contact = self.contact;
         let dim = z0.len();
         let mut z = z0.clone();

@@ -48,7 +48,7 @@ pub(crate) fn move_section<F: Fn(f64) -> ChainParams>(
 ) -> Option<(f64, StepPoint, DVector<f64>)> {
     let p = point.described.point.parameter;
     let params = (problem.family)(p);
-    let duration = f64::from(problem.period) * params.period();
+    let duration = problem.duration(&params);
     let mut o = offsets(&point.ev.eval.events, problem.phase, duration);
     o.sort_by(f64::total_cmp);
     let (first, last) = (*o.first()?, *o.last()?);

@@ -99,15 +99,11 @@ impl Segments<'_> {
 
     /// Position and velocity of a stop's frame at `t`, m and m/s.
     fn frame(&self, frame: StopFrame, t: f64) -> (f64, f64) {
-        match frame {
-            StopFrame::Fixed => (0.0, 0.0),
-            StopFrame::Base => {
-                let w = self.params.omega();
-                let a = self.params.excitation.amplitude;
-                let (s, c) = (w * t.rem_euclid(self.params.period())).sin_cos();
-                (a * s, a * w * c)
-            }
-        }
+        let w = self.params.omega();
+        let a = self.params.excitation.amplitude;
+        let (s, c) = (w * t.rem_euclid(self.params.period())).sin_cos();
+        let [y, yd, ..] = ChainParams::frame_motion(frame, a * s, a * w * c, w);
+        (y, yd)
     }
 
     /// The gap of `contact` in state `z` at `t`, m, and its rate, m/s.
